@@ -1,0 +1,3 @@
+"""egosearch: a reproducible benchmark for learned egocentric object search."""
+
+__version__ = "0.1.0"

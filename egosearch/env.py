@@ -1,0 +1,221 @@
+"""The search task of paper 4.1 as a ``gymnasium.Env``.
+
+Observation (a ``Dict``):
+- ``depth``: the last K = 5 depth frames, oldest first, uint8 100x100, depth / 5 m * 255; at
+  reset the first frame is repeated K times;
+- ``mask``: the 29-d mask feature [xc, yc, r, alpha, 5x5 mask] plus a visibility flag;
+- ``proprio``: (q_p, q_y, last change of q_p, last change of q_y); zeros for the head-off body.
+
+Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.agent.AgentSpec`
+(head-off: [dx, dy, dtheta]).
+
+Reward: r = 1.0 r_s + 1.0 r_d + 1.0 r_l + 0.1 r_c with r_s = 10 on success, r_d = minus the
+distance to the target while it is seen (else 0), r_l = -0.1 and r_c = clip(-0.1 n_col, -3, 0)
+over the episode's collision count.
+
+Two ways to start an episode:
+- training (no scenario given): a random target on the placement scheme's surfaces, a random
+  collision-free start, camera height U[1.0, 1.8] m per episode plus U[-0.1, 0.1] m per step;
+- evaluation: ``reset(options={"scenario": s})`` with an :class:`egosearch.scenarios.Scenario`,
+  at its fixed height without noise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from egosearch.agent import AgentSpec, AgentState, check_height
+from egosearch.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario, check_placement, navgrid_for
+from egosearch.scene import layouts as layouts_mod
+from egosearch.scene.objects import TARGET_OBJECTS, get_object
+from egosearch.scene.parts import Part
+from egosearch.scene.placement import sample_target
+from egosearch.sensor import DepthMaskSensor, mask_feature
+from egosearch.world import World
+
+FRAME_HISTORY = 5
+"""K of paper 4.1."""
+IMAGE_SIZE = 100
+"""Rendered side (px); the learner crops 84x84 from it (paper Table 2)."""
+MASK_FEATURE_DIM = 30
+REWARD_WEIGHTS = (1.0, 1.0, 1.0, 0.1)
+"""[w_s, w_d, w_l, w_c] of paper eq. 2."""
+SUCCESS_REWARD = 10.0
+LIVE_PENALTY = -0.1
+COLLISION_PENALTY_PER_HIT = -0.1
+COLLISION_PENALTY_FLOOR = -3.0
+
+
+def reward_terms(success: bool, visible: bool, distance: float, n_collisions: int) -> dict[str, float]:
+    """The four terms of paper eq. 2 and their weighted sum."""
+    terms = {
+        "r_s": SUCCESS_REWARD if success else 0.0,
+        "r_d": -distance if visible else 0.0,
+        "r_l": LIVE_PENALTY,
+        "r_c": float(np.clip(COLLISION_PENALTY_PER_HIT * n_collisions, COLLISION_PENALTY_FLOOR, 0.0)),
+    }
+    terms["reward"] = float(sum(w * terms[k] for w, k in zip(REWARD_WEIGHTS, ("r_s", "r_d", "r_l", "r_c"))))
+    return terms
+
+
+def target_distance(state: AgentState, target: Part, body_radius: float) -> float:
+    """Horizontal distance from the body's surface to the target's centre (m, >= 0)."""
+    d = math.hypot(target.center[0] - state.x, target.center[1] - state.y) - body_radius
+    return max(0.0, d)
+
+
+class SearchEnv(gymnasium.Env):
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 1.0 / 0.15}
+
+    def __init__(self, layout: str = "kitchen_living", placement: str = "everywhere",
+                 head: bool = True, height: float | None = None, height_noise: bool | None = None,
+                 max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
+                 render_mode: str | None = None):
+        """
+        Args:
+            layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
+            placement: ``no_low_cabinets`` or ``everywhere``.
+            head: False for the head-off body (camera fixed to the body).
+            height: fixed camera height (m); None draws it per episode as in training.
+            height_noise: per-step height noise; default on exactly when ``height`` is None.
+            max_steps: T_max.
+            objects: target object names to draw from in training (default: all).
+            render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
+        """
+        self.scene = layouts_mod.get_scene(layout)
+        self.layout = layout
+        self.placement = check_placement(placement)
+        self.fixed_height = None if height is None else check_height(height)
+        self.height_noise = (height is None) if height_noise is None else bool(height_noise)
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode={render_mode!r}; allowed: None, rgb_array")
+        self.render_mode = render_mode
+        self.max_steps = int(max_steps)
+        self.objects = tuple(objects) if objects else tuple(sorted(TARGET_OBJECTS))
+        for name in self.objects:
+            get_object(name)
+        self.spec_agent = replace(AgentSpec(), head=bool(head))
+        self._scale = self.spec_agent.action_scale()
+        self.world = World(self.scene, self.spec_agent)
+        self.sensor = DepthMaskSensor(self.scene, width=IMAGE_SIZE, height=IMAGE_SIZE)
+        self.observation_space = spaces.Dict({
+            "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
+            "mask": spaces.Box(-4.0, 4.0, (MASK_FEATURE_DIM,), np.float32),
+            "proprio": spaces.Box(-4.0, 4.0, (4,), np.float32),
+        })
+        self.action_space = spaces.Box(-1.0, 1.0, (self.spec_agent.action_dim,), np.float32)
+        self._frames = np.zeros((FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8)
+        self._last_depth = self._last_mask = None
+
+    # -- episode ---------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        rng = self.np_random
+        scenario: Scenario | None = (options or {}).get("scenario")
+        spec = self.spec_agent
+        if scenario is not None:
+            if scenario.layout != self.layout:
+                raise ValueError(f"scenario layout={scenario.layout!r} but this env is {self.layout!r}")
+            self.target = scenario.target()
+            x, y, theta = scenario.start_x, scenario.start_y, scenario.start_theta
+            self.base_height = scenario.height
+            self.scenario_id = scenario.scenario_id
+        else:
+            self.target = sample_target(self.scene, get_object(self.objects[int(rng.integers(len(self.objects)))]),
+                                        self.placement, rng)
+            x, y, theta = self._random_start(rng)
+            lo, hi = spec.train_height_range
+            self.base_height = self.fixed_height if self.fixed_height is not None else float(rng.uniform(lo, hi))
+            self.scenario_id = -1
+        self.sensor.set_target(self.target)
+        self.world.reset_agent(x, y, theta)
+        pitch = 0.0 if spec.head else spec.fixed_pitch
+        self.state = AgentState(x, y, theta, pitch, 0.0, self._camera_height(rng, scenario is None))
+        self.steps = 0
+        self.collisions = 0
+        self.path_length = 0.0
+        self._dq = np.zeros(2)
+        depth, mask = self._sense()
+        self._frames[:] = depth
+        return self._observation(mask), self._info(mask.any(), False)
+
+    def _random_start(self, rng) -> tuple[float, float, float]:
+        grid = navgrid_for(self.layout)
+        rows, cols = np.nonzero(grid.main_region)
+        for _ in range(1000):
+            i = int(rng.integers(len(rows)))
+            x, y = grid.center(rows[i], cols[i])
+            if self.world.is_free(x, y, margin=0.01):
+                return x, y, float(rng.uniform(-math.pi, math.pi))
+        raise RuntimeError(f"no collision-free start found in {self.layout}")
+
+    def _camera_height(self, rng, noisy: bool) -> float:
+        if self.height_noise and noisy:
+            return self.base_height + float(rng.uniform(-self.spec_agent.height_noise, self.spec_agent.height_noise))
+        return self.base_height
+
+    def step(self, action):
+        spec, s = self.spec_agent, self.state
+        a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0) * self._scale
+        (x, y, theta), collided = self.world.move(a[0], a[1], a[2])
+        self.path_length += math.hypot(x - s.x, y - s.y)
+        s.x, s.y, s.theta = x, y, theta
+        if spec.head:
+            pitch = float(np.clip(s.pitch + a[3], *spec.pitch_limits))
+            head_yaw = float(np.clip(s.head_yaw + a[4], *spec.yaw_limits))
+            self._dq = np.array([pitch - s.pitch, head_yaw - s.head_yaw])
+            s.pitch, s.head_yaw = pitch, head_yaw
+        s.camera_height = self._camera_height(self.np_random, self.scenario_id < 0)
+        self.collisions += int(collided)
+        self.steps += 1
+        depth, mask = self._sense()
+        self._frames[:-1] = self._frames[1:]
+        self._frames[-1] = depth
+        visible = bool(mask.any())
+        distance = target_distance(s, self.target, spec.body_radius)
+        success = visible and distance <= SUCCESS_DISTANCE
+        terms = reward_terms(success, visible, distance, self.collisions)
+        truncated = not success and self.steps >= self.max_steps
+        info = self._info(visible, success, distance)
+        info.update(terms, collided=collided)
+        return self._observation(mask), terms["reward"], success, truncated, info
+
+    # -- sensing ---------------------------------------------------------------------------
+    def _sense(self):
+        s = self.state
+        depth, mask = self.sensor.render_uint8(s.camera_position, s.camera_yaw, s.pitch)
+        self._last_depth, self._last_mask = depth, mask
+        return depth, mask
+
+    def _observation(self, mask: np.ndarray) -> dict:
+        s = self.state
+        proprio = np.zeros(4, np.float32)
+        if self.spec_agent.head:
+            proprio[:] = (s.pitch, s.head_yaw, self._dq[0], self._dq[1])
+        return {"depth": self._frames.copy(), "mask": mask_feature(mask).astype(np.float32),
+                "proprio": proprio}
+
+    def _info(self, visible: bool, success: bool, distance: float | None = None) -> dict:
+        s = self.state
+        if distance is None:
+            distance = target_distance(s, self.target, self.spec_agent.body_radius)
+        return {"success": bool(success), "visible": bool(visible), "distance": float(distance),
+                "collisions": self.collisions, "path_length": self.path_length, "steps": self.steps,
+                "scenario_id": self.scenario_id, "camera_height": s.camera_height,
+                "pose": (s.x, s.y, s.theta, s.pitch, s.head_yaw)}
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        from egosearch.render import depth_to_colormap
+
+        return depth_to_colormap(self._last_depth.astype(np.float32) / 255.0 * self.sensor.max_depth,
+                                 self._last_mask, max_depth=self.sensor.max_depth)
+
+    def close(self):
+        self.world.close()

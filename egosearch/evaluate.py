@@ -1,0 +1,82 @@
+"""A policy over a scenario set -> one row per episode."""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+
+import gymnasium
+
+import egosearch.envs  # noqa: F401  (registers the ids)
+from egosearch.metrics import episode_spl
+from egosearch.scenarios import Scenario
+
+EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl",
+                   "collisions", "episode_return")
+
+
+def make_env(env_id: str, scenario: Scenario, **kwargs) -> gymnasium.Env:
+    """An env for the scenario's home, at its camera height and placement scheme."""
+    return gymnasium.make(env_id, layout=scenario.layout, placement=scenario.placement,
+                          height=scenario.height, **kwargs)
+
+
+def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0) -> dict:
+    """One deterministic episode of ``policy`` on ``scenario``."""
+    obs, info = env.reset(seed=seed, options={"scenario": scenario})
+    policy.reset(seed=seed)
+    total = 0.0
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy.act(obs))
+        total += float(reward)
+        done = terminated or truncated
+    success = bool(info["success"])
+    return {
+        "scenario_id": scenario.scenario_id,
+        "success": int(success),
+        "steps": info["steps"],
+        "path_length": round(info["path_length"], 4),
+        "shortest_path": scenario.shortest_path,
+        "spl": round(episode_spl(success, scenario.shortest_path, info["path_length"]), 5),
+        "collisions": info["collisions"],
+        "episode_return": round(total, 4),
+    }
+
+
+def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
+             progress: bool = False, desc: str = "evaluate") -> list[dict]:
+    """Run ``make_policy(env)`` on every scenario; the env is rebuilt only when the home or
+    height changes."""
+    rows, env, env_key, policy = [], None, None, None
+    iterator = scenarios
+    if progress:
+        from tqdm import tqdm
+
+        iterator = tqdm(scenarios, desc=desc, unit="ep")
+    try:
+        for sc in iterator:
+            key = (sc.layout, sc.placement, sc.height)
+            if key != env_key:
+                if env is not None:
+                    env.close()
+                env, env_key = make_env(env_id, sc), key
+                policy = make_policy(env)
+            rows.append(run_episode(env, policy, sc, seed=seed + sc.scenario_id))
+    finally:
+        if env is not None:
+            env.close()
+    return rows
+
+
+def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
+    """Fixed columns, written atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=EPISODE_COLUMNS)
+        writer.writeheader()
+        writer.writerows(rows)
+    os.replace(tmp, path)

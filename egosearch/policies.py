@@ -1,0 +1,130 @@
+"""Searchers that share one interface, so evaluation and the replanner never ask which they hold.
+
+A policy has ``reset(seed=None)`` (called at the start of every episode) and
+``act(obs) -> np.ndarray`` (a normalised action in [-1, 1]). The learned actor lives in
+:mod:`egosearch.rl.train` (``ActorPolicy``) and follows the same interface.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+import numpy as np
+
+from egosearch.agent import wrap_angle
+from egosearch.navgrid import NavGrid
+from egosearch.scenarios import navgrid_for, success_region
+
+
+class Policy(Protocol):
+    def reset(self, seed: int | None = None) -> None: ...
+
+    def act(self, obs: dict) -> np.ndarray: ...
+
+
+class RandomPolicy:
+    """The floor: uniform random actions."""
+
+    def __init__(self, action_dim: int, seed: int = 0):
+        self.action_dim = action_dim
+        self.rng = np.random.default_rng(seed)
+
+    def reset(self, seed: int | None = None) -> None:
+        if seed is not None:
+            self.rng = np.random.default_rng(seed)
+
+    def act(self, obs: dict) -> np.ndarray:
+        return self.rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32)
+
+
+class OraclePolicy:
+    """A privileged searcher that proves the task solvable: it knows the target, walks the
+    geodesic shortest path to the nearest pose that sees it, and aims the camera at it.
+
+    It reads the env's hidden state (``env.unwrapped``), which a learned policy never sees.
+    """
+
+    #: How far ahead along the path the body aims (m): smooths the grid's zig-zags.
+    LOOKAHEAD = 0.35
+    #: Extra clearance the oracle keeps from obstacles beyond the body radius (m).
+    MARGIN = 0.04
+
+    def __init__(self, env):
+        self.env = env.unwrapped
+        self._episode_key = None
+
+    def reset(self, seed: int | None = None) -> None:
+        self._episode_key = None
+
+    def _plan(self) -> None:
+        env = self.env
+        base: NavGrid = navgrid_for(env.layout)
+        self.grid = _margin_grid(env.layout, self.MARGIN)
+        region = success_region(env.layout, env.target, env.base_height)
+        goal = region & self.grid.free
+        if not goal.any():
+            goal, self.grid = region, base
+        self.dist = self.grid.distances_to(goal)
+        gx, gy = np.meshgrid(self.grid.xs, self.grid.ys)
+        self._cells_xy = (gx, gy)
+
+    def act(self, obs: dict) -> np.ndarray:
+        env = self.env
+        key = (id(env.target), env.scenario_id, env.base_height)
+        if env.steps == 0 or key != self._episode_key:
+            self._plan()
+            self._episode_key = key
+        s, spec, target = env.state, env.spec_agent, env.target
+        wx, wy = self._waypoint(s.x, s.y)
+        to_target = math.atan2(target.center[1] - s.y, target.center[0] - s.x)
+        arrived = (wx, wy) == (s.x, s.y)
+        if arrived or not spec.head and math.hypot(wx - s.x, wy - s.y) < 0.6:
+            heading = to_target
+        else:
+            heading = math.atan2(wy - s.y, wx - s.x)
+        dtheta = float(np.clip(wrap_angle(heading - s.theta), -spec.max_turn, spec.max_turn))
+        theta = s.theta + dtheta
+        ddx, ddy = wx - s.x, wy - s.y
+        c, sn = math.cos(theta), math.sin(theta)
+        dx, dy = c * ddx + sn * ddy, -sn * ddx + c * ddy
+        dx = float(np.clip(dx, -spec.max_forward, spec.max_forward))
+        dy = float(np.clip(dy, -spec.max_lateral, spec.max_lateral))
+        action = [dx / spec.max_forward, dy / spec.max_lateral, dtheta / spec.max_turn]
+        if spec.head:
+            nx, ny = s.x + c * dx - sn * dy, s.y + sn * dx + c * dy
+            look = math.atan2(target.center[1] - ny, target.center[0] - nx)
+            want_yaw = float(np.clip(wrap_angle(look - theta), *spec.yaw_limits))
+            horizontal = math.hypot(target.center[0] - nx, target.center[1] - ny)
+            want_pitch = math.atan2(target.center[2] - s.camera_height, horizontal)
+            want_pitch = float(np.clip(want_pitch, *spec.pitch_limits))
+            action += [(want_pitch - s.pitch) / spec.max_pitch_rate, (want_yaw - s.head_yaw) / spec.max_yaw_rate]
+        return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
+
+    def _waypoint(self, x: float, y: float) -> tuple[float, float]:
+        """The cell within LOOKAHEAD of (x, y) that is geodesically nearest the goal."""
+        row, col = self.grid.cell(x, y)
+        if self.dist[row, col] == 0:
+            return (x, y)
+        k = int(math.ceil(self.LOOKAHEAD / self.grid.resolution))
+        r0, r1 = max(0, row - k), min(self.grid.shape[0], row + k + 1)
+        c0, c1 = max(0, col - k), min(self.grid.shape[1], col + k + 1)
+        gx, gy = self._cells_xy
+        window = self.dist[r0:r1, c0:c1].copy()
+        far = (gx[r0:r1, c0:c1] - x) ** 2 + (gy[r0:r1, c0:c1] - y) ** 2 > self.LOOKAHEAD ** 2
+        window[far] = np.inf
+        if not np.isfinite(window).any():
+            return (x, y)
+        i, j = np.unravel_index(int(np.argmin(window)), window.shape)
+        return self.grid.center(r0 + i, c0 + j)
+
+
+_MARGIN_GRIDS: dict = {}
+
+
+def _margin_grid(layout: str, margin: float) -> NavGrid:
+    key = (layout, margin)
+    if key not in _MARGIN_GRIDS:
+        base = navgrid_for(layout)
+        _MARGIN_GRIDS[key] = NavGrid(base.scene, base.spec, base.resolution, margin=margin)
+    return _MARGIN_GRIDS[key]

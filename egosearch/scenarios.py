@@ -1,0 +1,248 @@
+"""Evaluation scenarios as plain data: generation, CSV round-trip, validation.
+
+A scenario fixes everything an episode depends on (home, start pose, target object and pose,
+camera height, placement scheme), so that every policy is evaluated on the same 100 (paper
+6.1). It also stores ℓ, the geodesic length from the start to the nearest body position that
+satisfies success (within :data:`SUCCESS_DISTANCE` of the target *and* seeing it at this
+camera height); scenarios with no such position within reach are rejected at generation.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import asdict, dataclass, fields
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from egosearch.agent import AgentSpec, check_height
+from egosearch.navgrid import NavGrid
+from egosearch.scene import layouts as layouts_mod
+from egosearch.scene.meshes import scene_meshes
+from egosearch.scene.objects import TARGET_OBJECTS, get_object, target_part
+from egosearch.scene.parts import Part, Scene
+from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
+
+SUCCESS_DISTANCE = 0.5
+"""Paper 4.1: success when the target is within 0.5 m and seen. We measure it horizontally from
+the body's surface (the cylinder) to the target's centre: from the camera (on the body axis) a
+target at the back of a table would be out of reach of any body that stands at the table."""
+
+MAX_STEPS = 100
+"""T_max of paper 4.1."""
+
+MAX_SHORTEST_PATH = 0.6 * MAX_STEPS * AgentSpec().max_forward
+"""Longest accepted ℓ (m): 60% of what a body walking straight at full speed covers in
+T_max steps, leaving time to turn and look. Longer scenarios are rejected at generation."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One evaluation episode, fully determined."""
+
+    scenario_id: int
+    layout: str
+    placement: str
+    height: float
+    start_x: float
+    start_y: float
+    start_theta: float
+    target_object: str
+    target_x: float
+    target_y: float
+    target_z: float
+    """Height of the target's bottom, i.e. of the surface it rests on (m)."""
+    target_yaw: float
+    shortest_path: float
+    """ℓ of SPL (m)."""
+
+    def target(self) -> Part:
+        return target_part(get_object(self.target_object), self.target_x, self.target_y,
+                           self.target_z, self.target_yaw)
+
+
+COLUMNS = tuple(f.name for f in fields(Scenario))
+_TYPES = {f.name: (int if f.type in ("int", int) else str if f.type in ("str", str) else float)
+          for f in fields(Scenario)}
+
+
+class ScenarioFileError(ValueError):
+    """A scenario CSV that cannot be used: the message names the file, row and field."""
+
+
+def check_placement(placement: str) -> str:
+    if placement not in PLACEMENT_SCHEMES:
+        raise ValueError(f"placement={placement!r} is unknown; allowed: {', '.join(PLACEMENT_SCHEMES)}")
+    return placement
+
+
+def write_scenarios(path: str | os.PathLike, scenarios: list[Scenario]) -> None:
+    """Write atomically: a reader never sees half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer.writeheader()
+        for sc in scenarios:
+            row = asdict(sc)
+            writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
+    os.replace(tmp, path)
+
+
+def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
+    """Read and validate a scenario CSV; any defect is one line naming the row and field."""
+    path = Path(path)
+    if not path.exists():
+        raise ScenarioFileError(f"{path}: no such scenario file")
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        header = reader.fieldnames or []
+        missing = [c for c in COLUMNS if c not in header]
+        if missing:
+            raise ScenarioFileError(f"{path}: missing columns {', '.join(missing)}; "
+                                    f"expected {', '.join(COLUMNS)}")
+        out = []
+        for line, row in enumerate(reader, start=2):
+            values = {}
+            for name in COLUMNS:
+                raw = (row.get(name) or "").strip()
+                try:
+                    value = _TYPES[name](raw)
+                except ValueError:
+                    raise ScenarioFileError(f"{path}:{line}: {name}={raw!r} is not a valid "
+                                            f"{_TYPES[name].__name__}") from None
+                if isinstance(value, float) and not math.isfinite(value):
+                    raise ScenarioFileError(f"{path}:{line}: {name}={raw!r} is not finite")
+                values[name] = value
+            try:
+                layouts_mod.get_scene(values["layout"])
+                check_placement(values["placement"])
+                check_height(values["height"])
+                get_object(values["target_object"])
+            except ValueError as err:
+                raise ScenarioFileError(f"{path}:{line}: {err}") from None
+            out.append(Scenario(**values))
+    if not out:
+        raise ScenarioFileError(f"{path}: holds no scenarios")
+    return out
+
+
+# -- generation ----------------------------------------------------------------------------
+
+@lru_cache(maxsize=8)
+def navgrid_for(layout: str) -> NavGrid:
+    return NavGrid(layouts_mod.get_scene(layout), AgentSpec())
+
+
+@lru_cache(maxsize=8)
+def _ray_mesh(layout: str):
+    """The home as one ray-castable mesh (ceiling excluded: it never blocks a look down)."""
+    import trimesh
+
+    scene = layouts_mod.get_scene(layout)
+    meshes = [m for part, m in scene_meshes(scene) if "ceiling" not in part.tags]
+    return trimesh.ray.ray_pyembree.RayMeshIntersector(trimesh.util.concatenate(meshes))
+
+
+def target_probe_points(target: Part) -> np.ndarray:
+    """Points on and in the target a camera must see at least one of: centre, top centre and
+    the corners of its box shrunk towards the centre."""
+    cx, cy, cz = target.center
+    hx, hy, hz = (0.35 * s for s in target.size)
+    c, s = math.cos(target.yaw), math.sin(target.yaw)
+    pts = [(cx, cy, cz), (cx, cy, cz + 0.45 * target.size[2])]
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            for sz in (-1, 1):
+                lx, ly = sx * hx, sy * hy
+                pts.append((cx + c * lx - s * ly, cy + s * lx + c * ly, cz + sz * hz))
+    return np.asarray(pts)
+
+
+def visible_from(layout: str, cameras: np.ndarray, target: Part) -> np.ndarray:
+    """For each camera position (N x 3), whether a straight line reaches a target probe point
+    unblocked by the home."""
+    points = target_probe_points(target)
+    origins = np.repeat(cameras, len(points), axis=0)
+    ends = np.tile(points, (len(cameras), 1))
+    vec = ends - origins
+    dist = np.linalg.norm(vec, axis=1)
+    dirs = vec / dist[:, None]
+    locs, index_ray, _ = _ray_mesh(layout).intersects_location(origins, dirs, multiple_hits=False)
+    hit = np.full(len(origins), np.inf)
+    hit[index_ray] = np.linalg.norm(locs - origins[index_ray], axis=1)
+    clear = hit >= dist - 1e-3
+    return clear.reshape(len(cameras), len(points)).any(axis=1)
+
+
+def success_region(layout: str, target: Part, height: float) -> np.ndarray:
+    """Grid cells where the body is close enough to the target and its camera sees it."""
+    grid = navgrid_for(layout)
+    near = grid.success_region(target.center[:2], SUCCESS_DISTANCE) & grid.main_region
+    rows, cols = np.nonzero(near)
+    if len(rows) == 0:
+        return near
+    cams = np.column_stack([grid.xs[cols], grid.ys[rows], np.full(len(rows), height)])
+    seen = visible_from(layout, cams, target)
+    region = np.zeros_like(near)
+    region[rows[seen], cols[seen]] = True
+    return region
+
+
+def _sample_start(grid: NavGrid, rng: np.random.Generator) -> tuple[float, float, float]:
+    rows, cols = np.nonzero(grid.main_region)
+    i = int(rng.integers(len(rows)))
+    jitter = rng.uniform(-0.5, 0.5, 2) * grid.resolution * 0.5
+    x, y = grid.center(rows[i], cols[i])
+    return float(x + jitter[0]), float(y + jitter[1]), float(rng.uniform(-math.pi, math.pi))
+
+
+def generate_scenarios(layout: str, placement: str, height: float, n: int, seed: int,
+                       objects: tuple[str, ...] | None = None, progress: bool = False,
+                       ) -> list[Scenario]:
+    """``n`` solvable scenarios, the same for the same arguments on any machine."""
+    scene: Scene = layouts_mod.get_scene(layout)
+    check_placement(placement)
+    height = check_height(height)
+    names = tuple(objects) if objects else tuple(sorted(TARGET_OBJECTS))
+    for name in names:
+        get_object(name)
+    grid = navgrid_for(layout)
+    rng = np.random.default_rng([seed, n])
+    out: list[Scenario] = []
+    rejected = 0
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n, desc=f"scenarios {layout}/{placement}/{height:g}m", unit="scn")
+    while len(out) < n:
+        if rejected > 50 * n + 100:
+            raise RuntimeError(f"{layout}/{placement}/{height} m: too many unsolvable scenarios "
+                               f"({rejected} rejected for {len(out)} kept)")
+        obj = get_object(names[int(rng.integers(len(names)))])
+        target = sample_target(scene, obj, placement, rng)
+        region = success_region(layout, target, height)
+        start = _sample_start(grid, rng)
+        if not region.any():
+            rejected += 1
+            continue
+        ell = grid.path_length(grid.distances_to(region), start[0], start[1])
+        if not math.isfinite(ell) or ell > MAX_SHORTEST_PATH:
+            rejected += 1
+            continue
+        out.append(Scenario(
+            scenario_id=len(out), layout=layout, placement=placement, height=height,
+            start_x=round(start[0], 4), start_y=round(start[1], 4), start_theta=round(start[2], 4),
+            target_object=obj.name, target_x=round(target.center[0], 4),
+            target_y=round(target.center[1], 4), target_z=round(target.z_min, 5),
+            target_yaw=round(target.yaw, 4), shortest_path=round(ell, 4)))
+        if bar is not None:
+            bar.update(1)
+    if bar is not None:
+        bar.close()
+    return out
