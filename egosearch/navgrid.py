@@ -51,15 +51,17 @@ class NavGrid:
         self.xs = np.arange(x0 + self.resolution / 2, x1, self.resolution)
         self.ys = np.arange(y0 + self.resolution / 2, y1, self.resolution)
         occupied = np.zeros((len(self.ys), len(self.xs)), dtype=bool)
+        half_diagonal = self.resolution * math.sqrt(0.5)
         body_lo = self.spec.body_clearance
         body_hi = self.spec.body_clearance + self.spec.body_height
         for part in self.scene.obstacles:
             if part.z_max <= body_lo or part.z_min >= body_hi:
                 continue
-            occupied |= _rasterize(part, self.xs, self.ys)
-        # Distance from each cell centre to the nearest occupied cell centre, less half a cell
-        # so that an obstacle edge anywhere inside that cell still counts.
-        clearance = ndimage.distance_transform_edt(~occupied) * self.resolution - self.resolution / 2
+            # Grown by half a cell diagonal so that a part thinner than a cell is never missed.
+            occupied |= _rasterize(part, self.xs, self.ys, grow=half_diagonal)
+        # Every point of an obstacle lies within half a diagonal of an occupied centre, so this
+        # is a lower bound on the true clearance of each cell centre.
+        clearance = (ndimage.distance_transform_edt(~occupied) * self.resolution) - half_diagonal
         inside = np.ones_like(occupied)
         border = int(math.ceil((self.spec.body_radius + self.margin) / self.resolution))
         inside[:border] = inside[-border:] = False

@@ -1,0 +1,42 @@
+import math
+
+import pytest
+
+from egosearch.env import reward_terms
+from egosearch.metrics import episode_spl, spl
+
+
+def test_spl_hand_worked():
+    # Three episodes: an optimal success, a success at twice the shortest path, a failure.
+    assert spl([1, 1, 0], [4.0, 3.0, 5.0], [4.0, 6.0, 1.0]) == pytest.approx((1.0 + 0.5 + 0.0) / 3)
+
+
+def test_spl_path_shorter_than_geodesic_counts_as_optimal():
+    # Grid geodesics overestimate slightly: a real path may come out shorter than l.
+    assert episode_spl(True, 2.0, 1.9) == 1.0
+    assert episode_spl(True, 0.0, 0.3) == 1.0
+    assert episode_spl(False, 2.0, 2.0) == 0.0
+
+
+def test_spl_rejects_empty_and_mismatched():
+    with pytest.raises(ValueError):
+        spl([], [], [])
+    with pytest.raises(ValueError):
+        spl([1], [1.0, 2.0], [1.0])
+
+
+def test_reward_terms_hand_worked():
+    # Success while seen at 0.3 m, 2 collisions so far: 10 - 0.3 - 0.1 + 0.1 * (-0.2).
+    t = reward_terms(success=True, visible=True, distance=0.3, n_collisions=2)
+    assert (t["r_s"], t["r_d"], t["r_l"], t["r_c"]) == (10.0, -0.3, -0.1, pytest.approx(-0.2))
+    assert t["reward"] == pytest.approx(10 - 0.3 - 0.1 - 0.02)
+
+
+def test_reward_distance_only_while_visible_and_collision_floor():
+    t = reward_terms(success=False, visible=False, distance=4.0, n_collisions=100)
+    assert t["r_d"] == 0.0
+    assert t["r_c"] == -3.0  # clip(-0.1 * 100, -3, 0)
+    assert t["reward"] == pytest.approx(-0.1 + 0.1 * -3.0)
+    seen = reward_terms(success=False, visible=True, distance=2.5, n_collisions=0)
+    assert seen["reward"] == pytest.approx(-2.5 - 0.1)
+    assert math.isclose(seen["r_c"], 0.0)

@@ -1,0 +1,102 @@
+"""Physics invariants of the abstract body on a hand-built room (no layout needed)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from egosearch.agent import AgentSpec
+from egosearch.navgrid import NavGrid
+from egosearch.scene.parts import TAG_OBSTACLE, TAG_WALL, Part, Scene
+from egosearch.world import PENETRATION_TOLERANCE, World, random_free_pose
+
+WALL = frozenset({TAG_OBSTACLE, TAG_WALL})
+
+
+def room() -> Scene:
+    """A 6 x 4 m room split by a wall with a 1 m doorway (y in [-0.5, 0.5]), plus a round table and a thin post."""
+    parts = [
+        Part("north", "box", (0, 2.05, 1.3), (6.2, 0.1, 2.6), tags=WALL),
+        Part("south", "box", (0, -2.05, 1.3), (6.2, 0.1, 2.6), tags=WALL),
+        Part("east", "box", (3.05, 0, 1.3), (0.1, 4.0, 2.6), tags=WALL),
+        Part("west", "box", (-3.05, 0, 1.3), (0.1, 4.0, 2.6), tags=WALL),
+        Part("split_a", "box", (0, 1.25, 1.3), (0.1, 1.5, 2.6), tags=WALL),
+        Part("split_b", "box", (0, -1.25, 1.3), (0.1, 1.5, 2.6), tags=WALL),
+        Part("table", "cylinder", (-1.5, -1.2, 0.375), (0.9, 0.9, 0.75), tags={TAG_OBSTACLE}),
+        Part("post", "box", (1.5, -1.0, 0.5), (0.05, 0.05, 1.0), yaw=0.6, tags={TAG_OBSTACLE}),
+    ]
+    return Scene("room", tuple(parts), (), (-3.0, -2.0, 3.0, 2.0))
+
+
+@pytest.fixture(scope="module")
+def world():
+    w = World(room(), AgentSpec())
+    yield w
+    w.close()
+
+
+def test_free_motion_tracks_the_command(world):
+    world.reset_agent(-2.0, 1.0, 0.0)
+    pose, collided = world.move(0.2, 0.1, 0.3)
+    assert not collided
+    assert pose == pytest.approx((-1.8, 1.1, 0.3), abs=2e-3)
+    # Body frame: a forward step after turning by 90 degrees goes along +y.
+    world.reset_agent(-2.0, 1.0, math.pi / 2)
+    pose, _ = world.move(0.2, 0.0, 0.0)
+    assert pose[:2] == pytest.approx((-2.0, 1.2), abs=2e-3)
+
+
+def test_wall_stops_the_body_and_counts(world):
+    world.reset_agent(-0.5, -1.0, 0.0)  # facing the split wall at x = -0.05
+    hits = 0
+    for _ in range(5):
+        pose, collided = world.move(0.25, 0.0, 0.0)
+        hits += collided
+    assert hits >= 3
+    assert pose[0] <= -0.05 - 0.2 + PENETRATION_TOLERANCE
+    assert world.penetration() <= PENETRATION_TOLERANCE
+
+
+def test_random_actions_never_end_inside_anything(world):
+    rng = np.random.default_rng(0)
+    spec = world.spec
+    scale = spec.action_scale()[:3]
+    world.reset_agent(*random_free_pose(world, rng))
+    worst = 0.0
+    for step in range(1500):
+        if step % 300 == 0:
+            world.reset_agent(*random_free_pose(world, rng))
+        world.move(*(rng.uniform(-1, 1, 3) * scale))
+        worst = max(worst, world.penetration())
+        x, y, _ = world.pose()
+        assert -3.0 + spec.body_radius - 0.01 <= x <= 3.0 - spec.body_radius + 0.01
+        assert -2.0 + spec.body_radius - 0.01 <= y <= 2.0 - spec.body_radius + 0.01
+    assert worst <= PENETRATION_TOLERANCE
+
+
+def test_navgrid_geodesic_goes_through_the_door():
+    grid = NavGrid(room(), AgentSpec())
+    goal = np.zeros(grid.shape, bool)
+    goal[grid.cell(2.0, 1.0)] = True
+    dist = grid.distances_to(goal)
+    # From (-2, 1) the straight line is blocked by split_a, which ends at y = 0.5: the body's
+    # centre must pass the doorway at y <= 0.3.
+    detour = grid.path_length(dist, -2.0, 1.0)
+    via_door = 2 * math.hypot(2.0, 0.7)
+    assert detour > 4.0 + 0.3  # longer than the blocked straight line
+    assert detour == pytest.approx(via_door, rel=0.06)
+    # In open floor the 16-connected grid is within 3% of Euclid, plus a cell for the ends.
+    goal2 = np.zeros(grid.shape, bool)
+    goal2[grid.cell(2.5, 1.5)] = True
+    d2 = grid.distances_to(goal2)
+    straight = math.hypot(2.5 - 0.6, 1.5 - 0.7)
+    assert grid.path_length(d2, 0.6, 0.7) == pytest.approx(straight, abs=0.03 * straight + grid.resolution)
+
+
+def test_navgrid_free_cells_really_clear_the_body(world):
+    grid = NavGrid(room(), AgentSpec())
+    rows, cols = np.nonzero(grid.free)
+    rng = np.random.default_rng(1)
+    for i in rng.choice(len(rows), 200, replace=False):
+        x, y = grid.center(rows[i], cols[i])
+        assert world.clearance_at(x, y) > -1e-3
