@@ -85,8 +85,9 @@ class OraclePolicy:
             heading = math.atan2(wy - s.y, wx - s.x)
         dtheta = float(np.clip(wrap_angle(heading - s.theta), -spec.max_turn, spec.max_turn))
         theta = s.theta + dtheta
+        # The env moves the body in its frame at the start of the step, then turns it.
         ddx, ddy = wx - s.x, wy - s.y
-        c, sn = math.cos(theta), math.sin(theta)
+        c, sn = math.cos(s.theta), math.sin(s.theta)
         dx, dy = c * ddx + sn * ddy, -sn * ddx + c * ddy
         dx = float(np.clip(dx, -spec.max_forward, spec.max_forward))
         dy = float(np.clip(dy, -spec.max_lateral, spec.max_lateral))

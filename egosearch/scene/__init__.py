@@ -1,5 +1,7 @@
 """Homes as plain data: parts, layouts, target objects and their placement."""
 
+from egosearch.scene.layouts import LAYOUT_NAMES, get_scene, random_home
+from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import (
     SHAPES,
     TAG_FLOOR,
@@ -12,8 +14,11 @@ from egosearch.scene.parts import (
     Scene,
     SupportSurface,
 )
+from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
 
 __all__ = [
     "SHAPES", "TAG_FLOOR", "TAG_FURNITURE", "TAG_LOW_CABINET_INTERIOR", "TAG_OBSTACLE",
     "TAG_TARGET", "TAG_WALL", "Part", "Scene", "SupportSurface",
+    "LAYOUT_NAMES", "get_scene", "random_home", "TARGET_OBJECTS", "get_object",
+    "PLACEMENT_SCHEMES", "sample_target",
 ]
