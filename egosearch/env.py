@@ -185,6 +185,36 @@ class SearchEnv(gymnasium.Env):
         info.update(terms, collided=collided)
         return self._observation(mask), terms["reward"], success, truncated, info
 
+    # -- state access for the replanner (paper Algorithm 1) ----------------------------------
+    def snapshot(self) -> dict:
+        """Everything a later :meth:`restore` needs to continue this episode exactly."""
+        return {"state": self.state.copy(), "frames": self._frames.copy(), "steps": self.steps,
+                "collisions": self.collisions, "path_length": self.path_length, "dq": self._dq.copy(),
+                "rng": self.np_random.bit_generator.state,
+                "last": (self._last_depth, self._last_mask)}
+
+    def restore(self, snap: dict) -> None:
+        self.set_agent_state(snap["state"])
+        self._frames[:] = snap["frames"]
+        self.steps, self.collisions, self.path_length = snap["steps"], snap["collisions"], snap["path_length"]
+        self._dq = snap["dq"].copy()
+        self.np_random.bit_generator.state = snap["rng"]
+        self._last_depth, self._last_mask = snap["last"]
+
+    def set_agent_state(self, state: AgentState) -> None:
+        """Put the body and camera at ``state`` (no physics on the way, nothing counted)."""
+        self.state = state.copy()
+        self.world.reset_agent(state.x, state.y, state.theta)
+
+    def observe(self, push: bool = True) -> tuple[dict, bool]:
+        """Render at the current state; with ``push`` the frame enters the depth history.
+        Returns the observation and whether the target is seen."""
+        depth, mask = self._sense()
+        if push:
+            self._frames[:-1] = self._frames[1:]
+            self._frames[-1] = depth
+        return self._observation(mask), bool(mask.any())
+
     # -- sensing ---------------------------------------------------------------------------
     def _sense(self):
         s = self.state

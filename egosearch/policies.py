@@ -14,7 +14,7 @@ import numpy as np
 
 from egosearch.agent import wrap_angle
 from egosearch.navgrid import NavGrid
-from egosearch.scenarios import navgrid_for, success_region
+from egosearch.scenarios import SUCCESS_DISTANCE, navgrid_for, success_region
 
 
 class Policy(Protocol):
@@ -47,8 +47,9 @@ class OraclePolicy:
 
     #: How far ahead along the path the body aims (m): smooths the grid's zig-zags.
     LOOKAHEAD = 0.35
-    #: Extra clearance the oracle keeps from obstacles beyond the body radius (m).
-    MARGIN = 0.04
+    #: The oracle aims this far inside the success distance (m), so that a body anywhere in
+    #: its goal cell is within the distance.
+    GOAL_SLACK = 0.08
 
     def __init__(self, env):
         self.env = env.unwrapped
@@ -59,12 +60,10 @@ class OraclePolicy:
 
     def _plan(self) -> None:
         env = self.env
-        base: NavGrid = navgrid_for(env.layout)
-        self.grid = _margin_grid(env.layout, self.MARGIN)
-        region = success_region(env.layout, env.target, env.base_height)
-        goal = region & self.grid.free
+        self.grid: NavGrid = navgrid_for(env.layout)
+        goal = success_region(env.layout, env.target, env.base_height, SUCCESS_DISTANCE - self.GOAL_SLACK)
         if not goal.any():
-            goal, self.grid = region, base
+            goal = success_region(env.layout, env.target, env.base_height)
         self.dist = self.grid.distances_to(goal)
         gx, gy = np.meshgrid(self.grid.xs, self.grid.ys)
         self._cells_xy = (gx, gy)
@@ -103,7 +102,8 @@ class OraclePolicy:
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
 
     def _waypoint(self, x: float, y: float) -> tuple[float, float]:
-        """The cell within LOOKAHEAD of (x, y) that is geodesically nearest the goal."""
+        """The cell within LOOKAHEAD of (x, y), reachable in a straight free line, that is
+        geodesically nearest the goal."""
         row, col = self.grid.cell(x, y)
         if self.dist[row, col] == 0:
             return (x, y)
@@ -114,18 +114,20 @@ class OraclePolicy:
         window = self.dist[r0:r1, c0:c1].copy()
         far = (gx[r0:r1, c0:c1] - x) ** 2 + (gy[r0:r1, c0:c1] - y) ** 2 > self.LOOKAHEAD ** 2
         window[far] = np.inf
-        if not np.isfinite(window).any():
-            return (x, y)
-        i, j = np.unravel_index(int(np.argmin(window)), window.shape)
-        return self.grid.center(r0 + i, c0 + j)
+        for flat in np.argsort(window, axis=None):
+            i, j = np.unravel_index(int(flat), window.shape)
+            if not np.isfinite(window[i, j]):
+                break
+            wx, wy = self.grid.center(r0 + i, c0 + j)
+            if self._line_free(x, y, wx, wy):
+                return (wx, wy)
+        return (x, y)
 
-
-_MARGIN_GRIDS: dict = {}
-
-
-def _margin_grid(layout: str, margin: float) -> NavGrid:
-    key = (layout, margin)
-    if key not in _MARGIN_GRIDS:
-        base = navgrid_for(layout)
-        _MARGIN_GRIDS[key] = NavGrid(base.scene, base.spec, base.resolution, margin=margin)
-    return _MARGIN_GRIDS[key]
+    def _line_free(self, x0: float, y0: float, x1: float, y1: float) -> bool:
+        length = math.hypot(x1 - x0, y1 - y0)
+        n = max(2, int(length / (self.grid.resolution / 2)) + 1)
+        # The grid's clearance is a lower bound: a body may stand where its cell reads blocked.
+        # Then the first few centimetres of any way out are ignored.
+        skip = 0.0 if self.grid.is_free(x0, y0) else 2 * self.grid.resolution
+        return all(self.grid.is_free(x0 + t * (x1 - x0), y0 + t * (y1 - y0))
+                   for t in np.linspace(0, 1, n)[1:] if t * length >= skip)

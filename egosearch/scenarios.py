@@ -163,9 +163,14 @@ def target_probe_points(target: Part) -> np.ndarray:
     return np.asarray(pts)
 
 
+#: A pose sees the target when this many probe points are in plain sight: one alone can be a
+#: sliver that the camera's pixels miss.
+MIN_VISIBLE_PROBES = 2
+
+
 def visible_from(layout: str, cameras: np.ndarray, target: Part) -> np.ndarray:
-    """For each camera position (N x 3), whether a straight line reaches a target probe point
-    unblocked by the home."""
+    """For each camera position (N x 3), whether straight lines reach at least
+    :data:`MIN_VISIBLE_PROBES` target probe points unblocked by the home."""
     points = target_probe_points(target)
     origins = np.repeat(cameras, len(points), axis=0)
     ends = np.tile(points, (len(cameras), 1))
@@ -176,13 +181,13 @@ def visible_from(layout: str, cameras: np.ndarray, target: Part) -> np.ndarray:
     hit = np.full(len(origins), np.inf)
     hit[index_ray] = np.linalg.norm(locs - origins[index_ray], axis=1)
     clear = hit >= dist - 1e-3
-    return clear.reshape(len(cameras), len(points)).any(axis=1)
+    return clear.reshape(len(cameras), len(points)).sum(axis=1) >= MIN_VISIBLE_PROBES
 
 
-def success_region(layout: str, target: Part, height: float) -> np.ndarray:
-    """Grid cells where the body is close enough to the target and its camera sees it."""
+def success_region(layout: str, target: Part, height: float, distance: float = SUCCESS_DISTANCE) -> np.ndarray:
+    """Grid cells where the body is within ``distance`` of the target and its camera sees it."""
     grid = navgrid_for(layout)
-    near = grid.success_region(target.center[:2], SUCCESS_DISTANCE) & grid.main_region
+    near = grid.success_region(target.center[:2], distance) & grid.main_region
     rows, cols = np.nonzero(near)
     if len(rows) == 0:
         return near
