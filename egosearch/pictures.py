@@ -50,6 +50,24 @@ def _viewpoint(layout: str, target, height: float, rng, near: float = 0.8, far: 
     return cams[int(np.argmax(seen))]
 
 
+def _over_the_shoulder(layout: str, scene, x: float, y: float, yaw: float, height: float):
+    """A third-person eye behind the searcher that sees it past walls and furniture."""
+    from egosearch.scenarios import visible_from
+    from egosearch.scene.parts import Part
+
+    head = Part("probe", "box", (x, y, height - 0.3), (0.3, 0.3, 0.6))
+    x0, y0, x1, y1 = scene.bounds
+    candidates = []
+    for distance in (2.4, 1.9, 1.4, 1.0):
+        for turn in (0.0, 0.4, -0.4, 0.8, -0.8, 1.2, -1.2):
+            a = yaw + math.pi + turn
+            ex, ey = x + distance * math.cos(a), y + distance * math.sin(a)
+            if x0 + 0.1 < ex < x1 - 0.1 and y0 + 0.1 < ey < y1 - 0.1:
+                candidates.append((ex, ey, min(2.3, scene.wall_height - 0.2)))
+    seen = visible_from(layout, np.asarray(candidates), head)
+    return candidates[int(np.argmax(seen))] if seen.any() else (x, y, scene.wall_height - 0.2)
+
+
 def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> list[Path]:
     import matplotlib
 
@@ -100,7 +118,8 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
             continue
         renderer = SceneRenderer(scene, target=target)
         image = renderer.third_person_rgb(eye, target.center, width=480, height=360, fov_deg=50)
-        shots.append((image, f"{obj.name} ({scheme})"))
+        where = "inside a low cabinet" if scheme == "everywhere" else "no_low_cabinets"
+        shots.append((image, f"{obj.name} ({where})"))
     fig, axes = plt.subplots(2, 3, figsize=(12, 6.4))
     for ax, (image, title) in zip(axes.ravel(), shots):
         ax.imshow(image)
@@ -129,8 +148,7 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
     depth, mask = sensor.render((x, y, height), yaw, pitch)
     first_person = depth_to_colormap(depth, mask, max_depth=sensor.max_depth)
     renderer = SceneRenderer(scene.with_parts(tuple(agent_parts(x, y, yaw, height))), target=target)
-    back = 2.2
-    eye3 = (x - back * math.cos(yaw), y - back * math.sin(yaw), 2.3)
+    eye3 = _over_the_shoulder(layout, scene, x, y, yaw, height)
     third_person = renderer.third_person_rgb(eye3, (x + math.cos(yaw), y + math.sin(yaw), 0.6),
                                              width=640, height=480, fov_deg=70)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), gridspec_kw={"width_ratios": [4, 3]})
