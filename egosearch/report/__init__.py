@@ -1,0 +1,23 @@
+"""The report layer: CSV in, files out (Tables 1 and 2, Figures 6 and 7, variant comparisons).
+
+Imports pandas, scipy and matplotlib only; never torch, the simulator, gymnasium or other
+egosearch modules (the CLI passes Table 2's rows in).
+"""
+
+from egosearch.report.data import (
+    cells_from_paths,
+    group_eval_paths,
+    parse_eval_path,
+    read_curves,
+    read_episodes,
+    read_fullbody,
+)
+from egosearch.report.figures import fig6, fig7, figure6, figure6_frame, figure7, figure7_frame
+from egosearch.report.stats import bootstrap_ci, compare_cells, holm, wilson_ci
+from egosearch.report.tables import PAPER_TABLE1, compare_report, format_compare, table1, table1_frame, table2
+
+__all__ = [
+    "PAPER_TABLE1", "bootstrap_ci", "fig6", "fig7", "cells_from_paths", "compare_cells", "compare_report", "figure6",
+    "figure6_frame", "figure7", "figure7_frame", "format_compare", "group_eval_paths", "holm", "parse_eval_path",
+    "read_curves", "read_episodes", "read_fullbody", "table1", "table1_frame", "table2", "wilson_ci",
+]

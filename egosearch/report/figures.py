@@ -1,0 +1,282 @@
+"""Figures 6 and 7 of the paper from the result CSVs: 300-dpi PNG + vector PDF (+ the numbers as CSV).
+
+Uses matplotlib's object API (``matplotlib.figure.Figure``, Agg canvas), never pyplot, so it neither
+needs a display nor changes the global backend; the style is applied per figure with
+``matplotlib.rc_context``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter, MultipleLocator
+
+from egosearch.report.data import _with, output_base, read_curves, read_fullbody
+from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean
+
+PathLike = str | os.PathLike
+
+OKABE_ITO = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
+"""Colour-blind-safe palette (Okabe & Ito 2008)."""
+
+STYLE = {
+    "font.family": "serif",
+    "font.serif": ["STIXGeneral", "DejaVu Serif"],
+    "mathtext.fontset": "stix",
+    "font.size": 9, "axes.labelsize": 9, "axes.titlesize": 9, "legend.fontsize": 8,
+    "xtick.labelsize": 8, "ytick.labelsize": 8,
+    "axes.spines.top": False, "axes.spines.right": False, "axes.linewidth": 0.8,
+    "axes.grid": True, "grid.color": "#b0b0b0", "grid.alpha": 0.35, "grid.linewidth": 0.5,
+    "axes.axisbelow": True, "legend.frameon": False,
+    "lines.linewidth": 1.6, "errorbar.capsize": 2.5,
+    "savefig.dpi": 300, "savefig.bbox": "tight", "savefig.pad_inches": 0.03,
+    "pdf.fonttype": 42, "ps.fonttype": 42,
+}
+"""Paper-like look: Times-like serif (STIX ships with matplotlib), light grid, no top/right spines."""
+
+FIG6_LABELS = {"head_on": "with head movement", "head_off": "without head movement"}
+
+BASELINES = ("one_step_short", "one_step_long", "noisy_search")
+METHOD_LABELS = {"one_step_short": "1-step short", "one_step_long": "1-step long", "noisy_search": "Noisy search",
+                 "ours": "Ours"}
+MG_LABELS = {"humanoid_phase": "Humanoid, phase MG", "humanoid_matching": "Humanoid, matching MG",
+             "fetch": "Fetch"}
+MG_ORDER = ("humanoid_phase", "humanoid_matching", "fetch")
+
+FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "success_rate", "low", "high")
+FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
+                "success_rate", "spl", "spl_low", "spl_high", "attempts", "attempts_low", "attempts_high",
+                "penetration_rate", "collisions", "ci_unit")
+
+
+def _steps_formatter(x: float, _pos=None) -> str:
+    if x == 0:
+        return "0"
+    if abs(x) >= 1e6:
+        return f"{x / 1e6:g}M"
+    if abs(x) >= 1e3:
+        return f"{x / 1e3:g}k"
+    return f"{x:g}"
+
+
+def _save(fig: Figure, base: Path) -> list[Path]:
+    FigureCanvasAgg(fig)
+    outs = [_with(base, ".png"), _with(base, ".pdf")]
+    fig.savefig(outs[0], dpi=300)
+    fig.savefig(outs[1])
+    return outs
+
+
+# --------------------------------------------------------------------------------------------- Figure 6
+def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str, str] | None = None,
+                  confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> pd.DataFrame:
+    """Numbers behind Figure 6: per variant and evaluation step, the mean success rate over seeds and a
+    percentile bootstrap band over seeds (NaN where fewer than 2 seeds were evaluated at that step).
+
+    Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
+    """
+    labels = {**FIG6_LABELS, **(labels or {})}
+    if not curves:
+        raise ValueError("figure6: no training curves given")
+    rows = []
+    for variant, paths in curves.items():
+        paths = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+        if not paths:
+            raise ValueError(f"figure6: variant {variant!r} has no curve files")
+        df = read_curves(paths)
+        if df.empty:
+            raise ValueError(f"figure6: the curves of {variant!r} have no evaluated rows")
+        for step, g in df.groupby("env_steps", sort=True):
+            v = g["success_rate"].to_numpy(dtype=float)
+            lo, hi = bootstrap_ci(v, np.mean, confidence, n_resamples, seed) if v.size >= 2 else (math.nan, math.nan)
+            rows.append({"variant": variant, "label": labels.get(variant, variant), "env_steps": int(step),
+                         "n_seeds": int(v.size), "success_rate": float(v.mean()), "low": lo, "high": hi})
+    return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
+
+
+def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,
+            confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> list[Path]:
+    """Figure 6: evaluation success rate vs environment steps, one line per variant (mean over seeds) with a
+    bootstrap band over seeds where at least 2 seeds were evaluated.
+
+    ``curves``: ``{variant: [curve.csv per seed]}``; ``labels``: legend text per variant (default:
+    ``head_on`` -> "with head movement", ``head_off`` -> "without head movement"). Writes
+    ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (the plotted numbers; a directory
+    prefix gets ``fig6.*``) and returns the paths. ValueError on no curves / no evaluated rows.
+    """
+    df = figure6_frame(curves, labels, confidence, n_resamples, seed)
+    base = output_base(out_prefix, "fig6")
+    df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    with matplotlib.rc_context(STYLE):
+        fig = Figure(figsize=(3.5, 2.5))
+        ax = fig.add_subplot()
+        for i, (_variant, g) in enumerate(df.groupby("variant", sort=False)):
+            colour = OKABE_ITO[i % len(OKABE_ITO)]
+            x, y = g["env_steps"].to_numpy(), g["success_rate"].to_numpy()
+            n_seeds = int(g["n_seeds"].max())
+            label = g["label"].iloc[0] + (f" ({n_seeds} seeds)" if n_seeds > 1 else "")
+            ax.plot(x, y, color=colour, label=label, marker="o" if len(x) == 1 else None, markersize=3)
+            band = g["low"].notna().to_numpy()
+            if band.any():
+                ax.fill_between(x, g["low"].to_numpy(), g["high"].to_numpy(), where=band, color=colour,
+                                alpha=0.2, linewidth=0, interpolate=False)
+        ax.set_xlabel("Environment steps")
+        ax.set_ylabel("Success rate")
+        ax.set_ylim(0, 1.02)
+        ax.set_xlim(left=0)
+        ax.yaxis.set_major_locator(MultipleLocator(0.2))
+        ax.xaxis.set_major_formatter(FuncFormatter(_steps_formatter))
+        ax.legend(loc="lower right")
+        outs = _save(fig, base)
+    return [*outs, _with(base, ".csv")]
+
+
+# --------------------------------------------------------------------------------------------- Figure 7
+def _method_label(method: str, M, T, multi_m: bool, multi_t: bool) -> str:
+    name = METHOD_LABELS.get(method, method)
+    parts = []
+    if method == "ours" or multi_m:
+        parts.append(f"M={M:g}" if isinstance(M, float) else f"M={M}")
+    if multi_t:
+        parts.append(f"T={T}")
+    return f"{name} {' '.join(parts)}".strip()
+
+
+def figure7_frame(fullbody_files: Iterable[PathLike], confidence: float = 0.95, n_resamples: int = 10_000,
+                  seed: int = 0) -> pd.DataFrame:
+    """Numbers behind Figure 7: one row per (mg, method, M, T), baselines first, then ``ours`` by M.
+
+    Means are over all episodes pooled over seeds; CIs are percentile bootstraps that resample
+    scenarios (each scenario's seeds averaged first; ``ci_unit`` = ``scenario``). If a scenario id
+    repeats within one seed of a group (several scenario files pooled into one CSV) scenarios cannot be
+    told apart and episodes are resampled instead (``ci_unit`` = ``episode``). ``attempts`` is the mean
+    number of abstract trajectories planned per episode over all episodes (failed ones included).
+    """
+    paths = [fullbody_files] if isinstance(fullbody_files, (str, os.PathLike)) else list(fullbody_files)
+    if not paths:
+        raise ValueError("figure7: no full-body CSVs given")
+    df = read_fullbody(paths)
+    if df.empty:
+        raise ValueError("figure7: the full-body CSVs have no episodes")
+    rows = []
+    for method, gm in df.groupby("method", sort=False):
+        multi_m = gm["M"].nunique() > 1 and method != "ours"
+        multi_t = gm["T"].nunique() > 1
+        for (mg, M, T), g in gm.groupby(["mg", "M", "T"], sort=True):
+            if g.duplicated(["seed", "scenario_id"]).any():
+                unit, gg, cl = "episode", g.reset_index(drop=True).rename_axis("episode").reset_index(), "episode"
+            else:
+                unit, gg, cl = "scenario", g, "scenario_id"
+            spl, spl_lo, spl_hi = cluster_bootstrap_mean(gg, "spl", cl, confidence, n_resamples, seed)
+            att, att_lo, att_hi = cluster_bootstrap_mean(gg, "attempts", cl, confidence, n_resamples, seed)
+            rows.append({"mg": mg, "method": method, "label": _method_label(method, M, T, multi_m, multi_t),
+                         "M": M, "T": T, "baseline": method != "ours", "n_episodes": len(g),
+                         "n_scenarios": int(g["scenario_id"].nunique()), "n_seeds": int(g["seed"].nunique()),
+                         "success_rate": float(g["success"].mean()), "spl": spl, "spl_low": spl_lo,
+                         "spl_high": spl_hi, "attempts": att, "attempts_low": att_lo, "attempts_high": att_hi,
+                         "penetration_rate": float(g["penetration_rate"].mean()),
+                         "collisions": float(g["collisions"].mean()), "ci_unit": unit})
+    out = pd.DataFrame(rows, columns=list(FIG7_COLUMNS))
+    border = {m: i for i, m in enumerate(BASELINES)}
+    out["_o1"] = [0 if b else 1 for b in out["baseline"]]
+    out["_o2"] = [border.get(m, len(BASELINES)) for m in out["method"]]
+    mgo = {m: i for i, m in enumerate(MG_ORDER)}
+    out["_o3"] = [mgo.get(m, len(MG_ORDER)) for m in out["mg"]]
+    out = out.sort_values(["_o1", "_o2", "method", "M", "T", "_o3", "mg"], kind="stable")
+    return out.drop(columns=["_o1", "_o2", "_o3"]).reset_index(drop=True)
+
+
+def _yerr(mean, lo, hi) -> np.ndarray:
+    lo = np.where(np.isnan(lo), mean, lo)
+    hi = np.where(np.isnan(hi), mean, hi)
+    return np.vstack([np.maximum(mean - lo, 0), np.maximum(hi - mean, 0)])
+
+
+def figure7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, confidence: float = 0.95,
+            n_resamples: int = 10_000, seed: int = 0) -> list[Path]:
+    """Figure 7: left, SPL per method (bars, bootstrap CI over scenarios; baselines left of a dashed line,
+    then ours for each M); right, abstract-trajectory attempts vs M for ours (mean and CI).
+
+    Several motion generators (``mg``) are shown as grouped bars / separate lines with one colour each.
+    Writes ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (:func:`figure7_frame`; a
+    directory prefix gets ``fig7.*``) and returns the paths. ValueError on no files / no episodes.
+    """
+    df = figure7_frame(fullbody_files, confidence, n_resamples, seed)
+    base = output_base(out_prefix, "fig7")
+    df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    mgs = sorted(df["mg"].unique(), key=lambda m: (MG_ORDER.index(m) if m in MG_ORDER else len(MG_ORDER), m))
+    cats = list(dict.fromkeys(df["label"]))
+    n_base = int(df.drop_duplicates("label")["baseline"].sum())
+    single = len(mgs) == 1
+    with matplotlib.rc_context(STYLE):
+        fig = Figure(figsize=(7.0, 2.7))
+        gs = fig.add_gridspec(1, 2, width_ratios=[1.9, 1.0], wspace=0.28)
+        ax, ax2 = fig.add_subplot(gs[0]), fig.add_subplot(gs[1])
+        width = 0.8 / len(mgs)
+        for j, mg in enumerate(mgs):
+            g = df[df["mg"] == mg].set_index("label").reindex(cats)
+            present = g["spl"].notna().to_numpy()
+            x = np.arange(len(cats)) + (j - (len(mgs) - 1) / 2) * width
+            if single:
+                colours = ["#a6a6a6" if b else OKABE_ITO[0] for b in g["baseline"].fillna(True)]
+            else:
+                colours = [OKABE_ITO[j % len(OKABE_ITO)]] * len(cats)
+            spl = g["spl"].to_numpy(dtype=float)
+            err = _yerr(spl, g["spl_low"].to_numpy(dtype=float), g["spl_high"].to_numpy(dtype=float))
+            ax.bar(x[present], spl[present], width * 0.92, color=np.array(colours)[present],
+                   yerr=err[:, present], ecolor="#333333", error_kw={"elinewidth": 0.8}, edgecolor="none")
+        if 0 < n_base < len(cats):
+            ax.axvline(n_base - 0.5, color="#333333", linestyle="--", linewidth=0.9)
+        ax.set_xticks(np.arange(len(cats)), [c.replace(" ", "\n", 1) for c in cats])
+        ax.tick_params(axis="x", length=0)
+        ax.set_ylabel("SPL")
+        ax.set_xlim(-0.6, len(cats) - 0.4)
+        top = float(np.nanmax(np.r_[df["spl_high"].to_numpy(dtype=float), df["spl"].to_numpy(dtype=float)]))
+        ax.set_ylim(0, max(0.1, min(1.0, top * 1.15)) if np.isfinite(top) else 1.0)
+        ax.grid(axis="x", visible=False)
+        if single:
+            handles = [Patch(color="#a6a6a6", label="baselines")] if n_base else []
+            if n_base < len(cats):
+                handles.append(Patch(color=OKABE_ITO[0], label=f"ours ({MG_LABELS.get(mgs[0], mgs[0])})"))
+        else:
+            handles = [Patch(color=OKABE_ITO[j % len(OKABE_ITO)], label=MG_LABELS.get(m, m))
+                       for j, m in enumerate(mgs)]
+        ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.01), ncol=len(handles),
+                  borderaxespad=0.0, handlelength=1.2, columnspacing=1.2)
+
+        ours = df[df["method"] == "ours"]
+        ms = sorted(ours["M"].unique()) if not ours.empty else [0]
+        dodge = 0.015 * (max(ms) - min(ms)) if len(ms) > 1 else 0.1  # x offset between MGs' markers
+        if ours.empty:
+            ax2.text(0.5, 0.5, "no 'ours' runs", ha="center", va="center", transform=ax2.transAxes)
+        else:
+            for j, mg in enumerate(mgs):
+                g = ours[ours["mg"] == mg].groupby("M", sort=True).first().reset_index()
+                if g.empty:
+                    continue
+                colour = OKABE_ITO[0] if single else OKABE_ITO[j % len(OKABE_ITO)]
+                m = g["M"].to_numpy(dtype=float)
+                a = g["attempts"].to_numpy(dtype=float)
+                err = _yerr(a, g["attempts_low"].to_numpy(dtype=float), g["attempts_high"].to_numpy(dtype=float))
+                shift = 0.0 if single else (j - (len(mgs) - 1) / 2) * dodge
+                ax2.errorbar(m + shift, a, yerr=err, color=colour, marker="o", markersize=3.5, ecolor=colour)
+            ax2.set_xticks(ms, [f"{v:g}" for v in ms])
+            top = np.nanmax(np.r_[ours["attempts_high"].to_numpy(dtype=float), ours["attempts"].to_numpy(dtype=float)])
+            ax2.set_ylim(0, top * 1.08 if np.isfinite(top) and top > 0 else 1.0)
+        ax2.set_xlabel("M (executed steps per plan)")
+        ax2.set_ylabel("Attempts (abstract trajectories)")
+        outs = _save(fig, base)
+    return [*outs, _with(base, ".csv")]
+
+
+fig6 = figure6
+fig7 = figure7

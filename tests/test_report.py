@@ -1,0 +1,448 @@
+"""The report layer: statistics, tables, figures and comparisons from synthetic CSVs (fast, no torch/sim)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from egosearch.report import (
+    PAPER_TABLE1,
+    bootstrap_ci,
+    cells_from_paths,
+    compare_cells,
+    compare_report,
+    figure6,
+    figure7,
+    format_compare,
+    group_eval_paths,
+    holm,
+    parse_eval_path,
+    table1,
+    table2,
+    wilson_ci,
+)
+from egosearch.report.cli import cmd_compare, cmd_fig6, cmd_fig7, cmd_table1, cmd_table2
+
+EPISODE_COLUMNS = ["scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
+                   "episode_return"]
+CURVE_COLUMNS = ["env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss", "curl_loss",
+                 "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s"]
+FULLBODY_COLUMNS = ["scenario_id", "method", "mg", "M", "T", "success", "steps", "path_length", "shortest_path",
+                    "spl", "attempts", "penetrations", "penetration_rate", "collisions"]
+N_RES = 999  # bootstrap resamples in the figure/table tests (speed)
+
+
+# --------------------------------------------------------------------------------------------- synthetic data
+def episodes_frame(success, rng=None) -> pd.DataFrame:
+    """Per-episode rows with the evaluation CSV's columns; scenario ids 0..n-1."""
+    rng = rng or np.random.default_rng(0)
+    success = np.asarray(success, dtype=int)
+    n = success.size
+    shortest = np.round(rng.uniform(1.0, 6.0, n), 3)
+    path = np.round(shortest * rng.uniform(1.0, 2.5, n), 3)
+    spl = np.where(success == 1, shortest / np.maximum(path, shortest), 0.0)
+    return pd.DataFrame({"scenario_id": np.arange(n), "success": success, "steps": rng.integers(5, 100, n),
+                         "path_length": path, "shortest_path": shortest, "spl": np.round(spl, 5),
+                         "collisions": rng.integers(0, 4, n), "episode_return": np.round(rng.normal(0, 3, n), 3)},
+                        columns=EPISODE_COLUMNS)
+
+
+def eval_path(root: Path, variant: str, seed: int, layout: str, placement: str, height: float) -> Path:
+    return root / "eval" / variant / f"seed{seed}" / layout / placement / f"h{height:.2f}.csv"
+
+
+def write_eval(root, variant, seed, layout, placement, height, success, rng=None) -> Path:
+    p = eval_path(root, variant, seed, layout, placement, height)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    episodes_frame(success, rng).to_csv(p, index=False)
+    return p
+
+
+def make_eval_tree(root: Path, variant: str = "head_on", seeds=(0, 1, 2), n: int = 50, shift: float = 0.0,
+                   layouts=("kitchen", "bedroom")) -> list[Path]:
+    """All 6 Table-1 cells x seeds x layouts, success probability near the paper's, plus ``shift``."""
+    paths = []
+    for (h, pl), p in PAPER_TABLE1.items():
+        for s in seeds:
+            for li, lay in enumerate(layouts):
+                rng = np.random.default_rng(1000 * s + 17 * li + int(h * 100) + len(pl))
+                succ = rng.random(n) < min(1.0, max(0.0, p + shift))
+                paths.append(write_eval(root, variant, s, lay, pl, h, succ, rng))
+    return paths
+
+
+def write_curve(path: Path, steps, success) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    k = len(steps)
+    df = pd.DataFrame({c: np.zeros(k) for c in CURVE_COLUMNS})
+    df["env_steps"] = steps
+    df["success_rate"] = success
+    df.to_csv(path, index=False)
+    return path
+
+
+def make_curves(root: Path, seeds=(0, 1, 2)) -> dict[str, list[Path]]:
+    steps = np.arange(0, 750_001, 25_000)
+    out = {}
+    for variant, top in (("head_on", 0.85), ("head_off", 0.65)):
+        out[variant] = []
+        for s in seeds:
+            rng = np.random.default_rng(s + (0 if variant == "head_on" else 100))
+            curve = top * (1 - np.exp(-steps / 150_000)) + rng.normal(0, 0.04, steps.size)
+            out[variant].append(write_curve(root / "train" / variant / f"seed{s}" / "curve.csv", steps,
+                                            np.clip(curve, 0, 1)))
+    return out
+
+
+def fullbody_frame(method, mg, M, n, spl_mean, attempts_mean, rng, T=20) -> pd.DataFrame:
+    shortest = rng.uniform(1.0, 6.0, n)
+    success = (rng.random(n) < min(1.0, spl_mean * 1.4)).astype(int)
+    spl = np.where(success == 1, np.clip(rng.normal(spl_mean / max(success.mean(), 1e-3), 0.1, n), 0, 1), 0.0)
+    path = np.where(spl > 0, shortest / np.maximum(spl, 1e-3), shortest * 3)
+    return pd.DataFrame({"scenario_id": np.arange(n), "method": method, "mg": mg, "M": M, "T": T, "success": success,
+                         "steps": rng.integers(10, 100, n), "path_length": path, "shortest_path": shortest,
+                         "spl": spl, "attempts": rng.poisson(attempts_mean, n), "penetrations": rng.integers(0, 3, n),
+                         "penetration_rate": rng.uniform(0, 0.1, n), "collisions": rng.integers(0, 3, n)},
+                        columns=FULLBODY_COLUMNS)
+
+
+FB_SETTINGS = [("one_step_short", 5, 0.25, 60), ("one_step_long", 20, 0.3, 15), ("noisy_search", 5, 0.28, 12),
+               ("ours", 1, 0.72, 60), ("ours", 5, 0.68, 14), ("ours", 10, 0.6, 8), ("ours", 20, 0.5, 5)]
+
+
+def make_fullbody(root: Path, mgs=("humanoid_phase",), seeds=(0, 1), n: int = 40) -> list[Path]:
+    paths = []
+    for mi, mg in enumerate(mgs):
+        for method, M, spl, att in FB_SETTINGS:
+            for s in seeds:
+                rng = np.random.default_rng(hash((mg, method, M, s)) % 2**32)
+                p = root / "fullbody" / f"{mg}_{method}_M{M}" / f"seed{s}.csv"
+                p.parent.mkdir(parents=True, exist_ok=True)
+                fullbody_frame(method, mg, M, n, max(0.05, spl - 0.08 * mi), att, rng).to_csv(p, index=False)
+                paths.append(p)
+    return paths
+
+
+def cell_frame(success, seed=0) -> pd.DataFrame:
+    return episodes_frame(success).assign(seed=seed)
+
+
+# --------------------------------------------------------------------------------------------- stats
+def _wilson_by_hand(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
+    """Wilson score interval: (p + z²/2n ± z·sqrt(p(1-p)/n + z²/4n²)) / (1 + z²/n), p = k/n."""
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z / (1 + z * z / n) * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return centre - half, centre + half
+
+
+def test_wilson_hand_worked():
+    # (0, 10): centre = (0 + 0.19208)/1.38415 = 0.138766, half = 0.138766 -> [0, 0.277533]
+    # (5, 10): centre = 0.5, half = 1.95996/1.38415 * sqrt(0.025 + 0.0096) = 0.263407 -> [0.236593, 0.763407]
+    # (10, 10): mirror of (0, 10) -> [0.722467, 1]
+    expected = {(0, 10): (0.0, 0.277533), (5, 10): (0.236593, 0.763407), (10, 10): (0.722467, 1.0)}
+    for (k, n), (lo, hi) in expected.items():
+        got = wilson_ci(k, n)
+        assert got == pytest.approx((lo, hi), abs=1e-6)
+        assert got == pytest.approx(_wilson_by_hand(k, n), abs=1e-9)
+    lo90, hi90 = wilson_ci(5, 10, confidence=0.90)
+    assert lo90 > 0.236593 and hi90 < 0.763407
+
+
+def test_wilson_rejects_bad_input():
+    with pytest.raises(ValueError, match="n must be positive"):
+        wilson_ci(0, 0)
+    with pytest.raises(ValueError):
+        wilson_ci(11, 10)
+
+
+def test_bootstrap_constant_and_degenerate():
+    assert bootstrap_ci([0.7, 0.7, 0.7]) == (0.7, 0.7)
+    lo, hi = bootstrap_ci([0.5])
+    assert math.isnan(lo) and math.isnan(hi)
+    lo, hi = bootstrap_ci([])
+    assert math.isnan(lo) and math.isnan(hi)
+    assert bootstrap_ci([0.2, 0.4, 0.6], n_resamples=500, seed=3) == bootstrap_ci([0.2, 0.4, 0.6], n_resamples=500,
+                                                                                   seed=3)
+
+
+def test_bootstrap_coverage_sanity():
+    """Percentile bootstrap of the mean of n=30 normal values: brackets the true mean most of the time."""
+    rng = np.random.default_rng(0)
+    hits, widths = 0, []
+    for i in range(100):
+        x = rng.normal(1.0, 1.0, 30)
+        lo, hi = bootstrap_ci(x, n_resamples=1000, seed=i)
+        assert lo <= x.mean() <= hi
+        hits += lo <= 1.0 <= hi
+        widths.append(hi - lo)
+    assert 85 <= hits <= 100
+    # width close to the normal-theory 2 * 1.96 / sqrt(30) = 0.716
+    assert np.mean(widths) == pytest.approx(2 * 1.96 / math.sqrt(30), rel=0.15)
+
+
+def test_compare_planted_difference():
+    ids = np.arange(100)
+    ref = pd.concat([cell_frame(ids < 50, seed=s) for s in range(3)], ignore_index=True)
+    cand = pd.concat([cell_frame(ids < 80, seed=s) for s in (0, 1)], ignore_index=True)
+    res = compare_cells(ref, cand, "success")
+    assert res["reference"] == pytest.approx(0.5) and res["candidate"] == pytest.approx(0.8)
+    assert res["difference"] == pytest.approx(0.3)
+    assert res["ci_low"] > 0 and res["ci_low"] < 0.3 < res["ci_high"]
+    assert res["p_value"] < 0.001 and res["significant"]
+    assert (res["n_scenarios"], res["n_seeds_ref"], res["n_seeds_cand"]) == (100, 3, 2)
+    worse = compare_cells(cand, ref, "success")
+    assert worse["difference"] == pytest.approx(-0.3) and worse["ci_high"] < 0 and worse["significant"]
+
+
+def test_compare_identical_copy():
+    rng = np.random.default_rng(5)
+    ref = pd.concat([cell_frame(rng.random(100) < 0.6, seed=s) for s in range(2)], ignore_index=True)
+    for metric in ("success", "spl"):
+        res = compare_cells(ref, ref.copy(), metric)
+        assert res["difference"] == 0.0 and res["ci_low"] == 0.0 and res["ci_high"] == 0.0
+        assert res["p_value"] == pytest.approx(1.0) and not res["significant"]
+
+
+def test_compare_noise_not_significant_and_seed_averaging():
+    rng = np.random.default_rng(11)
+    ref = cell_frame(rng.random(100) < 0.5)
+    cand = cell_frame(rng.random(100) < 0.5)
+    res = compare_cells(ref, cand, "success")
+    assert res["ci_low"] <= res["difference"] <= res["ci_high"]
+    assert res["p_value"] > 0.01
+    # two candidate seeds disagreeing on scenario 0: that scenario counts 0.5
+    ref2 = cell_frame([0, 0])
+    cand2 = pd.concat([cell_frame([1, 0], seed=0), cell_frame([0, 0], seed=1)], ignore_index=True)
+    assert compare_cells(ref2, cand2, "success")["candidate"] == pytest.approx(0.25)
+
+
+def test_compare_rejects_bad_input():
+    with pytest.raises(ValueError, match="different scenarios"):
+        compare_cells(cell_frame(np.ones(10)), cell_frame(np.ones(11)), "success")
+    with pytest.raises(ValueError, match="metric"):
+        compare_cells(cell_frame(np.ones(10)), cell_frame(np.ones(10)), "steps")
+
+
+def test_holm():
+    assert holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
+    assert holm([]).size == 0
+
+
+# --------------------------------------------------------------------------------------------- tables
+def test_paths_parse_and_group(tmp_path):
+    p = eval_path(tmp_path, "head_on", 3, "kitchen", "everywhere", 1.65)
+    assert parse_eval_path(p) == {"variant": "head_on", "seed": 3, "layout": "kitchen", "placement": "everywhere",
+                                  "height": 1.65}
+    paths = make_eval_tree(tmp_path, seeds=(0, 1), n=5)
+    groups = group_eval_paths(paths)
+    assert len(groups) == 6 * 2 and all(len(v) == 2 for v in groups.values())
+    cells = cells_from_paths(paths)
+    assert set(cells) == set(PAPER_TABLE1) and all(len(v) == 4 for v in cells.values())
+    with pytest.raises(ValueError, match="seed"):
+        parse_eval_path(tmp_path / "x.csv")
+
+
+def test_table1(tmp_path):
+    paths = make_eval_tree(tmp_path / "r", seeds=(0, 1, 2), n=40)
+    files = group_eval_paths(paths)
+    df = table1(files, tmp_path / "out" / "table1", n_resamples=N_RES)
+    assert list(df.columns) == ["height", "placement", "n_episodes", "n_seeds", "success_rate", "wilson_low",
+                                "wilson_high", "seed_boot_low", "seed_boot_high", "spl", "paper_success_rate"]
+    assert len(df) == 6 and (df["n_episodes"] == 3 * 2 * 40).all() and (df["n_seeds"] == 3).all()
+    assert list(df["height"]) == [0.45, 0.45, 1.05, 1.05, 1.65, 1.65]
+    assert list(df["placement"][:2]) == ["no_low_cabinets", "everywhere"]
+    for r in df.itertuples():
+        assert r.wilson_low <= r.success_rate <= r.wilson_high
+        assert r.seed_boot_low <= r.seed_boot_high
+        assert r.paper_success_rate == PAPER_TABLE1[(r.height, r.placement)]
+        assert abs(r.success_rate - r.paper_success_rate) < 0.12
+    # pooled success rate is the mean over every episode of the cell
+    cell = [p for p in paths if parse_eval_path(p)["height"] == 1.05 and "everywhere" in str(p)]
+    pooled = pd.concat([pd.read_csv(p) for p in cell])["success"].mean()
+    row = df[(df.height == 1.05) & (df.placement == "everywhere")].iloc[0]
+    assert row.success_rate == pytest.approx(pooled)
+    out = tmp_path / "out"
+    assert pd.read_csv(out / "table1.csv").shape == (6, 11)
+    md = (out / "table1.md").read_text()
+    assert "| Head height | Excluding cabinets | Everywhere |" in md
+    assert "| 1.05m | ours " in md and "· paper 0.92 |" in md and "Wilson" in md
+    tex = (out / "table1.tex").read_text()
+    assert r"\toprule" in tex and r"\bottomrule" in tex and "Wilson" in tex and r"\caption{" in tex
+    assert "paper 0.76" in tex and "0.45m" in tex
+
+
+def test_table1_one_seed_and_directory_prefix(tmp_path):
+    paths = make_eval_tree(tmp_path / "r", seeds=(4,), n=10, layouts=("kitchen",))
+    out = tmp_path / "out"
+    out.mkdir()
+    df = table1({k: v[0] for k, v in group_eval_paths(paths).items()}, out, n_resamples=N_RES)
+    assert df["seed_boot_low"].isna().all() and (df["n_seeds"] == 1).all()
+    assert (out / "table1.csv").exists() and (out / "table1.md").exists() and (out / "table1.tex").exists()
+    with pytest.raises(ValueError, match="no evaluation files"):
+        table1({}, out)
+    # the key gives the seed: paths need not follow the results/ layout
+    flat = tmp_path / "flat.csv"
+    episodes_frame(np.ones(10)).to_csv(flat, index=False)
+    df = table1({(7, 1.05, "everywhere"): flat}, tmp_path / "flat_table", n_resamples=N_RES)
+    assert df["success_rate"].tolist() == [1.0] and (tmp_path / "flat_table.md").exists()
+
+
+def test_table2(tmp_path):
+    rows = [("Image Size", "100x100"), ("Discount rate γ", "0.99"), ("Alpha (SAC) : optimizer β1", "0.5"),
+            ("Critic : τ (polyak averaging)", "0.01"), ("Batch-size", "32"), ("Number of training steps", "0.75M")]
+    table2(rows, tmp_path / "table2")
+    md = (tmp_path / "table2.md").read_text().splitlines()
+    assert "CURL hyperparameters" in md[0]
+    body = [ln for ln in md if ln.startswith("| ") and "Parameter" not in ln]
+    assert body == [f"| {a} | {b} |" for a, b in rows]
+    tex = (tmp_path / "table2.tex").read_text()
+    assert r"Discount rate $\gamma$ & 0.99 \\" in tex and r"$\beta_1$" in tex and r"$\tau$" in tex
+    assert tex.index("Image Size") < tex.index("Discount") < tex.index("Batch-size") < tex.index("0.75M")
+    assert r"\toprule" in tex and "CURL hyperparameters" in tex
+
+
+def test_compare_report(tmp_path):
+    ref_paths = make_eval_tree(tmp_path / "r", "head_on", seeds=(0, 1), n=60)
+    cand_paths = make_eval_tree(tmp_path / "r", "head_off", seeds=(0, 1, 2), n=60, shift=-0.35)
+    ref, cand = cells_from_paths(ref_paths), cells_from_paths(cand_paths)
+    df = compare_report(ref, cand, tmp_path / "cmp.csv", n_resamples=N_RES)
+    assert len(df) == 12 and set(df["metric"]) == {"success", "spl"}
+    assert (df["n_scenarios"] == 120).all()  # 60 scenarios x 2 layouts, layouts kept apart
+    assert (df["n_seeds_ref"] == 2).all() and (df["n_seeds_cand"] == 3).all()
+    succ = df[df.metric == "success"]
+    assert (succ["difference"] < -0.15).all() and succ["significant"].all()
+    assert (df["p_holm"] >= df["p_value"]).all()
+    assert pd.read_csv(tmp_path / "cmp.csv").shape == df.shape
+    text = format_compare(df, "head_on", "head_off")
+    assert "*" in text and "everywhere" in text and len(text.splitlines()) == 12 + 3
+
+
+def test_compare_report_errors(tmp_path):
+    ref = cells_from_paths(make_eval_tree(tmp_path / "r", "a", seeds=(0,), n=8))
+    cand = cells_from_paths(make_eval_tree(tmp_path / "r", "b", seeds=(0,), n=8))
+    partial = {k: v for k, v in cand.items() if k != (1.65, "everywhere")}
+    with pytest.raises(ValueError, match=r"height=1.65, placement=everywhere.*only in the reference"):
+        compare_report(ref, partial, n_resamples=N_RES)
+    other = cells_from_paths(make_eval_tree(tmp_path / "r", "c", seeds=(0,), n=9))
+    with pytest.raises(ValueError, match=r"cell \(height=0.45, placement=no_low_cabinets\).*different scenarios"):
+        compare_report(ref, other, n_resamples=N_RES)
+    with pytest.raises(ValueError) as e:
+        compare_report(ref, other, n_resamples=N_RES)
+    assert "\n" not in str(e.value)
+
+
+# --------------------------------------------------------------------------------------------- figures
+def _png_ok(p: Path, min_bytes: int = 20_000):
+    assert p.exists() and p.stat().st_size > min_bytes
+    assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_figure6(tmp_path):
+    curves = make_curves(tmp_path / "r", seeds=(0, 1, 2))
+    outs = figure6(curves, tmp_path / "fig6", n_resamples=N_RES)
+    png, pdf, csv = outs
+    _png_ok(png)
+    assert pdf.read_bytes()[:5] == b"%PDF-" and pdf.stat().st_size > 5_000
+    df = pd.read_csv(csv)
+    assert set(df["variant"]) == {"head_on", "head_off"} and (df["n_seeds"] == 3).all()
+    assert (df["low"] <= df["success_rate"] + 1e-12).all() and (df["high"] >= df["success_rate"] - 1e-12).all()
+    assert set(df["label"]) == {"with head movement", "without head movement"}
+
+
+def test_figure6_one_seed_and_empty(tmp_path):
+    curves = make_curves(tmp_path / "r", seeds=(0,))
+    png, _, csv = figure6(curves, tmp_path / "one", n_resamples=N_RES)
+    _png_ok(png)
+    assert pd.read_csv(csv)["low"].isna().all()
+    with pytest.raises(ValueError, match="no training curves"):
+        figure6({}, tmp_path / "x")
+    with pytest.raises(ValueError, match="no curve files"):
+        figure6({"head_on": []}, tmp_path / "x")
+    empty = write_curve(tmp_path / "e" / "seed0" / "curve.csv", [], [])
+    with pytest.raises(ValueError, match="no evaluated rows"):
+        figure6({"head_on": [empty]}, tmp_path / "x")
+
+
+def test_figure7(tmp_path):
+    files = make_fullbody(tmp_path / "r", mgs=("humanoid_phase",), seeds=(0, 1))
+    png, pdf, csv = figure7(files, tmp_path / "fig7", n_resamples=N_RES)
+    _png_ok(png)
+    assert pdf.read_bytes()[:5] == b"%PDF-"
+    df = pd.read_csv(csv)
+    assert list(df["method"]) == ["one_step_short", "one_step_long", "noisy_search", "ours", "ours", "ours", "ours"]
+    assert list(df[df.method == "ours"]["M"]) == [1, 5, 10, 20]
+    assert (df["n_seeds"] == 2).all() and (df["n_episodes"] == 80).all() and (df["ci_unit"] == "scenario").all()
+    assert (df["spl_low"] <= df["spl"]).all() and (df["spl"] <= df["spl_high"]).all()
+    ours = df[df.method == "ours"]
+    assert ours["attempts"].is_monotonic_decreasing
+
+
+def test_figure7_several_mgs_one_seed_and_empty(tmp_path):
+    files = make_fullbody(tmp_path / "r", mgs=("humanoid_phase", "humanoid_matching", "fetch"), seeds=(0,))
+    png, _, csv = figure7(files, tmp_path / "fig7mg", n_resamples=N_RES)
+    _png_ok(png)
+    df = pd.read_csv(csv)
+    assert set(df["mg"]) == {"humanoid_phase", "humanoid_matching", "fetch"} and len(df) == 21
+    baselines_only = [p for p in files if "ours" not in p.parent.name]
+    png, _, csv = figure7(baselines_only, tmp_path / "fig7b", n_resamples=N_RES)
+    _png_ok(png, 10_000)
+    assert not pd.read_csv(csv)["method"].eq("ours").any()
+    with pytest.raises(ValueError, match="no full-body CSVs"):
+        figure7([], tmp_path / "x")
+    empty = tmp_path / "empty" / "seed0.csv"
+    empty.parent.mkdir()
+    pd.DataFrame(columns=FULLBODY_COLUMNS).to_csv(empty, index=False)
+    with pytest.raises(ValueError, match="no episodes"):
+        figure7([empty], tmp_path / "x")
+
+
+# --------------------------------------------------------------------------------------------- CLI helpers
+def test_cli_helpers(tmp_path, capsys):
+    ref = make_eval_tree(tmp_path / "r", "head_on", seeds=(0,), n=10, layouts=("kitchen",))
+    cand = make_eval_tree(tmp_path / "r", "head_off", seeds=(0,), n=10, layouts=("kitchen",))
+    cmd_table1(ref + cand, tmp_path / "o" / "table1", variant="head_on")
+    cmd_table2([("Batch-size", "32")], tmp_path / "o" / "table2")
+    df = cmd_compare(ref, cand, tmp_path / "o" / "compare.csv", "head_on", "head_off")
+    assert len(df) == 12
+    cmd_fig6(make_curves(tmp_path / "r", seeds=(0,)), tmp_path / "o" / "fig6")
+    cmd_fig7(make_fullbody(tmp_path / "r", seeds=(0,), n=10), tmp_path / "o" / "fig7")
+    out = capsys.readouterr().out
+    for name in ("table1.csv", "table1.md", "table1.tex", "table2.md", "table2.tex", "compare.csv", "fig6.png",
+                 "fig6.pdf", "fig7.png", "fig7.csv"):
+        assert (tmp_path / "o" / name).exists() and name in out
+    with pytest.raises(ValueError, match="several variants"):
+        cmd_table1(ref + cand, tmp_path / "o" / "t")
+
+
+# --------------------------------------------------------------------------------------------- isolation
+def test_report_imports_no_torch_or_simulator():
+    code = ("import sys, egosearch.report, egosearch.report.cli\n"
+            "bad = sorted(m for m in sys.modules if m.split('.')[0] in "
+            "('torch', 'pybullet', 'gymnasium', 'pyrender', 'trimesh', 'pybullet_data'))\n"
+            "mods = sorted(m for m in sys.modules if m.startswith('egosearch.') "
+            "and not m.startswith('egosearch.report') and m != 'egosearch.metrics')\n"
+            "print(bad, mods)\n"
+            "assert not bad and not mods, (bad, mods)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+# --------------------------------------------------------------------------------------------- properties
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 500).flatmap(lambda n: st.tuples(st.integers(0, n), st.just(n))))
+def test_wilson_brackets_the_rate(kn):
+    k, n = kn
+    lo, hi = wilson_ci(k, n)
+    assert 0.0 <= lo <= k / n <= hi <= 1.0
+    assert (lo, hi) == pytest.approx(_wilson_by_hand(k, n), abs=1e-9)
