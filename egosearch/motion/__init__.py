@@ -1,0 +1,22 @@
+"""Full-body characters for the abstract search policy (paper section 5).
+
+- :mod:`~egosearch.motion.mocap`: DeepMimic clips from pybullet_data;
+- :mod:`~egosearch.motion.humanoid` (1.65 m DeepMimic humanoid), :mod:`~egosearch.motion.fetch`;
+- :mod:`~egosearch.motion.base`: ``FullBodyPose`` and the ``MotionGenerator`` interface;
+  :mod:`~egosearch.motion.phase` (``PhaseMG``), :mod:`~egosearch.motion.matching` (``MatchingMG``),
+  ``FetchMG``;
+- :mod:`~egosearch.motion.replan`: Algorithm 1, baselines, ``evaluate_fullbody``;
+- :mod:`~egosearch.motion.video`: first-person + third-person search videos.
+"""
+
+from egosearch.motion.replan import (  # noqa: F401
+    DEFAULT_M,
+    DEFAULT_T,
+    FULLBODY_COLUMNS,
+    M_VALUES,
+    METHODS,
+    MOTION_GENERATORS,
+    evaluate_fullbody,
+    run_fullbody_episode,
+    write_fullbody,
+)

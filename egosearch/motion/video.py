@@ -1,0 +1,227 @@
+"""Search videos of full-body characters, like the paper's Figures 1 and 3.
+
+Each frame puts what the character's camera sees (the depth image with the target mask in red,
+as the policy gets it) beside a third-person view of the home with the character drawn from its
+collision shapes (the humanoid's spheres, capsules and feet boxes; Fetch's cylinders and boxes),
+its camera as a small dark box, and the current abstract plan as grey dots on the floor.
+
+The third-person picture has its own pyrender scene built from the scene parts with
+:func:`egosearch.scene.meshes.part_mesh`, so the character can move without rebuilding the home.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+import numpy as np  # noqa: E402
+import trimesh  # noqa: E402
+
+from egosearch.agent import STEP_SECONDS  # noqa: E402
+from egosearch.motion import quat  # noqa: E402
+from egosearch.motion.base import FullBodyPose  # noqa: E402
+
+CHARACTERS = ("humanoid_phase", "humanoid_matching", "fetch")
+FRAME_HEIGHT = 384
+THIRD_WIDTH = 512
+HUMANOID_COLOR = (0.25, 0.5, 0.85)
+FETCH_COLOR = (0.85, 0.85, 0.88)
+CAMERA_COLOR = (0.1, 0.1, 0.1)
+PLAN_COLOR = (0.55, 0.55, 0.55)
+
+
+def _transform(position, rotation=None) -> np.ndarray:
+    t = np.eye(4)
+    if rotation is not None:
+        x, y, z, w = rotation
+        t[:3, :3] = trimesh.transformations.quaternion_matrix([w, x, y, z])[:3, :3]
+    t[:3, 3] = position
+    return t
+
+
+def _centred(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    mesh.apply_translation(-mesh.bounds.mean(axis=0))
+    return mesh
+
+
+def camera_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
+    """A small box at the camera, turned by the head's yaw and pitch."""
+    yaw = pose.theta + pose.head_yaw
+    rot = quat.mul(quat.yaw(yaw), quat.from_axis_angle((0, 1, 0), -pose.pitch))
+    box = trimesh.creation.box(extents=(0.12, 0.08, 0.06))
+    box.apply_translation((0.1, 0.0, 0.0))
+    box.apply_transform(_transform((pose.x, pose.y, pose.camera_height), rot))
+    return box
+
+
+def humanoid_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
+    from egosearch.motion.humanoid import HUMANOID_SCALE, limb_shapes
+
+    s = HUMANOID_SCALE
+    meshes = []
+    for shape, centre, rot in limb_shapes(pose, s):
+        if shape.kind == "sphere":
+            m = trimesh.creation.icosphere(subdivisions=2, radius=shape.radius * s)
+        elif shape.kind == "capsule":
+            m = _centred(trimesh.creation.capsule(height=shape.length * s, radius=shape.radius * s, count=[12, 12]))
+        else:
+            m = trimesh.creation.box(extents=np.asarray(shape.size) * s)
+        m.apply_transform(_transform(centre, rot))
+        meshes.append(m)
+    return trimesh.util.concatenate(meshes)
+
+
+def fetch_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
+    from egosearch.motion.fetch import FETCH_PARTS
+
+    meshes = []
+    for kind, centre, dims in FETCH_PARTS:
+        if kind == "cylinder":
+            m = trimesh.creation.cylinder(radius=dims[0], height=dims[1], sections=24)
+        else:
+            m = trimesh.creation.box(extents=dims)
+        m.apply_translation(centre)
+        meshes.append(m)
+    body = trimesh.util.concatenate(meshes)
+    body.apply_transform(_transform((pose.x, pose.y, 0.0), quat.yaw(pose.theta)))
+    return body
+
+
+def plan_mesh(plan) -> trimesh.Trimesh | None:
+    if not plan:
+        return None
+    dots = []
+    for s in plan:
+        d = trimesh.creation.cylinder(radius=0.04, height=0.01, sections=12)
+        d.apply_translation((s.x, s.y, 0.01))
+        dots.append(d)
+    return trimesh.util.concatenate(dots)
+
+
+class CharacterView:
+    """pyrender third-person views of a home with one moving character."""
+
+    def __init__(self, scene, target=None, width: int = THIRD_WIDTH, height: int = FRAME_HEIGHT):
+        import pyrender
+
+        from egosearch.render import look_at_pose
+        from egosearch.scene.meshes import part_mesh
+
+        self._pyrender = pyrender
+        self._look_at_pose = look_at_pose
+        self.width, self.height = width, height
+        self.scene = pyrender.Scene(bg_color=(1.0, 1.0, 1.0, 1.0), ambient_light=(0.35,) * 3)
+        groups: dict[tuple, list] = {}
+        parts = [p for p in scene.parts if "ceiling" not in p.tags] + ([target] if target is not None else [])
+        for part in parts:
+            groups.setdefault(tuple(round(c, 4) for c in part.color), []).append(part_mesh(part))
+        for color, meshes in groups.items():
+            self.scene.add(self._mesh(trimesh.util.concatenate(meshes), color))
+        for direction, intensity in (((0.4, 0.3, -1.0), 1.6), ((-0.5, -0.6, -0.8), 0.9)):
+            light = pyrender.DirectionalLight(color=np.ones(3), intensity=intensity)
+            self.scene.add(light, pose=look_at_pose((0, 0, 0), direction))
+        self.camera = pyrender.PerspectiveCamera(yfov=math.radians(55.0), aspectRatio=width / height)
+        self._camera_node = self.scene.add(self.camera, pose=np.eye(4))
+        self._dynamic: list = []
+        self._renderer = pyrender.OffscreenRenderer(width, height)
+
+    def _mesh(self, mesh: trimesh.Trimesh, color):
+        pr = self._pyrender
+        material = pr.MetallicRoughnessMaterial(baseColorFactor=(*color[:3], 1.0), metallicFactor=0.0,
+                                                roughnessFactor=0.9)
+        return pr.Mesh.from_trimesh(mesh, material=material, smooth=False)
+
+    def render(self, items: list[tuple[trimesh.Trimesh, tuple]], eye, look_at) -> np.ndarray:
+        for node in self._dynamic:
+            self.scene.remove_node(node)
+        self._dynamic = [self.scene.add(self._mesh(m, c)) for m, c in items if m is not None]
+        self.scene.set_pose(self._camera_node, self._look_at_pose(eye, look_at))
+        color, _ = self._renderer.render(self.scene)
+        return np.ascontiguousarray(color[..., :3])
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.delete()
+            self._renderer = None
+
+
+def _character_items(character: str, pose: FullBodyPose, plan) -> list:
+    body = fetch_mesh(pose) if character == "fetch" else humanoid_mesh(pose)
+    color = FETCH_COLOR if character == "fetch" else HUMANOID_COLOR
+    return [(body, color), (camera_mesh(pose), CAMERA_COLOR), (plan_mesh(plan), PLAN_COLOR)]
+
+
+def write_search_video(layout: str, character: str, policy, scenario, out_path: str | os.PathLike,
+                       still_path: str | os.PathLike | None = None, method: str = "ours", M: int = 5,
+                       T: int = 20, seed: int = 0, env_id: str = "EgoSearch-v0") -> dict:
+    """Run one full-body episode and write it as a video (``.mp4`` or ``.gif``) plus one still PNG.
+
+    Args:
+        character: ``humanoid_phase``, ``humanoid_matching`` or ``fetch`` (the motion generator).
+        policy: a policy (``reset``/``act``) or a factory ``policy(env)`` (e.g. ``OraclePolicy``).
+        still_path: the frame where the target is found (else the last one), as PNG.
+    Returns the episode's row (see :data:`egosearch.motion.replan.FULLBODY_COLUMNS`) with the paths.
+    """
+    import imageio.v2 as imageio
+
+    from egosearch.evaluate import make_env
+    from egosearch.motion.replan import make_motion_generator, run_fullbody_episode
+    from egosearch.render import depth_to_colormap, upscale
+
+    if character not in CHARACTERS:
+        raise ValueError(f"character={character!r}; allowed: {', '.join(CHARACTERS)}")
+    if scenario.layout != layout:
+        raise ValueError(f"scenario {scenario.scenario_id} is in {scenario.layout!r}, not {layout!r}")
+    env = make_env(env_id, scenario)
+    view = None
+    try:
+        u = env.unwrapped
+        pol = policy(env) if isinstance(policy, type) or not hasattr(policy, "act") else policy
+        mg = make_motion_generator(character, u.world)
+        trace: list = []
+        row = run_fullbody_episode(env, pol, mg, scenario, T=T, M=M, seed=seed, method=method, trace=trace)
+        view = CharacterView(u.scene, u.target)
+        kind = "fetch" if character == "fetch" else "humanoid"
+        frames = []
+        cam_yaw = trace[0]["pose"].theta
+        for item in trace:
+            q, s = item["pose"], item["state"]
+            depth, mask = u.sensor.render(s.camera_position, s.camera_yaw, s.pitch)
+            first = depth_to_colormap(depth, mask, max_depth=u.sensor.max_depth)
+            factor = max(1, FRAME_HEIGHT // first.shape[0])
+            first = upscale(first, factor)
+            pad = FRAME_HEIGHT - first.shape[0]
+            if pad > 0:
+                first = np.pad(first, ((pad // 2, pad - pad // 2), (pad // 2, pad - pad // 2), (0, 0)),
+                               constant_values=255)
+            # A follow camera behind and above the character, turning smoothly.
+            cam_yaw += 0.3 * math.atan2(math.sin(q.theta - cam_yaw), math.cos(q.theta - cam_yaw))
+            c, sn = math.cos(cam_yaw), math.sin(cam_yaw)
+            eye = (q.x - 2.2 * c, q.y - 2.2 * sn, 3.3)
+            look = (q.x + 0.6 * c, q.y + 0.6 * sn, 0.7)
+            third = view.render(_character_items(kind, q, item["plan"]), eye, look)
+            frames.append(np.concatenate([first[:, :FRAME_HEIGHT], third], axis=1))
+        out_path = Path(out_path)
+        out_path.parent.mkdir(parents=True, exist_ok=True)
+        fps = 1.0 / STEP_SECONDS
+        if out_path.suffix.lower() == ".gif":
+            imageio.mimsave(out_path, frames, duration=STEP_SECONDS * 1000, loop=0)
+        else:
+            with imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=16) as w:
+                for f in frames:
+                    w.append_data(f)
+        row["video"] = str(out_path)
+        if still_path is not None:
+            still_path = Path(still_path)
+            still_path.parent.mkdir(parents=True, exist_ok=True)
+            seen = [i for i, item in enumerate(trace) if item["visible"]]
+            imageio.imwrite(still_path, frames[seen[-1] if seen else -1])
+            row["still"] = str(still_path)
+        return row
+    finally:
+        if view is not None:
+            view.close()
+        env.close()
