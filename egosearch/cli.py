@@ -51,6 +51,103 @@ def _cmd_evaluate(args) -> None:
     print(f"{args.policy}: success {rate:.3f}  SPL {value:.3f}  over {len(rows)} episodes -> {args.out}")
 
 
+def _cmd_train(args) -> None:
+    from egosearch.evaluate import scenario_evaluator
+    from egosearch.rl.config import load_config
+    from egosearch.rl.train import train
+    from egosearch.variants import load_variant
+
+    variant = load_variant(args.variant)
+    overrides = {**variant.config, "seed": args.seed}
+    if args.threads:
+        overrides["num_threads"] = args.threads
+    cfg = load_config(args.profile, overrides)
+    env = variant.train_env
+    evaluator = scenario_evaluator(variant.env_id, env["layout"], env["placement"], n=cfg.eval_episodes)
+    try:
+        summary = train(variant.env_id, cfg, args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
+                        variant=variant.name)
+    finally:
+        evaluator.close()
+    print(json.dumps(summary))
+
+
+def _cmd_fullbody(args) -> None:
+    from egosearch.motion.replan import evaluate_fullbody, parse_setting, write_fullbody
+    from egosearch.rl.train import ActorPolicy
+    from egosearch.scenarios import read_scenarios
+
+    method, m, mg = parse_setting(args.setting)
+    policy = ActorPolicy(args.weights)
+    scenarios = read_scenarios(args.scenarios)[: args.limit or None]
+    rows = evaluate_fullbody(policy.env_id or "EgoSearch-v0", lambda env: policy, scenarios, method=method,
+                             mg_name=mg, M=m, T=args.T, seed=args.seed, progress=True)
+    write_fullbody(args.out, rows)
+    rate = sum(r["success"] for r in rows) / len(rows)
+    print(f"{args.setting}: success {rate:.3f} over {len(rows)} episodes -> {args.out}")
+
+
+def _group_curves(paths: list[str]) -> dict[str, list[str]]:
+    """``.../train/{variant}/seed{seed}/curve.csv`` grouped by variant, in first-seen order."""
+    from pathlib import Path
+
+    groups: dict[str, list[str]] = {}
+    for path in paths:
+        groups.setdefault(Path(path).parent.parent.name, []).append(path)
+    return groups
+
+
+def _cmd_report(args) -> None:
+    from egosearch.report import cli as report
+
+    if args.what == "table1":
+        report.cmd_table1(args.files, args.out_prefix, variant=args.variant)
+    elif args.what == "table2":
+        from egosearch.rl.config import load_config, table2_rows
+
+        report.cmd_table2(table2_rows(load_config(args.profile)), args.out_prefix)
+    elif args.what == "fig6":
+        report.cmd_fig6(_group_curves(args.files), args.out_prefix)
+    elif args.what == "fig7":
+        report.cmd_fig7(args.files, args.out_prefix)
+    elif args.what == "compare":
+        if not args.reference or not args.candidate:
+            raise ValueError("compare needs --reference CSV... and --candidate CSV...")
+        report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
+                           candidate_name="candidate")
+    elif args.what == "provenance":
+        from egosearch.report.provenance import write_provenance
+
+        record = write_provenance(args.profile, args.results, args.out)
+        print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
+    elif args.what == "regenerate":
+        _regenerate(args.profile, args.variant or "head_on")
+
+
+def _regenerate(profile: str, reference: str) -> None:
+    """Tables and figures from the CSVs already in results/<profile>/: seconds, no training."""
+    from pathlib import Path
+
+    from egosearch.report import cli as report
+    from egosearch.rl.config import load_config, table2_rows
+
+    results, figs = Path("results") / profile, Path("paper_figs") / profile
+    evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
+    curves = sorted(str(p) for p in (results / "train").glob("*/seed*/curve.csv"))
+    fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
+    if not (evals or curves or fullbody):
+        raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
+    figs.mkdir(parents=True, exist_ok=True)
+    if evals:
+        report.cmd_table1(evals, figs / "table1", variant=reference)
+    if curves:
+        report.cmd_fig6(_group_curves(curves), figs / "fig6")
+    if fullbody:
+        report.cmd_fig7(fullbody, figs / "fig7")
+    learner = {"smoke": "smoke", "cpu": "cpu", "paper": "paper"}[profile]
+    report.cmd_table2(table2_rows(load_config(learner)), figs / "table2")
+
+
 def _cmd_bench(args) -> None:
     from egosearch import bench
 
@@ -99,6 +196,25 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True)
     p.set_defaults(func=_cmd_evaluate)
 
+    p = sub.add_parser("train", help="train a variant's search policy with SAC+CURL (resumable)")
+    p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...)")
+    p.add_argument("--profile", default="cpu", help="smoke, cpu or paper")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
+    p.add_argument("--out-dir", required=True)
+    p.set_defaults(func=_cmd_train)
+
+    p = sub.add_parser("fullbody", help="full-body search (Algorithm 1 or a baseline) -> per-episode CSV")
+    p.add_argument("--setting", required=True,
+                   help="ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> or noisy_search-<mg>")
+    p.add_argument("--weights", required=True, help="actor.pt of the search policy")
+    p.add_argument("--scenarios", required=True)
+    p.add_argument("--limit", type=int, default=0, help="use the first N scenarios (0: all)")
+    p.add_argument("--T", type=int, default=20, help="planning horizon")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True)
+    p.set_defaults(func=_cmd_fullbody)
+
     p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics) or learner")
     p.add_argument("what", choices=("env", "learner"))
     p.add_argument("--layout", default="kitchen_living")
@@ -106,6 +222,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=3000)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
+    p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate"))
+    p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
+    p.add_argument("--out-prefix", help="output path without extension")
+    p.add_argument("--variant", help="table1/regenerate: the variant the files belong to (default head_on)")
+    p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate: smoke, cpu or paper")
+    p.add_argument("--reference", nargs="*", help="compare: the reference variant's evaluation CSVs")
+    p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")
+    p.add_argument("--results", default="results/cpu", help="provenance: the results folder")
+    p.add_argument("--out", help="compare/provenance: output file")
+    p.set_defaults(func=_cmd_report)
 
     p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")
     p.add_argument("--layout", default="kitchen_living")

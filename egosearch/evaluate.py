@@ -80,3 +80,37 @@ def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
         writer.writeheader()
         writer.writerows(rows)
     os.replace(tmp, path)
+
+
+def scenario_evaluator(env_id: str, layout: str, placement: str, n: int, seed: int = 7):
+    """``evaluate(policy) -> {success_rate, spl, episode_return}`` on ``n`` fixed held-out
+    scenarios of the training home (the three evaluation heights in turn). The learner calls it
+    every ``eval_every`` steps: these rows are Figure 6's data."""
+    from egosearch.agent import EVAL_HEIGHTS
+    from egosearch.metrics import spl
+    from egosearch.scenarios import generate_scenarios
+
+    per_height = [generate_scenarios(layout, placement, h, n=-(-n // len(EVAL_HEIGHTS)), seed=seed)
+                  for h in EVAL_HEIGHTS]
+    scenarios = [sc for i in range(max(map(len, per_height))) for group in per_height
+                 for sc in group[i:i + 1]][:n]
+    envs: dict = {}
+
+    def evaluate_policy(policy) -> dict:
+        rows = []
+        for sc in scenarios:
+            if sc.height not in envs:
+                envs[sc.height] = make_env(env_id, sc)
+            rows.append(run_episode(envs[sc.height], policy, sc, seed=seed + sc.scenario_id))
+        return {"success_rate": sum(r["success"] for r in rows) / len(rows),
+                "spl": spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
+                           [r["path_length"] for r in rows]),
+                "episode_return": sum(r["episode_return"] for r in rows) / len(rows)}
+
+    def close() -> None:
+        for env in envs.values():
+            env.close()
+        envs.clear()
+
+    evaluate_policy.close = close
+    return evaluate_policy

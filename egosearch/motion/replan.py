@@ -91,6 +91,22 @@ def get_method(name: str) -> Method:
     return METHODS[name]
 
 
+def parse_setting(setting: str) -> tuple[str, int | None, str]:
+    """``ours-M5-humanoid_phase`` -> ("ours", 5, "humanoid_phase"); a baseline such as
+    ``noisy_search-fetch`` takes the method's default M (None for the one-step lines, which
+    execute their whole line; :data:`DEFAULT_M` for noisy search)."""
+    method, _, mg = setting.rpartition("-")
+    m: int | None = None
+    if method.startswith("ours-M") and method[len("ours-M"):].isdigit():
+        method, m = "ours", int(method[len("ours-M"):])
+    elif method == "noisy_search":
+        m = DEFAULT_M
+    if method not in METHODS or method == "ours" and m is None or mg not in MOTION_GENERATORS:
+        raise ValueError(f"setting={setting!r}; expected ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> "
+                         f"or noisy_search-<mg> with <mg> in {', '.join(MOTION_GENERATORS)}")
+    return method, m, mg
+
+
 def make_motion_generator(name: str, world=None) -> MotionGenerator:
     if name not in MOTION_GENERATORS:
         raise ValueError(f"motion generator {name!r} is unknown; allowed: {', '.join(MOTION_GENERATORS)}")

@@ -1,0 +1,29 @@
+# egosearch: the paper's experiments as one DAG.
+#   snakemake --cores 2 all                     # everything at the default `cpu` profile (~3 h)
+#   snakemake --cores 2 table1                  # Table 1 only (trains what it needs)
+#   snakemake --cores 2 compare --config variant=my_variant
+# Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
+from snakemake.utils import min_version, validate
+
+min_version("9.0")
+
+configfile: "egosearch/workflow/config.yaml"
+validate(config, "egosearch/workflow/config.schema.json")
+
+include: "egosearch/workflow/rules/common.smk"
+include: "egosearch/workflow/rules/scenarios.smk"
+include: "egosearch/workflow/rules/train.smk"
+include: "egosearch/workflow/rules/evaluate.smk"
+include: "egosearch/workflow/rules/fullbody.smk"
+include: "egosearch/workflow/rules/report.smk"
+
+
+rule all:
+    input:
+        rules.table1.output,
+        rules.table2.output,
+        rules.table2_paper.output,
+        rules.fig6.output,
+        rules.fig7.output,
+        rules.pictures.output,
+        provenance_file(),

@@ -1,0 +1,84 @@
+# Names and paths shared by every rule. Every output path is a function of
+# (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
+from pathlib import Path
+
+from egosearch.variants import load_variant
+
+# Optional (`--use-conda`): the software every rule runs with.
+CONDA_ENV = "../envs/egosearch.yaml"
+
+PROFILE = config["profile"]
+PROF = config["profiles"][PROFILE]
+LAYOUT = config["layout"]
+SEEDS = PROF["seeds"]
+HEIGHTS = [f"{h:g}" for h in config["heights"]]
+PLACEMENTS = config["placements"]
+FULLBODY = PROF["fullbody"]
+REF = config["reference_variant"]
+RESULTS = f"results/{PROFILE}"
+FIGS = f"paper_figs/{PROFILE}"
+BASELINES = ["one_step_short", "one_step_long", "noisy_search"]
+
+# A typo in a variant name stops here, naming the variant, before any job starts.
+VARIANTS = {name: load_variant(name) for name in dict.fromkeys(config["variants"] + [REF])}
+
+wildcard_constraints:
+    profile="smoke|cpu|paper",
+    variant="[A-Za-z0-9_\\-]+",
+    seed="[0-9]+",
+    height="[0-9.]+",
+    placement="no_low_cabinets|everywhere",
+    layout="kitchen_living|bedroom_bath|home[0-9]+",
+    setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
+
+
+def scenario_file(placement, height):
+    return f"{RESULTS}/scenarios/{LAYOUT}/{placement}/h{height}.csv"
+
+
+def eval_files(variant):
+    return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{LAYOUT}/{{placement}}/h{{height}}.csv",
+                  seed=SEEDS, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def curve_files(variant):
+    return expand(f"{RESULTS}/train/{variant}/seed{{seed}}/curve.csv", seed=SEEDS)
+
+
+def fullbody_settings():
+    out = []
+    for mg in FULLBODY["motion_generators"]:
+        out += [f"ours-M{m}-{mg}" for m in FULLBODY["ms"]]
+        out += [f"{baseline}-{mg}" for baseline in BASELINES]
+    return out
+
+
+def fullbody_files():
+    return expand(f"{RESULTS}/fullbody/{{setting}}/seed{{seed}}.csv",
+                  setting=fullbody_settings(), seed=FULLBODY["seeds"])
+
+
+def provenance_file():
+    return f"{RESULTS}/provenance.json"
+
+
+def train_resources(profile):
+    """Portable resources: the same DAG runs locally, under slurm or cluster-generic."""
+    if profile == "paper":
+        return dict(mem_mb=8000, runtime=72 * 60, gpu=1)
+    if profile == "cpu":
+        return dict(mem_mb=3000, runtime=90, gpu=0)
+    return dict(mem_mb=1500, runtime=10, gpu=0)
+
+
+def fullbody_scenarios(wildcards):
+    # Each character searches at its own camera height: the humanoid at 1.65 m, Fetch at 1.05 m.
+    height = "1.05" if wildcards.setting.endswith("-fetch") else "1.65"
+    return scenario_file("everywhere", height)
+
+
+def compare_candidate(wildcards):
+    if not config.get("variant"):
+        raise ValueError("compare needs a variant: snakemake compare --config variant=NAME")
+    load_variant(config["variant"])
+    return eval_files(config["variant"])

@@ -1,0 +1,20 @@
+rule evaluate:
+    """One trained policy on one Table 1 cell: a row per episode."""
+    input:
+        actor="results/{profile}/train/{variant}/seed{seed}/actor.pt",
+        scenarios="results/{profile}/scenarios/{layout}/{placement}/h{height}.csv",
+    output:
+        "results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output} > {log} 2>&1"

@@ -1,0 +1,129 @@
+# Tables and figures: CSV in, files out; seconds, no torch, no simulator.
+
+rule table1:
+    """Success rate per camera height x placement scheme, pooled over seeds (paper Table 1)."""
+    input:
+        eval_files(REF),
+    output:
+        expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
+    log:
+        f"{RESULTS}/logs/report/table1.log",
+    params:
+        variant=REF,
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report table1 --variant {params.variant} --out-prefix {params.prefix} {input} > {log} 2>&1"
+
+
+rule table2:
+    """The learner's hyperparameters of this profile, generated from the config (paper Table 2)."""
+    output:
+        expand(f"{FIGS}/table2.{{ext}}", ext=["md", "tex"]),
+    log:
+        f"{RESULTS}/logs/report/table2.log",
+    params:
+        learner=PROF["learner"],
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report table2 --profile {params.learner} --out-prefix {params.prefix} > {log} 2>&1"
+
+
+rule table2_paper:
+    """Table 2 of the paper, regenerated from the `paper` profile of the config."""
+    output:
+        expand("paper_figs/table2.{ext}", ext=["md", "tex"]),
+    log:
+        f"{RESULTS}/logs/report/table2_paper.log",
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report table2 --profile paper --out-prefix {params.prefix} > {log} 2>&1"
+
+
+rule fig6:
+    """Success rate vs environment steps, head on vs head off (paper Figure 6)."""
+    input:
+        [curve_files(v) for v in VARIANTS],
+    output:
+        expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
+    log:
+        f"{RESULTS}/logs/report/fig6.log",
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report fig6 --out-prefix {params.prefix} {input} > {log} 2>&1"
+
+
+rule fig7:
+    """SPL per method and attempts vs M of the full-body replanner (paper Figure 7)."""
+    input:
+        fullbody_files(),
+    output:
+        expand(f"{FIGS}/fig7.{{ext}}", ext=["png", "pdf", "csv"]),
+    log:
+        f"{RESULTS}/logs/report/fig7.log",
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report fig7 --out-prefix {params.prefix} {input} > {log} 2>&1"
+
+
+rule pictures:
+    """The world's pictures: top-down map, placements, first/third-person views."""
+    output:
+        expand("paper_figs/world/{layout}_{kind}.png", layout=[LAYOUT], kind=["topdown", "placements", "views"]),
+    log:
+        f"{RESULTS}/logs/report/pictures.log",
+    params:
+        layout=LAYOUT,
+        out_dir=lambda wc, output: str(Path(output[0]).parent),
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch pictures --layout {params.layout} --out-dir {params.out_dir} > {log} 2>&1"
+
+
+rule compare:
+    """Does a new variant beat the stored reference? Per cell: difference, 95% CI, p-value."""
+    input:
+        reference=eval_files(REF),
+        candidate=compare_candidate,
+    output:
+        f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
+    log:
+        f"{RESULTS}/logs/report/compare_{config.get('variant') or 'none'}.log",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report compare --reference {input.reference} --candidate {input.candidate} "
+        "--out {output} 2>&1 | tee {log}"
+
+
+rule provenance:
+    """Commit, profile, machine, date and the wall time of every rule, next to the results."""
+    input:
+        rules.table1.output,
+        rules.table2.output,
+        rules.fig6.output,
+        rules.fig7.output,
+    output:
+        provenance_file(),
+    log:
+        f"{RESULTS}/logs/report/provenance.log",
+    params:
+        profile=PROFILE,
+        results=lambda wc, output: str(Path(output[0]).parent),
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report provenance --profile {params.profile} --results {params.results} --out {output} > {log} 2>&1"

@@ -1,0 +1,20 @@
+rule scenarios:
+    """The fixed scenario set of one Table 1 cell (paper 6.1)."""
+    output:
+        "results/{profile}/scenarios/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/scenarios/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/scenarios/{layout}/{placement}/h{height}.tsv"
+    params:
+        n=PROF["scenarios_per_cell"],
+        seed=config["scenario_seed"],
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch scenarios --layout {wildcards.layout} --placement {wildcards.placement} "
+        "--height {wildcards.height} --n {params.n} --seed {params.seed} --out {output} > {log} 2>&1"

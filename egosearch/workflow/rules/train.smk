@@ -1,0 +1,20 @@
+rule train:
+    """SAC+CURL on the abstract searcher (paper 4.2). Resumes from its checkpoint if killed."""
+    output:
+        actor="results/{profile}/train/{variant}/seed{seed}/actor.pt",
+        curve="results/{profile}/train/{variant}/seed{seed}/curve.csv",
+    log:
+        "results/{profile}/logs/train/{variant}/seed{seed}.log",
+    benchmark:
+        "results/{profile}/benchmarks/train/{variant}/seed{seed}.tsv"
+    params:
+        learner=lambda wc: config["profiles"][wc.profile]["learner"],
+        out_dir=lambda wc, output: str(Path(output.actor).parent),
+    threads: 1
+    resources:
+        **train_resources(PROFILE),
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch train --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
+        "--threads {threads} --out-dir {params.out_dir} > {log} 2>&1"
