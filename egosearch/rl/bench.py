@@ -1,0 +1,117 @@
+"""``egosearch bench learner``: SAC + CURL update speed and replay memory (under ~60 s).
+
+Every number is a full SAC + CURL update (replay sampling, crops, critic, actor + temperature
+every 2nd update, Polyak every 2nd update, CURL), batch 32, 5 x 100 x 100 uint8 frames cropped
+to 84 x 84, timed over a stretch of consecutive updates after a warm-up. Updates/s are reported
+from the MEDIAN update time; ``*_best`` keys give the fastest update (the least disturbed by
+other processes on a shared machine; ``other_load`` is the CPU time other processes used during
+the run, in cores).
+
+Keys:
+- ``updates_per_s_table2``: the optimised update (``impl="fast"``, CURL's math exactly) at
+  Table 2 sizes, all cores;
+- ``updates_per_s_table2_shared``: same, with ``share_encoder_forward=True`` (not CURL's math);
+- ``updates_per_s_naive``: CURL's update transcribed line by line (``impl="reference"``);
+- ``updates_per_s_table2_1thread``: the optimised update at Table 2 sizes on ONE thread;
+- ``updates_per_s_cpu_profile``: the ``cpu`` profile's update on its thread count (one);
+- ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
+- ``torch_threads``, ``device``, ``cpu``.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import time
+
+import numpy as np
+import torch
+
+from egosearch.rl.config import load_config
+from egosearch.rl.replay import ReplayBuffer, replay_gb
+from egosearch.rl.sac_curl import SacCurlAgent, resolve_device
+from egosearch.rl.train import torch_threads
+
+
+def _cpu_seconds_all() -> float | None:
+    try:
+        with open("/proc/stat") as f:
+            fields = f.readline().split()[1:]
+        return (int(fields[0]) + int(fields[1]) + int(fields[2])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0) -> ReplayBuffer:
+    rng = np.random.default_rng(seed)
+    buf = ReplayBuffer(n, 100, 5, 30, 4, action_dim, device=device, seed=seed)
+    frames = np.repeat(rng.integers(0, 256, (1, 100, 100), dtype=np.uint8), 5, axis=0)
+    obs = {"depth": frames, "mask": np.zeros(30, np.float32), "proprio": np.zeros(4, np.float32)}
+    for t in range(n):
+        frames = np.concatenate([frames[1:], rng.integers(0, 256, (1, 100, 100), dtype=np.uint8)])
+        nxt = {"depth": frames, "mask": rng.normal(size=30).astype(np.float32),
+               "proprio": rng.normal(size=4).astype(np.float32)}
+        end = (t + 1) % 100 == 0
+        buf.add(obs, rng.uniform(-1, 1, action_dim), float(rng.normal()), nxt, False, end)
+        obs = nxt if not end else {**nxt, "depth": np.repeat(frames[-1:], 5, axis=0)}
+    return buf
+
+
+def time_updates(profile: str = "paper", overrides: dict | None = None, impl: str = "fast",
+                 threads: int | None = None, warmup: int = 3, updates: int = 10,
+                 action_dim: int = 5) -> dict[str, float]:
+    """Median and best seconds per full update (sampling included)."""
+    before = torch.get_num_threads()
+    if threads:
+        torch.set_num_threads(threads)
+    try:
+        cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
+        torch.manual_seed(0)
+        device = resolve_device(cfg.device)
+        agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
+        replay = _filled_replay(action_dim, device)
+        sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+        for _ in range(warmup):
+            agent.update(replay.sample(cfg.batch_size))
+        sync()
+        times = []
+        for _ in range(updates):
+            t0 = time.perf_counter()
+            agent.update(replay.sample(cfg.batch_size))
+            sync()
+            times.append(time.perf_counter() - t0)
+        return {"median_s": float(np.median(times)), "best_s": float(np.min(times))}
+    finally:
+        torch.set_num_threads(before)
+
+
+def bench_learner(quick: bool = False) -> dict:
+    """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds)."""
+    torch.set_num_threads(torch_threads(0))
+    n = 3 if quick else 10
+    cpu0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
+    runs = {
+        "table2": time_updates("paper", updates=n),
+        "table2_shared": time_updates("paper", {"share_encoder_forward": True}, updates=n),
+        "naive": time_updates("paper", impl="reference", warmup=2, updates=max(3, n // 2)),
+        "table2_1thread": time_updates("paper", threads=1, updates=max(3, n // 2)),
+    }
+    cpu_cfg = load_config("cpu", {})
+    runs["cpu_profile"] = time_updates("cpu", threads=torch_threads(cpu_cfg.num_threads), updates=2 * n)
+    wall = time.perf_counter() - wall0
+    cpu1 = _cpu_seconds_all()
+    own = time.process_time() - own0
+    result: dict = {}
+    for key, r in runs.items():
+        result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
+        result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
+    result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
+    result["replay_gb_100k"] = round(replay_gb(100_000), 3)
+    result["torch_threads"] = torch.get_num_threads()
+    result["cpu_profile_threads"] = torch_threads(cpu_cfg.num_threads)
+    result["device"] = str(resolve_device("auto"))
+    result["cpu"] = platform.processor() or platform.machine()
+    if cpu0 is not None and cpu1 is not None:
+        result["other_load"] = round(max(0.0, (cpu1 - cpu0) - own) / wall, 2) if wall > 0 else None
+    result["bench_s"] = round(wall, 1)
+    return result

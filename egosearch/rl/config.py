@@ -1,0 +1,431 @@
+"""SAC + CURL hyper-parameters: every value of the paper's Table 2, plus the knobs it leaves out.
+
+One typed dataclass, CleanRL style: each field carries its own docstring saying where the value
+comes from — "Table 2" (the paper, Appendix A), "CURL" (the defaults of the reference code of
+Srinivas et al. 2020, github.com/MishaLaskin/curl, which Table 2 follows almost line by line)
+or "ours" (engineering choices of this project that do not change the algorithm).
+
+Profiles are named override sets applied on top of the Table 2 defaults:
+
+- ``paper``: Table 2 exactly (and CURL's defaults for what Table 2 does not list);
+- ``cpu``:   sized so that the two variants x 3 seeds plus evaluation fit in about 3 h on the
+  2-core reference machine (see :func:`cpu_profile` for the measurements behind it);
+- ``smoke``: a training run that finishes in seconds, to exercise the plumbing.
+
+``table2_rows(cfg)`` renders a config as the (parameter, setting) rows of Table 2, in the
+paper's order and wording, so the table in the report is generated, not typed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from typing import Any
+
+ACTIVATIONS = ("relu", "elu", "leaky_relu", "gelu", "tanh")
+"""Activation names the networks understand (Table 2 uses ReLU everywhere)."""
+
+_ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
+                      "tanh": "Tanh"}
+
+
+@dataclass
+class SacCurlConfig:
+    """Hyper-parameters of one SAC + CURL training run (paper 4.2 and Table 2)."""
+
+    # ---- Table 2: observation and data -------------------------------------------------
+    image_size: int = 100
+    """Table 2 "Image Size" 100x100: side (px) of the depth frames the env renders and the
+    replay buffer stores."""
+    crop_size: int = 84
+    """Table 2 "Augmentation: Random Crop (84x84)": side of the random crop fed to the encoder
+    during updates (a centre crop when acting)."""
+    frame_history: int = 5
+    """Table 2 "Image History Buffer Size" (K of paper 4.1): depth frames stacked as channels."""
+    head_history: int = 1
+    """Table 2 "Head History Buffer Size": past head-joint changes in the proprioception; with
+    1 the env's proprio is (q_p, q_y, last dq_p, last dq_y), i.e. 2 * (1 + head_history) values.
+    Informational for the learner: it is checked against the env's proprio size."""
+    replay_capacity: int = 100_000
+    """Table 2 "Replay buffer": transitions kept (FIFO)."""
+    gamma: float = 0.99
+    """Table 2 "Discount rate gamma"."""
+    total_env_steps: int = 750_000
+    """Table 2 "Number of training steps" 0.75M: environment steps (simulation samples, paper
+    4.2: "0.75 million simulation samples"), not gradient updates."""
+    batch_size: int = 32
+    """Table 2 "Batch-size": transitions per gradient update (also the CURL negatives + 1)."""
+
+    # ---- Table 2: temperature -----------------------------------------------------------
+    init_temperature: float = 0.1
+    """Table 2 "Alpha (SAC): initial temperature"."""
+    alpha_lr: float = 1e-4
+    """Table 2 "Alpha (SAC): learning rate" (Adam on log alpha)."""
+    alpha_beta1: float = 0.5
+    """Table 2 "Alpha (SAC): optimizer beta1"."""
+    alpha_beta2: float = 0.999
+    """Table 2 "Alpha (SAC): optimizer beta2"."""
+
+    # ---- Table 2: actor -----------------------------------------------------------------
+    actor_lr: float = 1e-3
+    """Table 2 "Actor: learning rate"."""
+    actor_beta1: float = 0.9
+    """Table 2 "Actor: optimizer beta1"."""
+    actor_beta2: float = 0.999
+    """Table 2 "Actor: optimizer beta2"."""
+    actor_num_layers: int = 4
+    """Table 2 "Actor: Number of layers" = 4. A *layer* here is one fully connected (Linear)
+    layer of the actor's MLP that follows the image embedding, COUNTING THE OUTPUT LAYER and
+    not counting the encoder: 4 = three hidden layers of ``actor_hidden_dim`` units + the
+    output layer (mean and log-std). This reading also matches the text of 4.2 ("3 fully
+    connected layers with 1024 neurons to obtain the final action output"); we follow Table 2.
+    Note: CURL's reference code has 2 hidden layers (3 Linear layers) and its ``--num_layers 4``
+    is the encoder's conv depth, which is probably where Table 2's "4" comes from; set 3 here
+    to get CURL's exact MLP."""
+    actor_hidden_dim: int = 1024
+    """Table 2 "Actor: Hidden dim": units of every hidden layer of the actor MLP."""
+    actor_activation: str = "relu"
+    """Table 2 "Actor: Activation function"."""
+    actor_log_std_min: float = -10.0
+    """CURL: lower bound of the actor's log-std (tanh-rescaled into [min, max])."""
+    actor_log_std_max: float = 2.0
+    """CURL: upper bound of the actor's log-std."""
+
+    # ---- Table 2: critic ----------------------------------------------------------------
+    critic_lr: float = 1e-3
+    """Table 2 "Critic: learning rate" (also trains the encoder through the critic loss)."""
+    critic_tau: float = 0.01
+    """Table 2 "Critic: tau (polyak averaging)": target Q-heads move by this fraction."""
+    critic_beta1: float = 0.9
+    """Table 2 "Critic: optimizer beta1"."""
+    critic_beta2: float = 0.999
+    """Table 2 "Critic: optimizer beta2"."""
+    critic_num_layers: int = 4
+    """Table 2 "Critic: Number of layers": Linear layers of EACH Q-function MLP, counting the
+    output layer (4 = three hidden layers of ``critic_hidden_dim`` + the scalar output). Same
+    counting rule as ``actor_num_layers``; CURL's code has 3."""
+    critic_hidden_dim: int = 1024
+    """Table 2 "Critic: Hidden dim"."""
+    critic_activation: str = "relu"
+    """Table 2 "Critic: Activation function"."""
+
+    # ---- Table 2: encoder ---------------------------------------------------------------
+    encoder_lr: float = 1e-3
+    """Table 2 "Encoder (CNN): learning rate": Adam step of the CURL (contrastive) loss on the
+    encoder and on the bilinear matrix W."""
+    encoder_tau: float = 0.05
+    """Table 2 "Encoder (CNN): tau (polyak averaging)": the key / target encoder moves by this
+    fraction (conv layers, linear projection and LayerNorm)."""
+    encoder_num_layers: int = 4
+    """Table 2 "Encoder (CNN): Number of layers": 3x3 conv layers, the first with stride 2 and
+    the rest with stride 1 (CURL's pixel encoder); 84x84 -> 41 -> 39 -> 37 -> 35."""
+    encoder_num_filters: int = 32
+    """Table 2 "Encoder (CNN): Number of filters": channels of every conv layer."""
+    encoder_latent_dim: int = 128
+    """Table 2 "Encoder (CNN): Latent dimension" (paper 4.2: "an embedding of 128 dimensions"):
+    output of the linear projection + LayerNorm that follows the convs."""
+    encoder_activation: str = "relu"
+    """Table 2 "Encoder (CNN): Activation function"."""
+    encoder_beta1: float = 0.9
+    """CURL (not in Table 2): beta1 of the encoder / CURL optimiser (PyTorch's Adam default)."""
+    encoder_beta2: float = 0.999
+    """CURL (not in Table 2): beta2 of the encoder / CURL optimiser (PyTorch's Adam default)."""
+    encoder_tanh: bool = False
+    """CURL: no tanh after the LayerNorm. CURL's ``PixelEncoder`` only applies tanh when
+    ``output_logits=False``, and its actor and critic build it with ``output_logits=True``."""
+
+    # ---- CURL (not in Table 2) ----------------------------------------------------------
+    curl_latent: int = 128
+    """CURL: side of the bilinear matrix W (logits = q W k^T). It acts on the encoder
+    embedding, so it must equal ``encoder_latent_dim`` (CURL builds W from the encoder's
+    feature dim; its ``curl_latent_dim`` argument is unused)."""
+    curl_double_encoder_step: bool = True
+    """CURL: its reference code registers the critic's encoder in BOTH ``encoder_optimizer``
+    and ``cpc_optimizer`` (both Adam at ``encoder_lr``), so every contrastive gradient is applied
+    twice. The two Adam states see identical gradients, so this equals one Adam step at
+    2 x ``encoder_lr`` on the encoder (W keeps 1 x). True reproduces that; False applies the
+    contrastive step once."""
+    actor_update_freq: int = 2
+    """CURL: the actor and temperature are updated every this many gradient updates."""
+    critic_target_update_freq: int = 2
+    """CURL: the target critic and key encoder are Polyak-averaged every this many updates."""
+    curl_update_freq: int = 1
+    """CURL (``cpc_update_freq``): the contrastive loss is applied every this many updates."""
+
+    # ---- training loop (CURL defaults or ours) ------------------------------------------
+    init_steps: int = 1000
+    """CURL: environment steps of uniformly random actions before the first update."""
+    update_every: int = 1
+    """Ours (CURL: 1): gradient updates happen after every ``update_every``-th env step."""
+    updates_per_step: int = 1
+    """Ours (CURL: 1): gradient updates done each time updates are due; the update-to-data
+    ratio is ``updates_per_step / update_every``."""
+    eval_every: int = 10_000
+    """Ours: environment steps between evaluations (a row of curve.csv each)."""
+    eval_episodes: int = 10
+    """Ours (CURL: 10): deterministic episodes of the default evaluation."""
+    log_every: int = 1_000
+    """Ours: environment steps between rows of train.csv / progress-bar refreshes."""
+    checkpoint_every: int = 10_000
+    """Ours: environment steps between resumable checkpoints (atomic writes)."""
+    seed: int = 1
+    """Ours: seeds torch, numpy, python's random, the env and its action space."""
+
+    # ---- implementation (ours; they do not change the algorithm) ------------------------
+    device: str = "auto"
+    """Ours: "auto" = CUDA when available, else CPU; or any torch device string."""
+    num_threads: int = 0
+    """Ours: torch CPU threads; 0 = every core this process may run on."""
+    share_encoder_forward: bool = False
+    """Ours, OFF by default: compute the anchor crop's conv features once per update, BEFORE
+    the critic's optimiser step, and reuse them for the CURL query and (detached) the actor.
+    That saves one conv forward (~8-10% of an update) but is not CURL's math: CURL computes the
+    CURL and actor losses after the critic step, so with True they lag the critic step by one
+    update (lr-sized). False (default) reproduces CURL's numbers exactly; the optimised update
+    still shares every pass that CURL's order allows (see ``SacCurlAgent._update_fast``)."""
+    channels_last: bool = True
+    """Ours: run the convs in channels-last memory layout (same math, faster oneDNN kernels)."""
+    compile: bool = False
+    """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
+    ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
+    kernels near the CPU's peak; see ``egosearch.rl.bench``). May help on a GPU."""
+    keep_checkpoint: bool = False
+    """Ours: keep the last checkpoint (agent + optimisers + replay) after training finishes;
+    by default it is deleted once actor.pt and done.json are written (replay buffers are large
+    and must never be committed)."""
+
+    # -------------------------------------------------------------------------------------
+    def validate(self) -> SacCurlConfig:
+        """Raise ``ValueError`` (one line naming the field and its allowed range) if any value
+        is out of range; return ``self`` otherwise."""
+
+        def bad(name: str, allowed: str) -> None:
+            raise ValueError(f"SacCurlConfig.{name}={getattr(self, name)!r} is out of range; "
+                             f"allowed: {allowed}")
+
+        for f in fields(self):
+            value = getattr(self, f.name)
+            expected = {"int": int, "float": (int, float), "str": str, "bool": bool}[f.type]
+            if isinstance(value, bool) and f.type != "bool" or not isinstance(value, expected):
+                raise ValueError(f"SacCurlConfig.{f.name}={value!r} has the wrong type; "
+                                 f"expected {f.type}")
+            if f.type == "float" and not math.isfinite(value):
+                bad(f.name, "a finite number")
+        for name in ("image_size", "crop_size", "frame_history", "replay_capacity",
+                     "total_env_steps", "batch_size", "actor_hidden_dim", "critic_hidden_dim",
+                     "encoder_num_filters", "encoder_latent_dim", "curl_latent",
+                     "actor_update_freq", "critic_target_update_freq", "curl_update_freq",
+                     "update_every", "updates_per_step", "eval_every", "eval_episodes",
+                     "log_every", "checkpoint_every"):
+            if getattr(self, name) < 1:
+                bad(name, "an integer >= 1")
+        for name in ("head_history", "init_steps", "seed", "num_threads"):
+            if getattr(self, name) < 0:
+                bad(name, "an integer >= 0")
+        for name in ("actor_num_layers", "critic_num_layers"):
+            if getattr(self, name) < 2:
+                bad(name, "an integer >= 2 (Linear layers incl. the output layer)")
+        if self.encoder_num_layers < 1:
+            bad("encoder_num_layers", "an integer >= 1")
+        if self.crop_size > self.image_size:
+            bad("crop_size", f"1..image_size={self.image_size}")
+        # 3x3 convs: first stride 2, then stride 1; the last map must keep at least 1 pixel.
+        if (self.crop_size - 3) // 2 + 1 - 2 * (self.encoder_num_layers - 1) < 1:
+            bad("encoder_num_layers", f"1..{((self.crop_size - 3) // 2 + 1 - 1) // 2 + 1} "
+                f"for crop_size={self.crop_size} (the conv output would be empty)")
+        if not 0.0 < self.gamma <= 1.0:
+            bad("gamma", "(0, 1]")
+        for name in ("alpha_lr", "actor_lr", "critic_lr", "encoder_lr", "init_temperature"):
+            if getattr(self, name) <= 0:
+                bad(name, "> 0")
+        for name in ("critic_tau", "encoder_tau"):
+            if not 0.0 < getattr(self, name) <= 1.0:
+                bad(name, "(0, 1]")
+        for name in ("alpha_beta1", "actor_beta1", "critic_beta1", "encoder_beta1",
+                     "alpha_beta2", "actor_beta2", "critic_beta2", "encoder_beta2"):
+            if not 0.0 <= getattr(self, name) < 1.0:
+                bad(name, "[0, 1)")
+        if self.actor_log_std_min >= self.actor_log_std_max:
+            bad("actor_log_std_min", f"< actor_log_std_max={self.actor_log_std_max}")
+        for name in ("actor_activation", "critic_activation", "encoder_activation"):
+            if getattr(self, name) not in ACTIVATIONS:
+                bad(name, ", ".join(ACTIVATIONS))
+        if self.curl_latent != self.encoder_latent_dim:
+            bad("curl_latent", f"equal to encoder_latent_dim={self.encoder_latent_dim}")
+        if self.batch_size > self.replay_capacity:
+            bad("batch_size", f"1..replay_capacity={self.replay_capacity}")
+        if not (self.device == "auto" or self.device == "cpu" or self.device.startswith("cuda")
+                or self.device == "mps"):
+            bad("device", "auto, cpu, cuda, cuda:N or mps")
+        return self
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-python dict (JSON / ``torch.load(weights_only=True)`` safe)."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any]) -> SacCurlConfig:
+        """Inverse of :meth:`to_dict`; unknown keys are a one-line ``ValueError``."""
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise ValueError(f"unknown SacCurlConfig field(s): {', '.join(unknown)}")
+        return cls(**values).validate()
+
+
+# ---- profiles -------------------------------------------------------------------------------
+
+def paper_profile() -> dict[str, Any]:
+    """Table 2 exactly (CURL's defaults for what Table 2 leaves out): 0.75M env steps, one
+    update per step, batch 32, 1024-unit MLPs, 32-filter 4-layer encoder. About 35 hours on the
+    2-core reference CPU (~6 updates/s with both cores); meant for a GPU."""
+    return {}
+
+
+def cpu_profile() -> dict[str, Any]:
+    """Sized for the 2-core reference CPU: head-on + head-off x 3 seeds + evaluation in ~3 h.
+
+    Budget: 6 runs, two at a time with ONE torch thread each (``num_threads`` 1), so 3 waves of
+    ~25 min (~1500 s) of training per run, leaving ~1.5 h for the held-out evaluations.
+
+    Measured on that machine (``egosearch bench learner``; Xeon, AVX-512, one thread per job,
+    two jobs side by side, median update incl. replay sampling, batch 32, 5 x 84 x 84 crops):
+
+    - Table 2 sizes: ~0.33 s per update (~3 updates/s/core). 1500 s would buy ~4.5k updates,
+      0.6% of Table 2's 750k, far too few. The encoder's convs dominate (~80% of the FLOPs of
+      an update; conv cost grows with filters^2), the MLP width matters much less;
+    - 16 filters, 1024-unit MLPs: ~0.165 s; 16 filters, 256-unit MLPs: ~0.12 s per update;
+    - one env step (sensor + physics, ``egosearch bench env``) ~0.75 ms, plus acting ~1.5 ms.
+
+    So this profile keeps the ALGORITHM and everything that shapes the data and the losses
+    (100 -> 84 random crops, K = 5, head history 1, replay 100k, gamma, every lr / beta / tau,
+    batch 32, initial temperature, CURL, layer counts, latent 128) and shrinks:
+
+    - ``encoder_num_filters`` 32 -> 16 and MLP hidden 1024 -> 256 (0.12 s per update);
+    - ``total_env_steps`` 750k -> 24k (3.2%) with one update every 2 env steps
+      (``update_every`` 2): (24k - 1k warm-up) / 2 = 11.5k updates ~ 1380 s, env steps and
+      acting ~ 70 s, 7 evaluations x 10 episodes ~ 20 s: ~ 25 min per run.
+
+    Re-measure with ``egosearch bench learner`` (``updates_per_s_cpu_profile``) and scale
+    ``total_env_steps`` if the machine differs.
+    """
+    return {
+        "total_env_steps": 24_000,
+        "update_every": 2,
+        "updates_per_step": 1,
+        "encoder_num_filters": 16,
+        "actor_hidden_dim": 256,
+        "critic_hidden_dim": 256,
+        "init_steps": 1000,
+        "eval_every": 4_000,
+        "eval_episodes": 10,
+        "log_every": 500,
+        "checkpoint_every": 4_000,
+        "num_threads": 1,
+    }
+
+
+def smoke_profile() -> dict[str, Any]:
+    """Finishes a whole training run (warm-up, updates, evaluation, checkpoint, actor.pt) in a
+    few seconds: 100->84 crops and K = 5 as in the paper, but a 2-layer 8-filter encoder,
+    64-unit MLPs, 300 env steps, a 1000-transition replay and 2 evaluation episodes."""
+    return {
+        "total_env_steps": 300,
+        "replay_capacity": 1_000,
+        "init_steps": 100,
+        "encoder_num_layers": 2,
+        "encoder_num_filters": 8,
+        "encoder_latent_dim": 32,
+        "curl_latent": 32,
+        "actor_hidden_dim": 64,
+        "critic_hidden_dim": 64,
+        "actor_num_layers": 3,
+        "critic_num_layers": 3,
+        "eval_every": 150,
+        "eval_episodes": 2,
+        "log_every": 50,
+        "checkpoint_every": 150,
+    }
+
+
+PROFILES: dict[str, Callable[[], dict[str, Any]]] = {
+    "smoke": smoke_profile,
+    "cpu": cpu_profile,
+    "paper": paper_profile,
+}
+"""Profile name -> function returning its overrides of the Table 2 defaults."""
+
+
+def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> SacCurlConfig:
+    """The config of ``profile`` with ``overrides`` on top, validated.
+
+    Unknown profile or field names and out-of-range values are one-line ``ValueError``s.
+    """
+    if profile not in PROFILES:
+        raise ValueError(f"unknown profile {profile!r}; allowed: {', '.join(PROFILES)}")
+    values = PROFILES[profile]()
+    values.update(overrides or {})
+    return SacCurlConfig.from_dict(values)
+
+
+# ---- Table 2 --------------------------------------------------------------------------------
+
+def _num(x: float) -> str:
+    """Decimal notation as printed in Table 2 (0.0001, not 1e-04)."""
+    text = f"{x:.10f}".rstrip("0").rstrip(".")
+    return text if text not in ("", "-0") else "0"
+
+
+def _steps(n: int) -> str:
+    return f"{_num(n / 1e6)}M"
+
+
+def table2_rows(cfg: SacCurlConfig) -> list[tuple[str, str]]:
+    """``cfg`` as the (parameter, setting) rows of the paper's Table 2, same order and wording.
+
+    With the ``paper`` profile this reproduces Table 2 exactly (e.g. ("Batch-size", "32"),
+    ("Replay buffer", "100000"), ("Number of training steps", "0.75M")).
+    """
+    act = _ACTIVATION_LABELS
+    return [
+        ("Image Size", f"{cfg.image_size}x{cfg.image_size}"),
+        ("Augmentation", f"Random Crop ({cfg.crop_size}x{cfg.crop_size})"),
+        ("Image History Buffer Size", str(cfg.frame_history)),
+        ("Head History Buffer Size", str(cfg.head_history)),
+        ("Replay buffer", str(cfg.replay_capacity)),
+        ("Discount rate γ", _num(cfg.gamma)),
+        ("Number of training steps", _steps(cfg.total_env_steps)),
+        ("Batch-size", str(cfg.batch_size)),
+        ("Alpha (SAC) : initial temperature", _num(cfg.init_temperature)),
+        ("Alpha (SAC) : learning rate", _num(cfg.alpha_lr)),
+        ("Alpha (SAC) : optimizer β1", _num(cfg.alpha_beta1)),
+        ("Alpha (SAC) : optimizer β2", _num(cfg.alpha_beta2)),
+        ("Actor : learning rate", _num(cfg.actor_lr)),
+        ("Actor : optimizer β1", _num(cfg.actor_beta1)),
+        ("Actor : optimizer β2", _num(cfg.actor_beta2)),
+        ("Actor : Number of layers", str(cfg.actor_num_layers)),
+        ("Actor : Hidden dim", str(cfg.actor_hidden_dim)),
+        ("Actor : Activation function", act[cfg.actor_activation]),
+        ("Critic : learning rate", _num(cfg.critic_lr)),
+        ("Critic : τ (polyak averaging)", _num(cfg.critic_tau)),
+        ("Critic : optimizer β1", _num(cfg.critic_beta1)),
+        ("Critic : optimizer β2", _num(cfg.critic_beta2)),
+        ("Critic : Number of layers", str(cfg.critic_num_layers)),
+        ("Critic : Hidden dim", str(cfg.critic_hidden_dim)),
+        ("Critic : Activation function", act[cfg.critic_activation]),
+        ("Encoder (CNN) : learning rate", _num(cfg.encoder_lr)),
+        ("Encoder (CNN) : τ (polyak averaging)", _num(cfg.encoder_tau)),
+        ("Encoder (CNN) : Number of layers", str(cfg.encoder_num_layers)),
+        ("Encoder (CNN) : Number of filters", str(cfg.encoder_num_filters)),
+        ("Encoder (CNN) : Latent dimension", str(cfg.encoder_latent_dim)),
+        ("Encoder (CNN) : Activation function", act[cfg.encoder_activation]),
+    ]
+
+
+TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(SacCurlConfig()))
+"""Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
+
+__all__ = ["ACTIVATIONS", "PROFILES", "SacCurlConfig", "TABLE2_PAPER", "cpu_profile",
+           "load_config", "paper_profile", "smoke_profile", "table2_rows"]

@@ -1,0 +1,296 @@
+"""A frame-deduplicating replay buffer for K-frame depth stacks.
+
+The env's observation holds the last K depth frames (oldest first); consecutive observations
+share K-1 of them. Storing obs and next_obs stacks would cost 2K frames per transition; this
+buffer stores each depth frame ONCE (uint8, ``image_size`` x ``image_size``) in a ring of frames
+and rebuilds both stacks by index at sample time.
+
+Layout
+------
+- A frame ring of ``n_frames`` slots. An episode of T transitions writes T + 1 frames in a row:
+  its first observation's newest frame f_0 (at the episode's first ``add``) and then the newest
+  frame f_{t+1} of every next observation.
+- A transition ring of ``capacity`` slots holding, per transition, the absolute number of the
+  frame f_t (newest frame of obs_t), the step t within its episode, the action, the reward, the
+  terminated/truncated flags and the (small) mask / proprio vectors of obs and next_obs.
+- The stack of obs_t is frames [f_{max(t-K+1+j, 0)} for j = 0..K-1] (oldest first), and that of
+  next_obs_t is the same shifted by one, so one gather of K + 1 frames yields both
+  (obs = [:, :K], next_obs = [:, 1:]).
+
+Padding at episode starts: frames before the episode's first frame are the FIRST FRAME OF THE
+EPISODE repeated, exactly as the env pads its history at reset (it repeats the first frame K
+times). Frames never leak across episode boundaries.
+
+Every frame costs 1 + 1/T slots (T = episode length), so the frame ring is slightly larger than
+the transition ring: ``n_frames = capacity + capacity // 8 + K + 1`` keeps all ``capacity``
+transitions sampleable as long as episodes average >= 8 steps; with shorter episodes the oldest
+transitions whose frames were overwritten are dropped from sampling (never returned corrupted).
+
+At 100k transitions (Table 2) this is ~1.14 GB (:func:`replay_gb`), vs. ~10 GB for naively
+stored obs + next_obs stacks.
+
+Checkpoints: :meth:`ReplayBuffer.save` / :meth:`load` write / read an ``.npz`` (hundreds of MB
+to GB: keep them out of version control; name them ``*.replay.npz``, which is git-ignored).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import torch
+
+_FORMAT = "egosearch-replay-v1"
+
+
+def frame_slots(capacity: int, frame_history: int) -> int:
+    """Frame-ring size for a transition capacity (see the module docstring)."""
+    return capacity + capacity // 8 + frame_history + 1
+
+
+def replay_gb(capacity: int = 100_000, image_size: int = 100, frame_history: int = 5,
+              mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5) -> float:
+    """Exact memory (GB = 1e9 bytes) of the arrays of a :class:`ReplayBuffer`."""
+    frames = frame_slots(capacity, frame_history) * image_size * image_size  # uint8
+    per_transition = (8 + 4  # frame number (int64), step in episode (int32)
+                      + 4 * action_dim + 4  # action, reward (float32)
+                      + 2  # terminated, truncated (bool)
+                      + 4 * 2 * (mask_dim + proprio_dim))  # mask/proprio of obs and next_obs
+    return (frames + capacity * per_transition) / 1e9
+
+
+class ReplayBuffer:
+    """FIFO replay of (obs, action, reward, next_obs, terminated, truncated).
+
+    ``add`` takes the env's dict observations (``depth`` (K, H, W) uint8 oldest first, ``mask``,
+    ``proprio``) and keeps only the newest depth frame of each. ``sample`` returns torch tensors
+    on ``device``: ``obs_depth`` / ``next_obs_depth`` (B, K, H, W) uint8 (two views of one
+    (B, K+1, H, W) gather), ``mask``, ``proprio``, ``next_mask``, ``next_proprio``, ``action``,
+    ``reward`` (B, 1), ``not_done`` (B, 1) = 1 - terminated (time-limit truncation still
+    bootstraps, as in CURL) and ``index`` (absolute transition numbers).
+    """
+
+    def __init__(self, capacity: int, image_size: int = 100, frame_history: int = 5,
+                 mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5,
+                 device: str | torch.device = "cpu", seed: int | None = None):
+        if capacity < 1:
+            raise ValueError(f"ReplayBuffer capacity={capacity} is out of range; allowed: >= 1")
+        self.capacity = int(capacity)
+        self.image_size = int(image_size)
+        self.k = int(frame_history)
+        self.mask_dim, self.proprio_dim, self.action_dim = int(mask_dim), int(proprio_dim), int(action_dim)
+        self.device = torch.device(device)
+        self.n_frames = frame_slots(self.capacity, self.k)
+        self.frames = np.zeros((self.n_frames, self.image_size, self.image_size), np.uint8)
+        c = self.capacity
+        self.frame_no = np.zeros(c, np.int64)  # absolute frame number of f_t
+        self.t_in_ep = np.zeros(c, np.int32)
+        self.action = np.zeros((c, self.action_dim), np.float32)
+        self.reward = np.zeros(c, np.float32)
+        self.terminated = np.zeros(c, bool)
+        self.truncated = np.zeros(c, bool)
+        self.mask = np.zeros((c, self.mask_dim), np.float32)
+        self.proprio = np.zeros((c, self.proprio_dim), np.float32)
+        self.next_mask = np.zeros((c, self.mask_dim), np.float32)
+        self.next_proprio = np.zeros((c, self.proprio_dim), np.float32)
+        self.n_added = 0  # transitions ever added
+        self.frames_written = 0  # frames ever written
+        self.episode_start = 0  # absolute frame number of the current episode's f_0
+        self.t = 0  # step of the next transition within the current episode
+        self.in_episode = False
+        self.rng = np.random.default_rng(seed)
+
+    # ---- writing -----------------------------------------------------------------------
+    def __len__(self) -> int:
+        """Transitions that can be sampled."""
+        return self.n_added - self._first_valid()
+
+    @property
+    def nbytes(self) -> int:
+        return sum(a.nbytes for a in self._arrays().values())
+
+    def new_episode(self) -> None:
+        """Force the next :meth:`add` to start a new episode (e.g. after resuming a run, when
+        the env was reset although the last stored transition did not end its episode)."""
+        self.in_episode = False
+
+    def _write_frame(self, frame: np.ndarray) -> int:
+        no = self.frames_written
+        self.frames[no % self.n_frames] = frame
+        self.frames_written += 1
+        return no
+
+    def add(self, obs: dict, action, reward: float, next_obs: dict, terminated: bool,
+            truncated: bool) -> None:
+        depth, next_depth = obs["depth"], next_obs["depth"]
+        expected = (self.k, self.image_size, self.image_size)
+        if depth.shape != expected or next_depth.shape != expected:
+            raise ValueError(f"depth must have shape {expected}, got {depth.shape} / {next_depth.shape}")
+        if not self.in_episode:
+            self.episode_start = self._write_frame(depth[-1])
+            self.t = 0
+            self.in_episode = True
+        elif not np.array_equal(self.frames[(self.frames_written - 1) % self.n_frames], depth[-1]):
+            raise ValueError("obs does not continue the previous transition's next_obs; the last "
+                             "transition did not end its episode (call new_episode() after a reset)")
+        i = self.n_added % self.capacity
+        self.frame_no[i] = self.frames_written - 1
+        self.t_in_ep[i] = self.t
+        self.action[i] = np.asarray(action, np.float32).reshape(self.action_dim)
+        self.reward[i] = float(reward)
+        self.terminated[i] = bool(terminated)
+        self.truncated[i] = bool(truncated)
+        self.mask[i] = obs["mask"]
+        self.proprio[i] = obs["proprio"]
+        self.next_mask[i] = next_obs["mask"]
+        self.next_proprio[i] = next_obs["proprio"]
+        self._write_frame(next_depth[-1])
+        self.n_added += 1
+        self.t += 1
+        if terminated or truncated:
+            self.in_episode = False
+
+    # ---- reading -----------------------------------------------------------------------
+    def _oldest_frame_needed(self, n: np.ndarray | int) -> np.ndarray:
+        i = np.asarray(n) % self.capacity
+        f, t = self.frame_no[i], self.t_in_ep[i]
+        return f - np.minimum(t, self.k - 1)
+
+    def _first_valid(self) -> int:
+        """Absolute number of the oldest transition whose frames are all still stored."""
+        lo = max(0, self.n_added - self.capacity)
+        if self.n_added == 0:
+            return 0
+        lowest_frame = self.frames_written - self.n_frames  # frames below this are overwritten
+        if lowest_frame <= 0 or self._oldest_frame_needed(lo) >= lowest_frame:
+            return lo
+        hi = self.n_added - 1  # the newest transition is always valid
+        while lo < hi:  # oldest-frame-needed is non-decreasing in n: binary search
+            mid = (lo + hi) // 2
+            if self._oldest_frame_needed(mid) >= lowest_frame:
+                hi = mid
+            else:
+                lo = mid + 1
+        return lo
+
+    def frame_numbers(self, n: np.ndarray) -> np.ndarray:
+        """(B, K+1) absolute frame numbers: obs stack = [:, :K], next_obs stack = [:, 1:]."""
+        i = np.asarray(n) % self.capacity
+        f, t = self.frame_no[i], self.t_in_ep[i].astype(np.int64)
+        back = np.arange(self.k - 1, -2, -1)  # K-1, ..., 0, -1
+        # frame j of the (K+1)-window is f_{max(t - back_j, 0)} of this episode
+        return f[:, None] - np.minimum(back[None, :], t[:, None])
+
+    def stacks(self, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Rebuilt (obs, next_obs) depth stacks (B, K, H, W) uint8 for absolute indices ``n``."""
+        window = self.frames[self.frame_numbers(n) % self.n_frames]
+        return window[:, :-1], window[:, 1:]
+
+    def sample_indices(self, batch_size: int) -> np.ndarray:
+        lo = self._first_valid()
+        if self.n_added - lo < 1:
+            raise ValueError("cannot sample from an empty ReplayBuffer")
+        return self.rng.integers(lo, self.n_added, size=batch_size)
+
+    def sample(self, batch_size: int, indices: np.ndarray | None = None) -> dict[str, torch.Tensor]:
+        n = self.sample_indices(batch_size) if indices is None else np.asarray(indices)
+        i = n % self.capacity
+        window = torch.from_numpy(self.frames[self.frame_numbers(n) % self.n_frames])
+        pin = self.device.type == "cuda"
+        dev = self.device
+
+        def put(a: np.ndarray) -> torch.Tensor:
+            x = torch.from_numpy(np.ascontiguousarray(a))
+            return x.pin_memory().to(dev, non_blocking=True) if pin else x.to(dev)
+
+        window = window.pin_memory().to(dev, non_blocking=True) if pin else window.to(dev)
+        return {
+            "obs_depth": window[:, :-1],
+            "next_obs_depth": window[:, 1:],
+            "mask": put(self.mask[i]),
+            "proprio": put(self.proprio[i]),
+            "next_mask": put(self.next_mask[i]),
+            "next_proprio": put(self.next_proprio[i]),
+            "action": put(self.action[i]),
+            "reward": put(self.reward[i][:, None]),
+            "not_done": put((~self.terminated[i]).astype(np.float32)[:, None]),
+            "index": torch.from_numpy(n),
+        }
+
+    # ---- checkpoints ----------------------------------------------------------------------
+    _SCALARS = ("capacity", "image_size", "k", "mask_dim", "proprio_dim", "action_dim",
+                "n_frames", "n_added", "frames_written", "episode_start", "t", "in_episode")
+
+    def _arrays(self) -> dict[str, np.ndarray]:
+        return {name: getattr(self, name) for name in (
+            "frames", "frame_no", "t_in_ep", "action", "reward", "terminated", "truncated",
+            "mask", "proprio", "next_mask", "next_proprio")}
+
+    def state_dict(self) -> dict:
+        """Plain arrays + scalars (only the filled part of the rings)."""
+        state = {name: int(getattr(self, name)) for name in self._SCALARS}
+        n_tr = min(self.n_added, self.capacity)
+        n_fr = min(self.frames_written, self.n_frames)
+        for name, arr in self._arrays().items():
+            state[name] = arr[:n_fr] if name == "frames" else arr[:n_tr]
+        state["rng"] = _rng_state_to_plain(self.rng)
+        state["format"] = _FORMAT
+        return state
+
+    def load_state_dict(self, state: dict) -> None:
+        if state.get("format") != _FORMAT:
+            raise ValueError(f"not a replay buffer state (format={state.get('format')!r})")
+        for name in ("capacity", "image_size", "k", "mask_dim", "proprio_dim", "action_dim"):
+            if int(state[name]) != getattr(self, name):
+                raise ValueError(f"replay buffer state has {name}={int(state[name])}, "
+                                 f"this buffer has {getattr(self, name)}")
+        for name, arr in self._arrays().items():
+            src = np.asarray(state[name])
+            if src.shape[1:] != arr.shape[1:] or src.shape[0] > arr.shape[0]:
+                raise ValueError(f"replay buffer state array {name} has shape {src.shape}")
+            arr[:src.shape[0]] = src
+        for name in self._SCALARS:
+            setattr(self, name, bool(state[name]) if name == "in_episode" else int(state[name]))
+        self.rng.bit_generator.state = _rng_state_from_plain(state["rng"])
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write an ``.npz`` atomically (temp file in the same folder, fsync, rename)."""
+        path = Path(path)
+        tmp = path.with_name(f".tmp{os.getpid()}.{path.name}")
+        state = self.state_dict()
+        arrays = {k: v for k, v in state.items() if isinstance(v, np.ndarray)}
+        meta = {k: v for k, v in state.items() if not isinstance(v, np.ndarray)}
+        import json
+
+        with open(tmp, "wb") as f:
+            np.savez(f, __meta__=np.frombuffer(json.dumps(meta).encode(), np.uint8), **arrays)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+        return path
+
+    def load(self, path: str | os.PathLike) -> None:
+        import json
+        import zipfile
+
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                meta = json.loads(bytes(data["__meta__"]).decode())
+                state = {**meta, **{k: data[k] for k in data.files if k != "__meta__"}}
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile, EOFError) as err:
+            raise ValueError(f"cannot read replay buffer {path}: {type(err).__name__}: {err}") from None
+        self.load_state_dict(state)
+
+
+def _rng_state_to_plain(rng: np.random.Generator) -> dict:
+    state = rng.bit_generator.state
+    return {"bit_generator": state["bit_generator"],
+            "state": {k: str(v) for k, v in state["state"].items()},
+            "has_uint32": int(state["has_uint32"]), "uinteger": str(state["uinteger"])}
+
+
+def _rng_state_from_plain(plain: dict) -> dict:
+    return {"bit_generator": plain["bit_generator"],
+            "state": {k: int(v) for k, v in plain["state"].items()},
+            "has_uint32": int(plain["has_uint32"]), "uinteger": int(plain["uinteger"])}

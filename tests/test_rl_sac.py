@@ -1,0 +1,303 @@
+"""SAC + CURL learner: shapes, CURL, Polyak targets, fast == reference math, config, Table 2."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+import torch
+
+from egosearch.rl.config import PROFILES, TABLE2_PAPER, SacCurlConfig, load_config, table2_rows
+from egosearch.rl.sac_curl import (
+    METRIC_KEYS,
+    AgentStateError,
+    SacCurlAgent,
+    center_crop,
+    conv_out_side,
+    crop_at,
+    crop_gather,
+    crop_loop,
+    load_actor_net,
+)
+
+# A small but structurally complete config (100 -> 84 crops, K = 5, 4 conv layers).
+SMALL = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32,
+         "actor_hidden_dim": 64, "critic_hidden_dim": 64, "device": "cpu"}
+
+
+def make_agent(impl="fast", action_dim=5, seed=0, **overrides):
+    torch.manual_seed(seed)
+    return SacCurlAgent(load_config("paper", {**SMALL, **overrides}), action_dim, impl=impl)
+
+
+def make_batch(b=16, action_dim=5, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    window = torch.randint(0, 256, (b, 6, 100, 100), dtype=torch.uint8, generator=g)
+    return {"obs_depth": window[:, :-1], "next_obs_depth": window[:, 1:],
+            "mask": torch.randn(b, 30, generator=g), "proprio": torch.randn(b, 4, generator=g),
+            "next_mask": torch.randn(b, 30, generator=g), "next_proprio": torch.randn(b, 4, generator=g),
+            "action": torch.rand(b, action_dim, generator=g) * 2 - 1,
+            "reward": torch.randn(b, 1, generator=g),
+            "not_done": (torch.rand(b, 1, generator=g) > 0.2).float()}
+
+
+def one_obs(action_dim=5):
+    rng = np.random.default_rng(0)
+    return {"depth": rng.integers(0, 256, (5, 100, 100), dtype=np.uint8),
+            "mask": rng.normal(size=30).astype(np.float32), "proprio": rng.normal(size=4).astype(np.float32)}
+
+
+# ---- networks and shapes ------------------------------------------------------------------
+
+@pytest.mark.parametrize("action_dim", [5, 3])
+def test_act_and_update_shapes(action_dim):
+    agent = make_agent(action_dim=action_dim)
+    for deterministic in (True, False):
+        a = agent.act(one_obs(), deterministic=deterministic)
+        assert a.shape == (action_dim,) and a.dtype == np.float32
+        assert np.all(np.abs(a) <= 1)
+    batch = make_batch(action_dim=action_dim)
+    m1, m2 = agent.update(batch), agent.update(batch)
+    assert set(m1) == set(METRIC_KEYS)
+    assert np.isnan(m1["actor_loss"])  # the actor is updated every 2nd update (CURL)
+    assert all(np.isfinite(v) for v in m2.values())
+    assert m2["alpha"] != pytest.approx(0.1, abs=0) and m2["alpha"] == pytest.approx(0.1, rel=1e-2)
+
+
+def test_paper_architecture_sizes():
+    cfg = SacCurlConfig()
+    agent = SacCurlAgent(cfg, 5, device="cpu")
+    assert conv_out_side(84, 4) == 35
+    convs = agent.critic.convs.convs
+    assert len(convs) == 4 and [c.stride for c in convs] == [(2, 2), (1, 1), (1, 1), (1, 1)]
+    assert all(c.out_channels == 32 and c.kernel_size == (3, 3) for c in convs)
+    assert agent.critic.proj.fc.in_features == 32 * 35 * 35 and agent.critic.proj.fc.out_features == 128
+    linears = [m for m in agent.actor.trunk if isinstance(m, torch.nn.Linear)]
+    assert len(linears) == 4 and [m.out_features for m in linears] == [1024, 1024, 1024, 10]
+    assert linears[0].in_features == 128 + 30 + 4
+    q_linears = [m for m in agent.critic.q1 if isinstance(m, torch.nn.Linear)]
+    assert len(q_linears) == 4 and q_linears[0].in_features == 128 + 30 + 4 + 5
+    assert agent.W.shape == (128, 128) and agent.target_entropy == -5.0
+    assert agent.alpha == pytest.approx(0.1)
+
+
+def test_crop_helpers():
+    x = torch.randint(0, 256, (4, 5, 100, 100), dtype=torch.uint8)
+    oy, ox = torch.tensor([0, 16, 3, 9]), torch.tensor([16, 0, 7, 9])
+    for crop in (crop_at, crop_gather, crop_loop):  # crop_gather is the accelerator path
+        out = crop(x, oy, ox, 84)
+        for i in range(4):
+            assert torch.equal(out[i], x[i, :, oy[i]:oy[i] + 84, ox[i]:ox[i] + 84])
+    assert torch.equal(center_crop(x, 84), x[..., 8:92, 8:92])
+
+
+# ---- CURL and targets ---------------------------------------------------------------------
+
+def test_curl_only_updates_lower_the_contrastive_loss_on_a_fixed_batch():
+    agent = make_agent()
+    batch = make_batch(b=16)
+    anchor = crop_at(batch["obs_depth"], torch.randint(0, 17, (16,)), torch.randint(0, 17, (16,)), 84)
+    pos = crop_at(batch["obs_depth"], torch.randint(0, 17, (16,)), torch.randint(0, 17, (16,)), 84)
+    losses = [agent.curl_update(anchor, pos) for _ in range(20)]
+    assert losses[-1] < 0.8 * losses[0], losses
+
+
+def test_targets_move_by_polyak_tau_exactly():
+    agent = make_agent(critic_target_update_freq=2)
+    batch = make_batch()
+    before = [p.clone() for p in agent.critic_target.parameters()]
+    agent.update(batch)  # update 1: no Polyak step with freq 2
+    assert all(torch.equal(a, b) for a, b in zip(before, agent.critic_target.parameters()))
+    agent.update(batch)  # update 2: Polyak step
+    assert not all(torch.equal(a, b) for a, b in zip(before, agent.critic_target.parameters()))
+
+    online_q = [p.detach().clone() for p in agent.critic.q_parameters()]
+    target_q = [p.detach().clone() for p in agent.critic_target.q_parameters()]
+    online_e = [p.detach().clone() for p in agent.critic.encoder_parameters()]
+    target_e = [p.detach().clone() for p in agent.critic_target.encoder_parameters()]
+    agent._polyak()
+    tau_q, tau_e = agent.cfg.critic_tau, agent.cfg.encoder_tau
+    for o, t, new in zip(online_q, target_q, agent.critic_target.q_parameters()):
+        torch.testing.assert_close(new, (1 - tau_q) * t + tau_q * o, rtol=1e-6, atol=1e-7)
+    for o, t, new in zip(online_e, target_e, agent.critic_target.encoder_parameters()):
+        torch.testing.assert_close(new, (1 - tau_e) * t + tau_e * o, rtol=1e-6, atol=1e-7)
+    assert (tau_q, tau_e) == (0.01, 0.05)
+
+
+# ---- the optimised update computes CURL's math ---------------------------------------------
+
+def _params(agent):
+    nets = [agent.critic, agent.critic_target, agent.actor]
+    return [p.detach() for net in nets for p in net.parameters()] + [agent.W.detach(), agent.log_alpha.detach()]
+
+
+@pytest.mark.parametrize("channels_last, freqs", [
+    (False, (2, 2, 1)), (True, (2, 2, 1)), (True, (1, 1, 1)), (True, (1, 3, 2))])
+def test_fast_update_equals_reference_math(channels_last, freqs):
+    """With CURL's order (share_encoder_forward=False, the default) the fast path == the
+    transcription of CURL's update: same losses, same parameters after 4 updates (incl. actor,
+    alpha, Polyak and CURL on and off their schedules)."""
+    actor_f, target_f, curl_f = freqs
+    kw = {"actor_update_freq": actor_f, "critic_target_update_freq": target_f, "curl_update_freq": curl_f}
+    fast = make_agent("fast", channels_last=channels_last, **kw)
+    ref = make_agent("reference", **kw)
+    for a, b in zip(_params(fast), _params(ref)):
+        assert torch.equal(a, b)
+    for i in range(4):
+        batch = make_batch(seed=i)
+        torch.manual_seed(100 + i)
+        mf = fast.update(batch)
+        torch.manual_seed(100 + i)
+        mr = ref.update(batch)
+        for k in METRIC_KEYS:
+            assert mf[k] == pytest.approx(mr[k], rel=1e-4, abs=1e-5, nan_ok=True), (i, k)
+    max_lr = 2 * fast.cfg.encoder_lr
+    for a, b in zip(_params(fast), _params(ref)):
+        # Adam normalises gradients, so float-level differences can show up as up to ~lr in a
+        # few near-zero-gradient entries; everything else must agree to float precision.
+        diff = (a - b).abs()
+        assert diff.max() <= 4 * max_lr
+        assert (diff > 1e-5).float().mean() < 1e-3
+
+
+def test_shared_forward_differs_only_by_one_step_of_lag():
+    shared = make_agent("fast", share_encoder_forward=True)
+    ref = make_agent("reference", share_encoder_forward=True)  # the reference ignores it
+    batch = make_batch()
+    torch.manual_seed(7)
+    ms = shared.update(batch)
+    torch.manual_seed(7)
+    mr = ref.update(batch)
+    # same weights before the step: the critic loss is identical; in CURL's order the CURL loss
+    # is computed after the critic's Adam step moved the encoder, so it differs
+    assert ms["critic_loss"] == pytest.approx(mr["critic_loss"], rel=1e-5)
+    assert ms["curl_loss"] != pytest.approx(mr["curl_loss"], rel=1e-4)
+    assert ms["curl_loss"] == pytest.approx(mr["curl_loss"], rel=0.25)
+
+
+def test_double_encoder_step_matches_two_adam_steps():
+    """CURL steps its encoder with two identical Adam optimisers; the fast path does one step
+    at 2 x lr: the results agree."""
+    fast = make_agent("fast")
+    ref = make_agent("reference")
+    batch = make_batch()
+    anchor = center_crop(batch["obs_depth"], 84)
+    pos = crop_at(batch["obs_depth"], torch.zeros(16, dtype=torch.long), torch.zeros(16, dtype=torch.long), 84)
+    for _ in range(3):
+        assert fast.curl_update(anchor, pos) == pytest.approx(ref.curl_update(anchor, pos), rel=1e-5)
+    for a, b in zip(fast.critic.encoder_parameters(), ref.critic.encoder_parameters()):
+        torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-6)
+
+
+# ---- persistence ---------------------------------------------------------------------------
+
+def test_state_dict_roundtrip_weights_only():
+    a = make_agent()
+    batch = make_batch()
+    a.update(batch)
+    a.update(batch)
+    buf = io.BytesIO()
+    torch.save(a.state_dict(), buf)
+    buf.seek(0)
+    state = torch.load(buf, weights_only=True)
+    b = make_agent(seed=123)
+    b.load_state_dict(state)
+    assert b.num_updates == 2
+    torch.manual_seed(0)
+    ma = a.update(batch)
+    torch.manual_seed(0)
+    mb = b.update(batch)
+    assert ma == pytest.approx(mb, nan_ok=True, rel=0, abs=0)
+    other = make_agent(encoder_num_filters=4)
+    with pytest.raises(AgentStateError, match="encoder_num_filters"):
+        other.load_state_dict(state)
+
+
+def test_actor_state_loads_weights_only_and_acts_like_the_agent():
+    agent = make_agent()
+    agent.update(make_batch())
+    buf = io.BytesIO()
+    torch.save(agent.actor_state({"variant": "head-on", "config": agent.cfg.to_dict()}), buf)
+    buf.seek(0)
+    state = torch.load(buf, weights_only=True)
+    assert state["metadata"]["variant"] == "head-on"
+    assert not any(k.startswith("q") for k in state["state_dict"])  # actor only
+    net = load_actor_net(state)
+    obs = one_obs()
+    with torch.no_grad():
+        depth = center_crop(torch.as_tensor(obs["depth"])[None], 84).float()
+        extra = torch.cat([torch.as_tensor(obs["mask"]), torch.as_tensor(obs["proprio"])])[None]
+        mu, _ = net(depth, extra)
+    np.testing.assert_allclose(torch.tanh(mu)[0].numpy(), agent.act(obs, deterministic=True), atol=1e-5)
+
+
+# ---- config ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("overrides, field", [
+    ({"crop_size": 101}, "crop_size"),
+    ({"actor_lr": -1e-3}, "actor_lr"),
+    ({"gamma": 0.0}, "gamma"),
+    ({"gamma": 1.01}, "gamma"),
+    ({"critic_tau": 1.5}, "critic_tau"),
+    ({"alpha_beta1": 1.0}, "alpha_beta1"),
+    ({"batch_size": 0}, "batch_size"),
+    ({"actor_activation": "swish"}, "actor_activation"),
+    ({"curl_latent": 64}, "curl_latent"),
+    ({"encoder_num_layers": 30}, "encoder_num_layers"),
+    ({"batch_size": 3.5}, "batch_size"),
+])
+def test_config_validation_errors_are_one_line_and_name_the_field(overrides, field):
+    with pytest.raises(ValueError) as err:
+        load_config("paper", overrides)
+    msg = str(err.value)
+    assert "\n" not in msg and field in msg
+
+
+def test_unknown_profile_or_field():
+    with pytest.raises(ValueError, match="unknown profile 'fast'; allowed: smoke, cpu, paper"):
+        load_config("fast", {})
+    with pytest.raises(ValueError, match="unknown SacCurlConfig field"):
+        load_config("paper", {"learning_rate": 1e-3})
+
+
+def test_profiles_are_valid_and_paper_is_table2():
+    for name in PROFILES:
+        load_config(name, {})
+    assert load_config("paper", {}) == SacCurlConfig()
+
+
+# the paper's Table 2 (Appendix A), verbatim
+PAPER_TABLE2 = [
+    ("Image Size", "100x100"), ("Augmentation", "Random Crop (84x84)"),
+    ("Image History Buffer Size", "5"), ("Head History Buffer Size", "1"),
+    ("Replay buffer", "100000"), ("Discount rate γ", "0.99"),
+    ("Number of training steps", "0.75M"), ("Batch-size", "32"),
+    ("Alpha (SAC) : initial temperature", "0.1"), ("Alpha (SAC) : learning rate", "0.0001"),
+    ("Alpha (SAC) : optimizer β1", "0.5"), ("Alpha (SAC) : optimizer β2", "0.999"),
+    ("Actor : learning rate", "0.001"), ("Actor : optimizer β1", "0.9"),
+    ("Actor : optimizer β2", "0.999"), ("Actor : Number of layers", "4"),
+    ("Actor : Hidden dim", "1024"), ("Actor : Activation function", "ReLU"),
+    ("Critic : learning rate", "0.001"), ("Critic : τ (polyak averaging)", "0.01"),
+    ("Critic : optimizer β1", "0.9"), ("Critic : optimizer β2", "0.999"),
+    ("Critic : Number of layers", "4"), ("Critic : Hidden dim", "1024"),
+    ("Critic : Activation function", "ReLU"), ("Encoder (CNN) : learning rate", "0.001"),
+    ("Encoder (CNN) : τ (polyak averaging)", "0.05"), ("Encoder (CNN) : Number of layers", "4"),
+    ("Encoder (CNN) : Number of filters", "32"), ("Encoder (CNN) : Latent dimension", "128"),
+    ("Encoder (CNN) : Activation function", "ReLU"),
+]
+
+
+def test_table2_rows_match_the_paper():
+    assert table2_rows(load_config("paper", {})) == PAPER_TABLE2
+    assert list(TABLE2_PAPER) == PAPER_TABLE2
+    rows = dict(table2_rows(load_config("cpu", {})))
+    assert rows["Batch-size"] == "32" and rows["Replay buffer"] == "100000"
+    assert rows["Encoder (CNN) : Number of filters"] == str(load_config("cpu", {}).encoder_num_filters)
+
+
+def test_bench_timer_runs():
+    from egosearch.rl.bench import time_updates
+
+    r = time_updates("smoke", threads=1, warmup=1, updates=2)
+    assert 0 < r["best_s"] <= r["median_s"] < 10

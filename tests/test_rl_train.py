@@ -1,0 +1,219 @@
+"""Training loop on the fake env: outputs, kill-and-resume, bad checkpoints, and learning."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from egosearch.rl.config import load_config
+from egosearch.rl.sac_curl import AgentStateError
+from egosearch.rl.train import (
+    CHECKPOINT_NAME,
+    CURVE_COLUMNS,
+    TRAIN_COLUMNS,
+    ActorPolicy,
+    CheckpointError,
+    default_evaluator,
+    train,
+)
+
+TESTS = Path(__file__).parent
+sys.path.insert(0, str(TESTS))
+from test_rl_fake_env import FAKE_ENV_ID, FAKE_NOHEAD_ENV_ID, register_fake_envs  # noqa: E402
+
+register_fake_envs()
+SMOKE = {"device": "cpu", "num_threads": 1}
+
+
+def read_csv(path: Path) -> tuple[list[str], list[dict]]:
+    with open(path) as f:
+        reader = csv.DictReader(f)
+        return list(reader.fieldnames), list(reader)
+
+
+class Interrupt(Exception):
+    pass
+
+
+def interrupt_at(n: int):
+    def hook(step: int) -> None:
+        if step == n:
+            raise Interrupt(step)
+    return hook
+
+
+def check_complete_run(out: Path, cfg, checkpoint_kept: bool = False) -> dict:
+    columns, rows = read_csv(out / "curve.csv")
+    assert tuple(columns) == CURVE_COLUMNS
+    steps = [int(r["env_steps"]) for r in rows]
+    expected = sorted({0, cfg.total_env_steps} | set(range(cfg.eval_every, cfg.total_env_steps + 1, cfg.eval_every)))
+    assert steps == expected, steps
+    columns, rows = read_csv(out / "train.csv")
+    assert tuple(columns) == TRAIN_COLUMNS
+    assert [int(r["env_steps"]) for r in rows] == list(range(cfg.log_every, cfg.total_env_steps + 1, cfg.log_every))
+    done = json.loads((out / "done.json").read_text())
+    assert done["env_steps"] == cfg.total_env_steps
+    assert done["updates"] == cfg.total_env_steps - cfg.init_steps + 1  # an update after every step >= init_steps
+    # deleted at the end unless asked for (it holds the replay buffer)
+    assert (out / CHECKPOINT_NAME).exists() == checkpoint_kept
+    assert not list(out.glob("**/.tmp*"))  # no temp file left behind, even after a kill -9
+    return done
+
+
+def test_smoke_training_outputs(tmp_path):
+    cfg = load_config("smoke", SMOKE)
+    summary = train(FAKE_ENV_ID, cfg, tmp_path, variant="head-on", progress=False)
+    done = check_complete_run(tmp_path, cfg)
+    assert summary == done
+    assert json.loads((tmp_path / "config.json").read_text())["config"] == cfg.to_dict()
+    # actor.pt: actor-only weights + metadata, readable with weights_only=True
+    state = torch.load(tmp_path / "actor.pt", weights_only=True)
+    assert state["metadata"]["variant"] == "head-on" and state["metadata"]["env_id"] == FAKE_ENV_ID
+    assert state["metadata"]["config"] == cfg.to_dict()
+    policy = ActorPolicy(tmp_path / "actor.pt")
+    policy.reset(seed=3)
+    import gymnasium
+
+    env = gymnasium.make(FAKE_ENV_ID)
+    obs, _ = env.reset(seed=0)
+    a1, a2 = policy.act(obs), policy.act(obs)
+    assert a1.shape == (5,) and a1.dtype == np.float32 and np.array_equal(a1, a2)  # deterministic
+    # a finished run is not trained again
+    mtime = (tmp_path / "actor.pt").stat().st_mtime_ns
+    assert train(FAKE_ENV_ID, cfg, tmp_path, variant="head-on", progress=False) == done
+    assert (tmp_path / "actor.pt").stat().st_mtime_ns == mtime
+
+
+def test_head_off_variant_and_a_custom_evaluator(tmp_path):
+    cfg = load_config("smoke", {**SMOKE, "total_env_steps": 150, "eval_every": 50})
+    calls = []
+
+    def evaluate_fn(policy):
+        policy.reset(seed=0)
+        calls.append(policy.act({"depth": np.zeros((5, 100, 100), np.uint8), "mask": np.zeros(30, np.float32),
+                                 "proprio": np.zeros(4, np.float32)}))
+        return {"success_rate": 0.5, "spl": 0.25, "episode_return": -1.0}
+
+    train(FAKE_NOHEAD_ENV_ID, cfg, tmp_path, evaluate_fn=evaluate_fn, progress=False)
+    assert ActorPolicy(tmp_path / "actor.pt").action_dim == 3
+    assert len(calls) == 4 and calls[0].shape == (3,)  # steps 0, 50, 100, 150
+    _, rows = read_csv(tmp_path / "curve.csv")
+    assert [float(r["spl"]) for r in rows] == [0.25] * 4
+
+
+def test_interrupt_and_resume_continues_without_duplicate_rows(tmp_path):
+    cfg = load_config("smoke", SMOKE)  # checkpoints at 150 and 300; eval at 0, 150, 300
+    with pytest.raises(Interrupt):
+        train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=interrupt_at(230))
+    # rows after the checkpoint at 150 exist on disk (train.csv at 200) ...
+    _, rows = read_csv(tmp_path / "train.csv")
+    assert [int(r["env_steps"]) for r in rows][-1] == 200
+    ckpt = torch.load(tmp_path / CHECKPOINT_NAME, weights_only=True)
+    assert ckpt["env_steps"] == 150 and ckpt["csv_rows"] == {"curve": 2, "train": 3}
+    # ... and the rerun drops them, resumes at 150 and ends with exactly one row per step
+    seen = []
+    train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=seen.append)
+    assert seen[0] == 151 and seen[-1] == 300
+    check_complete_run(tmp_path, cfg)
+
+
+def test_kill_minus_9_and_rerun(tmp_path):
+    cfg = load_config("smoke", {**SMOKE, "checkpoint_every": 50, "total_env_steps": 400})
+    script = textwrap.dedent(f"""
+        import sys, time
+        sys.path.insert(0, {str(TESTS)!r})
+        from test_rl_fake_env import register_fake_envs, FAKE_ENV_ID
+        from egosearch.rl.config import SacCurlConfig
+        from egosearch.rl.train import train
+        register_fake_envs()
+        cfg = SacCurlConfig.from_dict({cfg.to_dict()!r})
+        train(FAKE_ENV_ID, cfg, {str(tmp_path)!r}, progress=False, on_step=lambda s: time.sleep(0.01))
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    ckpt = tmp_path / CHECKPOINT_NAME
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if ckpt.exists() and torch.load(ckpt, weights_only=True)["env_steps"] >= 150:
+            break
+        time.sleep(0.2)
+    assert proc.poll() is None, proc.stderr.read().decode()[-2000:]
+    time.sleep(0.37)  # somewhere mid-step / mid-write
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    proc.stderr.close()
+    assert not (tmp_path / "done.json").exists()
+    train(FAKE_ENV_ID, cfg, tmp_path, progress=False)
+    check_complete_run(tmp_path, cfg)
+
+
+def test_corrupted_or_foreign_checkpoint_is_a_clear_error(tmp_path):
+    cfg = load_config("smoke", SMOKE)
+    with pytest.raises(Interrupt):
+        train(FAKE_ENV_ID, cfg, tmp_path, variant="head-on", progress=False, on_step=interrupt_at(160))
+    ckpt = tmp_path / CHECKPOINT_NAME
+    good = ckpt.read_bytes()
+    listing = sorted(p.name for p in tmp_path.iterdir())
+    curve = (tmp_path / "curve.csv").read_text()
+
+    # another variant or another config: refused, nothing written
+    with pytest.raises(CheckpointError, match="variant='head-on'") as err:
+        train(FAKE_ENV_ID, cfg, tmp_path, variant="head-off", progress=False)
+    assert "\n" not in str(err.value)
+    with pytest.raises(CheckpointError, match="different config: batch_size=32 \\(now 16\\)"):
+        train(FAKE_ENV_ID, load_config("smoke", {**SMOKE, "batch_size": 16}), tmp_path,
+              variant="head-on", progress=False)
+    with pytest.raises(CheckpointError, match="env_kwargs"):
+        train(FAKE_ENV_ID, cfg, tmp_path, env_kwargs={"max_steps": 20}, variant="head-on", progress=False)
+    # a truncated (corrupted) file
+    ckpt.write_bytes(good[: len(good) // 2])
+    with pytest.raises(CheckpointError, match="cannot read checkpoint") as err:
+        train(FAKE_ENV_ID, cfg, tmp_path, variant="head-on", progress=False)
+    assert "\n" not in str(err.value)
+    ckpt.write_bytes(b"garbage")
+    with pytest.raises(CheckpointError, match="cannot read checkpoint"):
+        train(FAKE_ENV_ID, cfg, tmp_path, variant="head-on", progress=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == listing
+    assert (tmp_path / "curve.csv").read_text() == curve
+    assert not (tmp_path / "actor.pt").exists() and not (tmp_path / "done.json").exists()
+
+    ckpt.write_bytes(good)  # restored: resumes fine, and implementation-only fields may change
+    resumed = load_config("smoke", {**SMOKE, "keep_checkpoint": True})
+    train(FAKE_ENV_ID, resumed, tmp_path, variant="head-on", progress=False)
+    check_complete_run(tmp_path, cfg, checkpoint_kept=True)
+
+
+def test_bad_actor_file_is_a_clear_error(tmp_path):
+    bad = tmp_path / "actor.pt"
+    bad.write_bytes(b"\x00" * 100)
+    with pytest.raises(AgentStateError, match="cannot read actor file"):
+        ActorPolicy(bad)
+    torch.save({"format": "something-else"}, bad)
+    with pytest.raises(AgentStateError, match="not an actor file"):
+        ActorPolicy(bad)
+
+
+def test_learning_beats_random_on_the_fake_env(tmp_path):
+    from egosearch.policies import RandomPolicy
+
+    # ~25 s on one core: 500 updates of the smoke-sized learner (100 -> 84 crops, K = 5, CURL)
+    cfg = load_config("smoke", {**SMOKE, "total_env_steps": 700, "init_steps": 200, "eval_every": 700,
+                                "checkpoint_every": 700, "log_every": 100, "eval_episodes": 5, "seed": 0})
+    train(FAKE_ENV_ID, cfg, tmp_path, progress=False)
+    evaluate = default_evaluator(FAKE_ENV_ID, {}, episodes=20)
+    trained = evaluate(ActorPolicy(tmp_path / "actor.pt"))
+    random = evaluate(RandomPolicy(5, seed=0))
+    evaluate.close()
+    assert trained["success_rate"] >= 0.8, trained
+    assert random["success_rate"] <= 0.2, random
+    assert trained["episode_return"] > random["episode_return"] + 10
