@@ -21,19 +21,21 @@ def _cmd_scenarios(args) -> None:
 
 
 def _make_policy_factory(kind: str, weights: str | None, seed: int):
+    """(make_policy(env), the env id it acts in): a trained actor knows its own env id."""
     from egosearch.policies import OraclePolicy, RandomPolicy
 
     if kind == "oracle":
-        return OraclePolicy
+        return OraclePolicy, "EgoSearch-v0"
     if kind == "random":
-        return lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)
+        return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), "EgoSearch-v0"
     if kind == "actor":
         if not weights:
-            raise SystemExit("error: --policy actor needs --weights PATH/actor.pt")
+            raise ValueError("--policy actor needs --weights PATH/actor.pt")
         from egosearch.rl.train import ActorPolicy
 
-        return lambda env: ActorPolicy(weights)
-    raise SystemExit(f"error: --policy={kind!r}; allowed: oracle, random, actor")
+        actor = ActorPolicy(weights)
+        return (lambda env: actor), actor.env_id or "EgoSearch-v0"
+    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, actor")
 
 
 def _cmd_evaluate(args) -> None:
@@ -42,8 +44,10 @@ def _cmd_evaluate(args) -> None:
     from egosearch.scenarios import read_scenarios
 
     scenarios = read_scenarios(args.scenarios)
-    rows = evaluate(args.env_id, _make_policy_factory(args.policy, args.weights, args.seed),
-                    scenarios, seed=args.seed, progress=True, desc=f"evaluate {args.policy}")
+    make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
+    env_id = args.env_id or env_id
+    rows = evaluate(env_id, make_policy, scenarios, seed=args.seed, progress=True,
+                    desc=f"evaluate {args.policy} on {env_id}")
     write_episodes(args.out, rows)
     rate = sum(r["success"] for r in rows) / len(rows)
     value = spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
@@ -191,7 +195,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenarios", required=True)
     p.add_argument("--policy", default="actor", help="actor, oracle or random")
     p.add_argument("--weights", help="actor.pt written by training (for --policy actor)")
-    p.add_argument("--env-id", default="EgoSearch-v0")
+    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True)
     p.set_defaults(func=_cmd_evaluate)

@@ -14,7 +14,7 @@ rule table1:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table1 --variant {params.variant} --out-prefix {params.prefix} {input} > {log} 2>&1"
+        "egosearch report table1 {input} --variant {params.variant} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule table2:
@@ -59,7 +59,7 @@ rule fig6:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig6 --out-prefix {params.prefix} {input} > {log} 2>&1"
+        "egosearch report fig6 {input} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig7:
@@ -75,7 +75,7 @@ rule fig7:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig7 --out-prefix {params.prefix} {input} > {log} 2>&1"
+        "egosearch report fig7 {input} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule pictures:
