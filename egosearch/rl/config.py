@@ -306,7 +306,7 @@ def cpu_profile() -> dict[str, Any]:
     - ``encoder_num_filters`` 32 -> 16 and MLP hidden 1024 -> 256 (0.12 s per update);
     - ``total_env_steps`` 750k -> 24k (3.2%) with one update every 2 env steps
       (``update_every`` 2): (24k - 1k warm-up) / 2 = 11.5k updates ~ 1380 s, env steps and
-      acting ~ 70 s, 7 evaluations x 10 episodes ~ 20 s: ~ 25 min per run.
+      acting ~ 70 s, 7 evaluations x 30 held-out scenarios ~ 60 s: ~ 25 min per run.
 
     Re-measure with ``egosearch bench learner`` (``updates_per_s_cpu_profile``) and scale
     ``total_env_steps`` if the machine differs.
@@ -320,7 +320,7 @@ def cpu_profile() -> dict[str, Any]:
         "critic_hidden_dim": 256,
         "init_steps": 1000,
         "eval_every": 4_000,
-        "eval_episodes": 10,
+        "eval_episodes": 30,
         "log_every": 500,
         "checkpoint_every": 4_000,
         "num_threads": 1,
