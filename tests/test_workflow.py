@@ -1,0 +1,92 @@
+"""The Snakemake suite: dry run, lint, schema, a smoke run of table1, and a cluster executor."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+REPO = Path(__file__).resolve().parent.parent
+SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+
+
+def run(args, cwd=REPO, timeout=600):
+    return subprocess.run(SNAKEMAKE + args, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture
+def checkout(tmp_path):
+    """A copy of the suite (no results), so that runs never touch the stored results."""
+    files = subprocess.run(["git", "ls-files"], cwd=REPO, capture_output=True, text=True).stdout.split()
+    dest = tmp_path / "suite"
+    for name in files:
+        if name.startswith(("results/", "paper_figs/")):
+            continue
+        src = REPO / name
+        if src.is_file():
+            (dest / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / name)
+    return dest
+
+
+def test_dry_run_of_all_lists_every_stage():
+    out = run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"])
+    assert out.returncode == 0, out.stderr
+    for rule in ("scenarios", "train", "evaluate", "fullbody", "table1", "table2", "fig6", "fig7", "provenance"):
+        assert rule in out.stdout, rule
+
+
+def test_lint_is_clean():
+    out = run(["--lint"])
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "Congratulations" in out.stdout + out.stderr
+
+
+@pytest.mark.parametrize("override, key", [
+    ("profile=fast", "profile"),
+    ("heights=[7.0]", "heights"),
+    ("placements=[under_the_sofa]", "placements"),
+])
+def test_schema_rejects_bad_config_before_any_job(override, key):
+    out = run(["-n", "all", "--config", override])
+    assert out.returncode != 0
+    assert key in out.stdout + out.stderr
+
+
+def test_unknown_variant_is_named_before_any_job():
+    out = run(["-n", "all", "--config", "variants=[head_on,hed_off]"])
+    assert out.returncode != 0
+    assert "hed_off" in out.stdout + out.stderr and "allowed" in out.stdout + out.stderr
+
+
+def test_smoke_table1_end_to_end(checkout):
+    out = run(["--cores", "2", "table1", "--config", "profile=smoke"], cwd=checkout, timeout=900)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    md = (checkout / "paper_figs/smoke/table1.md").read_text()
+    assert "paper 0.92" in md and "0.45m" in md
+    evals = sorted((checkout / "results/smoke/eval/head_on/seed0/kitchen_living").rglob("h*.csv"))
+    assert len(evals) == 6
+    # The scenario sets are fixed: the same rows on a second generation.
+    scen = checkout / "results/smoke/scenarios/kitchen_living/everywhere/h1.65.csv"
+    again = subprocess.run(["egosearch", "scenarios", "--placement", "everywhere", "--height", "1.65", "--n", "4",
+                            "--seed", "2021", "--out", str(checkout / "again.csv")], capture_output=True, text=True)
+    assert again.returncode == 0, again.stderr
+    assert scen.read_text() == (checkout / "again.csv").read_text()
+
+
+def test_cluster_generic_executor_runs_the_same_dag(checkout):
+    submit = checkout / "tests/data/local_submit.sh"
+    out = run(["--executor", "cluster-generic", "--cluster-generic-submit-cmd", f"bash {submit}", "--jobs", "2",
+               "--latency-wait", "30", "table2", "table2_paper", "--config", "profile=smoke"], cwd=checkout)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    table = (checkout / "paper_figs/table2.md").read_text()
+    assert "| Batch-size | 32 |" in table and "| Replay buffer | 100000 |" in table
+    assert "0.75M" in table
+
+
+def test_config_file_is_valid_yaml_with_all_profiles():
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    assert set(config["profiles"]) == {"smoke", "cpu", "paper"}
+    assert config["profile"] == "cpu"
