@@ -152,6 +152,20 @@ def _regenerate(profile: str, reference: str) -> None:
     report.cmd_table2(table2_rows(load_config(learner)), figs / "table2")
 
 
+def _cmd_video(args) -> None:
+    from egosearch.motion.video import write_search_video
+    from egosearch.scenarios import read_scenarios
+
+    scenarios = {sc.scenario_id: sc for sc in read_scenarios(args.scenarios)}
+    if args.scenario_id not in scenarios:
+        raise ValueError(f"--scenario-id={args.scenario_id} is not in {args.scenarios}")
+    scenario = scenarios[args.scenario_id]
+    make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
+    row = write_search_video(scenario.layout, args.character, make_policy, scenario, args.out,
+                             still_path=args.still, M=args.M, T=args.T, seed=args.seed, env_id=env_id)
+    print(f"{args.character}: success {row['success']} in {row['steps']} steps -> {args.out}, {args.still}")
+
+
 def _cmd_bench(args) -> None:
     from egosearch import bench
 
@@ -226,6 +240,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=3000)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
+    p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch")
+    p.add_argument("--scenarios", required=True)
+    p.add_argument("--scenario-id", type=int, default=0)
+    p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
+    p.add_argument("--weights", help="actor.pt of the search policy")
+    p.add_argument("--M", type=int, default=5, help="steps executed per plan")
+    p.add_argument("--T", type=int, default=20, help="planning horizon")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True, help=".mp4 or .gif")
+    p.add_argument("--still", required=True, help=".png of the moment the target is found")
+    p.set_defaults(func=_cmd_video)
 
     p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
     p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate"))
