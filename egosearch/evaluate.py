@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import csv
 import os
-from pathlib import Path
 
 import gymnasium
 
 import egosearch.envs  # noqa: F401  (registers the ids)
+from egosearch.csvio import write_csv_atomic
 from egosearch.metrics import episode_spl
 from egosearch.scenarios import Scenario
 
@@ -71,15 +70,7 @@ def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
 
 
 def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
-    """Fixed columns, written atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=EPISODE_COLUMNS)
-        writer.writeheader()
-        writer.writerows(rows)
-    os.replace(tmp, path)
+    write_csv_atomic(path, EPISODE_COLUMNS, rows)
 
 
 def scenario_evaluator(env_id: str, layout: str, placement: str, n: int, seed: int = 7):

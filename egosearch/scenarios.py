@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from egosearch.agent import AgentSpec, check_height
+from egosearch.csvio import write_csv_atomic
 from egosearch.navgrid import NavGrid
 from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.meshes import scene_meshes
@@ -80,17 +81,9 @@ def check_placement(placement: str) -> str:
 
 
 def write_scenarios(path: str | os.PathLike, scenarios: list[Scenario]) -> None:
-    """Write atomically: a reader never sees half a file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
-        writer.writeheader()
-        for sc in scenarios:
-            row = asdict(sc)
-            writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
-    os.replace(tmp, path)
+    """Write atomically: a reader never sees half a file. Floats keep every digit (repr)."""
+    write_csv_atomic(path, COLUMNS, ({k: (repr(v) if isinstance(v, float) else v) for k, v in asdict(sc).items()}
+                                     for sc in scenarios))
 
 
 def read_scenarios(path: str | os.PathLike) -> list[Scenario]:

@@ -28,6 +28,16 @@ _JOINT_X, _JOINT_Y, _JOINT_YAW = 0, 1, 2
 _BODY_LINK = 2
 
 
+def add_static_part(client, part: Part) -> int:
+    """One immovable pybullet body for an obstacle part, in ``client``."""
+    if part.shape == "cylinder":
+        shape = client.createCollisionShape(pybullet.GEOM_CYLINDER, radius=part.size[0] / 2, height=part.size[2])
+    else:  # boxes, and meshes by their bounding box: furniture is never a loose mesh
+        shape = client.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[s / 2 for s in part.size])
+    return client.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=part.center,
+                                  baseOrientation=client.getQuaternionFromEuler((0, 0, part.yaw)))
+
+
 class World:
     """One pybullet client holding the static home and the searcher's body."""
 
@@ -39,7 +49,7 @@ class World:
         p.setPhysicsEngineParameter(fixedTimeStep=0.15 / SUBSTEPS, numSubSteps=0,
                                     numSolverIterations=10, deterministicOverlappingPairs=1)
         p.setGravity(0, 0, 0)
-        self.static_ids = [self._add_static(part) for part in scene.obstacles]
+        self.static_ids = [add_static_part(self._p, part) for part in scene.obstacles]
         self._static_set = frozenset(self.static_ids)
         self.agent_id = self._add_agent()
         self._probe_id = self._add_probe()
@@ -56,17 +66,6 @@ class World:
             pass
 
     # -- building -------------------------------------------------------------------------
-    def _add_static(self, part: Part) -> int:
-        p = self._p
-        if part.shape == "cylinder":
-            shape = p.createCollisionShape(pybullet.GEOM_CYLINDER, radius=part.size[0] / 2,
-                                           height=part.size[2])
-        else:  # boxes, and meshes by their bounding box: furniture is never a loose mesh
-            shape = p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[s / 2 for s in part.size])
-        orientation = p.getQuaternionFromEuler((0, 0, part.yaw))
-        return p.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape,
-                                 basePosition=part.center, baseOrientation=orientation)
-
     def _body_shape(self) -> int:
         return self._p.createCollisionShape(pybullet.GEOM_CYLINDER, radius=self.spec.body_radius,
                                             height=self.spec.body_height)

@@ -19,7 +19,8 @@ from pybullet_utils import bullet_client
 from egosearch.agent import AgentSpec
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose
-from egosearch.scene.parts import Part, Scene
+from egosearch.scene.parts import Scene
+from egosearch.world import add_static_part
 
 #: A shape this deep (m) inside an obstacle counts as a penetration; shallower contact is touch.
 PENETRATION_DEPTH = 0.01
@@ -30,7 +31,7 @@ class PenetrationCounter:
         self.scene = scene
         self.character = character
         self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
-        self.static_ids = [self._add_static(part) for part in scene.obstacles]
+        self.static_ids = [add_static_part(self._p, part) for part in scene.obstacles]
         self._static_set = frozenset(self.static_ids)
         self._part_of = dict(zip(self.static_ids, scene.obstacles))
         if character == "humanoid":
@@ -56,15 +57,6 @@ class PenetrationCounter:
             self.close()
         except Exception:
             pass
-
-    def _add_static(self, part: Part) -> int:
-        p = self._p
-        if part.shape == "cylinder":
-            shape = p.createCollisionShape(pybullet.GEOM_CYLINDER, radius=part.size[0] / 2, height=part.size[2])
-        else:
-            shape = p.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[s / 2 for s in part.size])
-        return p.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=part.center,
-                                 baseOrientation=p.getQuaternionFromEuler((0, 0, part.yaw)))
 
     def contacts(self, pose: FullBodyPose) -> list[tuple[str, float]]:
         """(obstacle part name, penetration depth in m > 0) for every obstacle the pose is inside."""

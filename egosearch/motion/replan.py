@@ -32,15 +32,14 @@ since the plan is redone after M steps. 20 steps are 3 s of search, a fifth of a
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from egosearch.agent import AgentState
+from egosearch.csvio import write_csv_atomic
 from egosearch.env import FRAME_HISTORY, target_distance
 from egosearch.metrics import episode_spl
 from egosearch.motion.base import FullBodyPose, IdentityMG, MotionGenerator
@@ -315,12 +314,4 @@ def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], metho
 
 
 def write_fullbody(path: str | os.PathLike, rows: list[dict]) -> None:
-    """Fixed columns, written atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=FULLBODY_COLUMNS)
-        writer.writeheader()
-        writer.writerows(rows)
-    os.replace(tmp, path)
+    write_csv_atomic(path, FULLBODY_COLUMNS, rows)
