@@ -1,3 +1,5 @@
+# Inputs are ancient(): stored results are trusted whatever their file times (a fresh clone gives
+# every file the checkout time). A job still reruns when a job upstream of it runs.
 # Names and paths shared by every rule. Every output path is a function of
 # (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
 from pathlib import Path

@@ -1,8 +1,8 @@
 rule evaluate:
     """One trained policy on one Table 1 cell: a row per episode."""
     input:
-        actor="results/{profile}/train/{variant}/seed{seed}/actor.pt",
-        scenarios="results/{profile}/scenarios/{layout}/{placement}/h{height}.csv",
+        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
         "results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
     log:

@@ -1,8 +1,8 @@
 rule fullbody:
     """Algorithm 1 (or a baseline of paper 6.4) with a full-body character."""
     input:
-        actor=f"{RESULTS}/train/{REF}/seed{{seed}}/actor.pt",
-        scenarios=fullbody_scenarios,
+        actor=ancient(f"{RESULTS}/train/{REF}/seed{{seed}}/actor.pt"),
+        scenarios=ancient(fullbody_scenarios),
     output:
         "results/{profile}/fullbody/{setting}/seed{seed}.csv",
     log:

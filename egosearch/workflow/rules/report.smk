@@ -3,7 +3,7 @@
 rule table1:
     """Success rate per camera height x placement scheme, pooled over seeds (paper Table 1)."""
     input:
-        eval_files(REF),
+        ancient(eval_files(REF)),
     output:
         expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
     log:
@@ -49,7 +49,7 @@ rule table2_paper:
 rule fig6:
     """Success rate vs environment steps, head on vs head off (paper Figure 6)."""
     input:
-        [curve_files(v) for v in VARIANTS],
+        ancient([curve_files(v) for v in VARIANTS]),
     output:
         expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
@@ -65,7 +65,7 @@ rule fig6:
 rule fig7:
     """SPL per method and attempts vs M of the full-body replanner (paper Figure 7)."""
     input:
-        fullbody_files(),
+        ancient(fullbody_files()),
     output:
         expand(f"{FIGS}/fig7.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
@@ -96,7 +96,7 @@ rule pictures:
 rule compare:
     """Does a new variant beat the stored reference? Per cell: difference, 95% CI, p-value."""
     input:
-        reference=eval_files(REF),
+        reference=ancient(eval_files(REF)),
         candidate=compare_candidate,
     output:
         f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
