@@ -364,3 +364,13 @@ def test_everywhere_puts_a_real_share_inside_low_cabinets(layout):
         floor += piece_of(surface).startswith("floor/")
     assert 0.10 <= low / 300 <= 0.35
     assert floor / 300 <= 0.3
+
+
+def test_studio_is_small_connected_and_named():
+    from egosearch.agent import AgentSpec
+    from egosearch.navgrid import NavGrid
+
+    scene = get_scene("studio")
+    assert scene.size_xy == (4.5, 4.0)
+    nav = NavGrid(scene, AgentSpec())
+    assert nav.main_region.sum() >= 0.95 * nav.free.sum() > 0

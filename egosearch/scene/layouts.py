@@ -25,8 +25,11 @@ from egosearch.scene import furniture as F
 from egosearch.scene.parts import Part, Scene, SupportSurface, to_local
 
 LAYOUT_NAMES = ("kitchen_living", "bedroom_bath")
+"""The paper's two homes (Figure 4)."""
+EASY_LAYOUTS = ("studio",)
+"""Small homes where the target is often in view: for learning tests, not for the paper's tables."""
 WALL_HEIGHT = F.WALL_HEIGHT
-_ALLOWED = "kitchen_living, bedroom_bath, home<seed>"
+_ALLOWED = "kitchen_living, bedroom_bath, studio, home<seed>"
 
 Rect = tuple[float, float, float, float]
 
@@ -177,6 +180,20 @@ def _build_bedroom_bath() -> Scene:
     h.add(F.wall_cabinet("bath/wall_cabinet_sink", 7.55, 3.4, S, width=0.8, depth=0.3, z_bottom=1.4))
     h.add(F.shelf_unit("bath/shelf", 6.4, 5.6, W))
     h.room("bathroom", (6.25, 3.25, 9.0, 7.0), (7.5, 5.2))
+    return h.scene()
+
+
+@functools.cache
+def studio() -> Scene:
+    """A 4.5 x 4 m room with a table, an armchair and a low open cabinet: most targets are in
+    view from most of the floor. The easy setting of the learning tests."""
+    b = (0.0, 0.0, 4.5, 4.0)
+    h = _Home("studio", b)
+    h.add(F.outer_walls(b))
+    h.add(F.table("studio/table", 2.6, 2.6, 0.0, width=1.0, depth=0.7))
+    h.add(F.armchair("studio/armchair", 0.6, 3.3, W, color=F.FABRIC_BEIGE))
+    h.add(F.low_cabinet("studio/cabinet", 3.2, 0.225, S, width=1.2, depth=0.45, height=0.6, n_boards=1))
+    h.room("studio", (0.0, 0.0, 4.5, 4.0))
     return h.scene()
 
 
@@ -586,11 +603,14 @@ def random_home(seed: int) -> Scene:
 
 # ----------------------------------------------------------------------------------- lookup
 def get_scene(name: str) -> Scene:
-    """A scene by name: ``"kitchen_living"``, ``"bedroom_bath"`` or ``"home<seed>"`` (e.g. ``"home7"``)."""
+    """A scene by name: ``"kitchen_living"``, ``"bedroom_bath"``, ``"studio"`` or ``"home<seed>"``
+    (e.g. ``"home7"``)."""
     if name == "kitchen_living":
         return kitchen_living()
     if name == "bedroom_bath":
         return bedroom_bath()
+    if name == "studio":
+        return studio()
     m = re.fullmatch(r"home(\d+)", name) if isinstance(name, str) else None
     if m:
         return random_home(int(m.group(1)))

@@ -30,7 +30,7 @@ wildcard_constraints:
     seed="[0-9]+",
     height="[0-9.]+",
     placement="no_low_cabinets|everywhere",
-    layout="kitchen_living|bedroom_bath|home[0-9]+",
+    layout="kitchen_living|bedroom_bath|studio|home[0-9]+",
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
 
 
