@@ -85,7 +85,7 @@ def test_get_scene_errors_and_lookup():
         with pytest.raises(ValueError) as err:
             get_scene(bad)
         msg = str(err.value)
-        assert repr(bad) in msg and "kitchen_living, bedroom_bath, home<seed>" in msg and "\n" not in msg
+        assert repr(bad) in msg and "kitchen_living, bedroom_bath, studio, home<seed>" in msg and "\n" not in msg
     assert get_scene("kitchen_living") is get_scene("kitchen_living")
     assert get_scene("home3") == _build_home(3)
 
