@@ -122,7 +122,7 @@ def _cmd_report(args) -> None:
     elif args.what == "provenance":
         from egosearch.report.provenance import write_provenance
 
-        record = write_provenance(args.profile, args.results, args.out)
+        record = write_provenance(args.profile, args.results, args.out, note=args.note or "")
         print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
     elif args.what == "regenerate":
         _regenerate(args.profile, args.variant or "head_on")
@@ -264,6 +264,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")
     p.add_argument("--results", default="results/cpu", help="provenance: the results folder")
     p.add_argument("--out", help="compare/provenance: output file")
+    p.add_argument("--note", help="provenance: free text kept in the record (e.g. how the run was resumed)")
     p.set_defaults(func=_cmd_report)
 
     p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")

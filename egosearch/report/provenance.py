@@ -54,7 +54,7 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
     return rows
 
 
-def write_provenance(profile: str, results: Path, out: Path) -> dict:
+def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> dict:
     results = Path(results)
     jobs = rule_times(results / "benchmarks")
     per_rule: dict[str, float] = {}
@@ -73,6 +73,8 @@ def write_provenance(profile: str, results: Path, out: Path) -> dict:
         "wall_s_all_jobs_summed": round(sum(per_rule.values()), 1),
         "jobs": jobs,
     }
+    if note:
+        record["note"] = note
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(out.name + ".tmp")
