@@ -214,22 +214,37 @@ def test_state_dict_roundtrip_weights_only():
         other.load_state_dict(state)
 
 
-def test_actor_state_loads_weights_only_and_acts_like_the_agent():
+@pytest.mark.parametrize("storage", [torch.float32, torch.float16])
+def test_actor_state_loads_weights_only_and_acts_like_the_agent(storage):
     agent = make_agent()
     agent.update(make_batch())
     buf = io.BytesIO()
-    torch.save(agent.actor_state({"variant": "head-on", "config": agent.cfg.to_dict()}), buf)
+    torch.save(agent.actor_state({"variant": "head-on", "config": agent.cfg.to_dict()}, storage_dtype=storage), buf)
     buf.seek(0)
     state = torch.load(buf, weights_only=True)
     assert state["metadata"]["variant"] == "head-on"
     assert not any(k.startswith("q") for k in state["state_dict"])  # actor only
+    assert all(v.dtype == storage for v in state["state_dict"].values() if v.is_floating_point())
     net = load_actor_net(state)
     obs = one_obs()
     with torch.no_grad():
         depth = center_crop(torch.as_tensor(obs["depth"])[None], 84).float()
         extra = torch.cat([torch.as_tensor(obs["mask"]), torch.as_tensor(obs["proprio"])])[None]
         mu, _ = net(depth, extra)
-    np.testing.assert_allclose(torch.tanh(mu)[0].numpy(), agent.act(obs, deterministic=True), atol=1e-5)
+    # float16 weights: within ~1e-3 of the live float32 agent.
+    np.testing.assert_allclose(torch.tanh(mu)[0].numpy(), agent.act(obs, deterministic=True), atol=5e-3)
+    # However it was stored, the loaded actor is the same float16 actor.
+    other = torch.float16 if storage == torch.float32 else torch.float32
+    twin = load_actor_net(torch.load(_saved(agent.actor_state({}, storage_dtype=other)), weights_only=True))
+    with torch.no_grad():
+        assert torch.equal(twin(depth, extra)[0], mu)
+
+
+def _saved(state) -> io.BytesIO:
+    buf = io.BytesIO()
+    torch.save(state, buf)
+    buf.seek(0)
+    return buf
 
 
 # ---- config ----------------------------------------------------------------------------------

@@ -648,13 +648,20 @@ class SacCurlAgent:
             opt.load_state_dict(state["optimisers"][k])
         self.num_updates = int(state["num_updates"])
 
-    def actor_state(self, metadata: dict[str, Any] | None = None) -> dict[str, Any]:
+    def actor_state(self, metadata: dict[str, Any] | None = None,
+                    storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
         """Actor-only weights (conv layers + actor projection + actor MLP) with ``arch`` and
         ``metadata``: tensors and plain python types only, so ``torch.load(weights_only=True)``
-        reads it. ``ActorNet(arch)`` loads ``state_dict``."""
+        reads it. ``ActorNet(arch)`` loads ``state_dict`` (casting back to float32).
+
+        Floating weights are stored as ``storage_dtype``: float16 halves the file (the conv-to-128
+        projection alone is 2.5M weights at the cpu profile), keeping a committed actor under
+        10 MB; actions then differ from the live agent's by ~1e-3. :func:`load_actor_net` rounds
+        through float16 whatever the storage, so every reported number is of the float16 actor."""
         weights = {f"convs.{k}": v for k, v in self.critic.convs.state_dict().items()}
         weights.update({f"head.{k}": v for k, v in self.actor.state_dict().items()})
-        weights = {k: v.detach().to("cpu", memory_format=torch.contiguous_format).clone()
+        weights = {k: v.detach().to("cpu", dtype=storage_dtype if v.is_floating_point() else v.dtype,
+                                    memory_format=torch.contiguous_format).clone()
                    for k, v in weights.items()}
         return {"format": ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights,
                 "metadata": dict(metadata or {})}
@@ -666,8 +673,11 @@ def load_actor_net(state: dict[str, Any], device: str | torch.device = "cpu") ->
         raise AgentStateError("not an actor file (format="
                               f"{state.get('format') if isinstance(state, dict) else None!r})")
     net = ActorNet(state["arch"])
+    # The stored policy is the float16 actor: weights saved in float32 (older files) are rounded
+    # the same way, so an actor file's actions do not depend on how it was stored.
+    weights = {k: v.to(torch.float16) if v.is_floating_point() else v for k, v in state["state_dict"].items()}
     try:
-        net.load_state_dict(state["state_dict"])
+        net.load_state_dict(weights)
     except RuntimeError as err:
         raise AgentStateError(f"actor weights do not match their arch: {str(err).splitlines()[0]}") from None
     return net.to(device).eval()
