@@ -51,11 +51,23 @@ COLLISION_PENALTY_PER_HIT = -0.1
 COLLISION_PENALTY_FLOOR = -3.0
 
 
-def reward_terms(success: bool, visible: bool, distance: float, n_collisions: int) -> dict[str, float]:
-    """The four terms of paper eq. 2 and their weighted sum."""
+DISTANCE_REWARDS = ("distance", "progress")
+"""How r_d is read: ``distance`` is the paper's text (minus the distance while the target is
+seen); ``progress`` is Savva et al.'s form, which the paper cites (the decrease of that distance
+since the last step, while seen): an ablation, never the default."""
+
+
+def reward_terms(success: bool, visible: bool, distance: float, n_collisions: int,
+                 previous_distance: float | None = None, distance_reward: str = "distance") -> dict[str, float]:
+    """The four terms of paper eq. 2 and their weighted sum. ``previous_distance`` (None when
+    the target was not seen at the last step) only matters for ``distance_reward="progress"``."""
+    if distance_reward == "progress":
+        r_d = previous_distance - distance if visible and previous_distance is not None else 0.0
+    else:
+        r_d = -distance if visible else 0.0
     terms = {
         "r_s": SUCCESS_REWARD if success else 0.0,
-        "r_d": -distance if visible else 0.0,
+        "r_d": r_d,
         "r_l": LIVE_PENALTY,
         "r_c": float(np.clip(COLLISION_PENALTY_PER_HIT * n_collisions, COLLISION_PENALTY_FLOOR, 0.0)),
     }
@@ -75,7 +87,7 @@ class SearchEnv(gymnasium.Env):
     def __init__(self, layout: str = "kitchen_living", placement: str = "everywhere",
                  head: bool = True, height: float | None = None, height_noise: bool | None = None,
                  max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
-                 render_mode: str | None = None):
+                 distance_reward: str = "distance", render_mode: str | None = None):
         """
         Args:
             layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
@@ -85,6 +97,8 @@ class SearchEnv(gymnasium.Env):
             height_noise: per-step height noise; default on exactly when ``height`` is None.
             max_steps: T_max.
             objects: target object names to draw from in training (default: all).
+            distance_reward: ``distance`` (paper) or ``progress`` (an ablation): see
+                :data:`DISTANCE_REWARDS`.
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
         """
         self.scene = layouts_mod.get_scene(layout)
@@ -96,6 +110,9 @@ class SearchEnv(gymnasium.Env):
             raise ValueError(f"render_mode={render_mode!r}; allowed: None, rgb_array")
         self.render_mode = render_mode
         self.max_steps = int(max_steps)
+        if distance_reward not in DISTANCE_REWARDS:
+            raise ValueError(f"distance_reward={distance_reward!r}; allowed: {', '.join(DISTANCE_REWARDS)}")
+        self.distance_reward = distance_reward
         self.objects = tuple(objects) if objects else tuple(sorted(TARGET_OBJECTS))
         for name in self.objects:
             get_object(name)
@@ -142,6 +159,7 @@ class SearchEnv(gymnasium.Env):
         self._dq = np.zeros(2)
         depth, mask = self._sense()
         self._frames[:] = depth
+        self._seen_distance = target_distance(self.state, self.target, spec.body_radius) if mask.any() else None
         return self._observation(mask), self._info(mask.any(), False)
 
     def _random_start(self, rng) -> tuple[float, float, float]:
@@ -179,7 +197,8 @@ class SearchEnv(gymnasium.Env):
         visible = bool(mask.any())
         distance = target_distance(s, self.target, spec.body_radius)
         success = visible and distance <= SUCCESS_DISTANCE
-        terms = reward_terms(success, visible, distance, self.collisions)
+        terms = reward_terms(success, visible, distance, self.collisions, self._seen_distance, self.distance_reward)
+        self._seen_distance = distance if visible else None
         truncated = not success and self.steps >= self.max_steps
         info = self._info(visible, success, distance)
         info.update(terms, collided=collided)
@@ -190,6 +209,7 @@ class SearchEnv(gymnasium.Env):
         """Everything a later :meth:`restore` needs to continue this episode exactly."""
         return {"state": self.state.copy(), "frames": self._frames.copy(), "steps": self.steps,
                 "collisions": self.collisions, "path_length": self.path_length, "dq": self._dq.copy(),
+                "seen_distance": self._seen_distance,
                 "rng": self.np_random.bit_generator.state,
                 "last": (self._last_depth, self._last_mask)}
 
@@ -198,6 +218,7 @@ class SearchEnv(gymnasium.Env):
         self._frames[:] = snap["frames"]
         self.steps, self.collisions, self.path_length = snap["steps"], snap["collisions"], snap["path_length"]
         self._dq = snap["dq"].copy()
+        self._seen_distance = snap["seen_distance"]
         self.np_random.bit_generator.state = snap["rng"]
         self._last_depth, self._last_mask = snap["last"]
 

@@ -40,3 +40,15 @@ def test_reward_distance_only_while_visible_and_collision_floor():
     seen = reward_terms(success=False, visible=True, distance=2.5, n_collisions=0)
     assert seen["reward"] == pytest.approx(-2.5 - 0.1)
     assert math.isclose(seen["r_c"], 0.0)
+
+
+def test_progress_reward_ablation_hand_worked():
+    # Seen at 2.0 m, now seen at 1.5 m: r_d = +0.5 (Savva et al.'s progress form).
+    t = reward_terms(success=False, visible=True, distance=1.5, n_collisions=0, previous_distance=2.0,
+                     distance_reward="progress")
+    assert t["r_d"] == pytest.approx(0.5) and t["reward"] == pytest.approx(0.5 - 0.1)
+    # First sight (nothing to compare with) and not seen: 0.
+    assert reward_terms(False, True, 1.5, 0, None, "progress")["r_d"] == 0.0
+    assert reward_terms(False, False, 1.5, 0, 2.0, "progress")["r_d"] == 0.0
+    # The paper's form ignores the previous distance.
+    assert reward_terms(False, True, 1.5, 0, 2.0)["r_d"] == -1.5
