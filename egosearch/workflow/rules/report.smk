@@ -8,6 +8,8 @@ rule table1:
         expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
     log:
         f"{RESULTS}/logs/report/table1.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/table1.tsv"
     params:
         variant=REF,
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
@@ -23,6 +25,8 @@ rule table2:
         expand(f"{FIGS}/table2.{{ext}}", ext=["md", "tex"]),
     log:
         f"{RESULTS}/logs/report/table2.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/table2.tsv"
     params:
         learner=PROF["learner"],
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
@@ -38,6 +42,8 @@ rule table2_paper:
         expand("paper_figs/table2.{ext}", ext=["md", "tex"]),
     log:
         f"{RESULTS}/logs/report/table2_paper.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/table2_paper.tsv"
     params:
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
     conda:
@@ -54,6 +60,8 @@ rule fig6:
         expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
         f"{RESULTS}/logs/report/fig6.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/fig6.tsv"
     params:
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
     conda:
@@ -70,6 +78,8 @@ rule fig7:
         expand(f"{FIGS}/fig7.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
         f"{RESULTS}/logs/report/fig7.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/fig7.tsv"
     params:
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
     conda:
@@ -84,6 +94,8 @@ rule pictures:
         expand("paper_figs/world/{layout}_{kind}.png", layout=[LAYOUT], kind=["topdown", "placements", "views"]),
     log:
         f"{RESULTS}/logs/report/pictures.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/pictures.tsv"
     params:
         layout=LAYOUT,
         out_dir=lambda wc, output: str(Path(output[0]).parent),
