@@ -20,6 +20,17 @@ def _cmd_scenarios(args) -> None:
     print(f"wrote {len(scenarios)} scenarios to {args.out}")
 
 
+def _acting_threads(threads: int) -> None:
+    """Acting is batch-1 inference, and extra torch threads spin against other jobs: beside two
+    training runs, a 2-thread actor ran full-body episodes 14x slower than a 1-thread one.
+    Snakemake sets OMP_NUM_THREADS itself; this is the default for hand-run commands."""
+    import torch
+
+    from egosearch.rl.train import torch_threads
+
+    torch.set_num_threads(torch_threads(threads))
+
+
 def _make_policy_factory(kind: str, weights: str | None, seed: int):
     """(make_policy(env), the env id it acts in): a trained actor knows its own env id."""
     from egosearch.policies import OraclePolicy, RandomPolicy
@@ -39,6 +50,7 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int):
 
 
 def _cmd_evaluate(args) -> None:
+    _acting_threads(args.threads)
     from egosearch.evaluate import evaluate, write_episodes
     from egosearch.metrics import spl
     from egosearch.scenarios import read_scenarios
@@ -77,6 +89,7 @@ def _cmd_train(args) -> None:
 
 
 def _cmd_fullbody(args) -> None:
+    _acting_threads(args.threads)
     from egosearch.motion.replan import evaluate_fullbody, parse_setting, write_fullbody
     from egosearch.rl.train import ActorPolicy
     from egosearch.scenarios import read_scenarios
@@ -126,6 +139,16 @@ def _cmd_report(args) -> None:
         print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
     elif args.what == "regenerate":
         _regenerate(args.profile, args.variant or "head_on")
+    elif args.what == "readme":
+        from egosearch.report.readme import update_readme
+
+        if update_readme(args.readme, args.profile, check=args.check):
+            print(f"{args.readme}: results blocks match results/{args.profile} and paper_figs/{args.profile}")
+        elif args.check:
+            raise ValueError(f"{args.readme} is out of date with the stored results; "
+                             f"run `egosearch report readme --profile {args.profile}`")
+        else:
+            print(f"rewrote the results blocks of {args.readme} from the {args.profile} results")
 
 
 def _regenerate(profile: str, reference: str) -> None:
@@ -153,6 +176,7 @@ def _regenerate(profile: str, reference: str) -> None:
 
 
 def _cmd_video(args) -> None:
+    _acting_threads(args.threads)
     from egosearch.motion.video import write_search_video
     from egosearch.scenarios import read_scenarios
 
@@ -212,6 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True)
+    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
     p.set_defaults(func=_cmd_evaluate)
 
     p = sub.add_parser("train", help="train a variant's search policy with SAC+CURL (resumable)")
@@ -231,6 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--T", type=int, default=20, help="planning horizon")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True)
+    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
     p.set_defaults(func=_cmd_fullbody)
 
     p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics) or learner")
@@ -252,19 +278,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True, help=".mp4 or .gif")
     p.add_argument("--still", required=True, help=".png of the moment the target is found")
+    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
     p.set_defaults(func=_cmd_video)
 
     p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
-    p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate"))
+    p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate",
+                                        "readme"))
     p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
     p.add_argument("--out-prefix", help="output path without extension")
     p.add_argument("--variant", help="table1/regenerate: the variant the files belong to (default head_on)")
-    p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate: smoke, cpu or paper")
+    p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate/readme: smoke, cpu or paper")
     p.add_argument("--reference", nargs="*", help="compare: the reference variant's evaluation CSVs")
     p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")
     p.add_argument("--results", default="results/cpu", help="provenance: the results folder")
     p.add_argument("--out", help="compare/provenance: output file")
     p.add_argument("--note", help="provenance: free text kept in the record (e.g. how the run was resumed)")
+    p.add_argument("--readme", default="README.md", help="readme: the file whose marked results blocks are rewritten")
+    p.add_argument("--check", action="store_true", help="readme: only check that the blocks are up to date")
     p.set_defaults(func=_cmd_report)
 
     p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")

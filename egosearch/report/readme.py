@@ -1,0 +1,121 @@
+"""Keep the README's Results section equal to the stored results, so that no number in it is typed.
+
+The README marks generated blocks with HTML comments::
+
+    <!-- egosearch:begin table1 -->
+    ... replaced by `egosearch report readme` ...
+    <!-- egosearch:end table1 -->
+
+Each block name maps to a function that renders Markdown from files under ``paper_figs/<profile>/``
+and ``results/<profile>/``. ``egosearch report readme --check`` fails when a block differs from
+what the stored files give (a test runs it), so the README cannot drift from the results.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+BLOCK = re.compile(r"(<!-- egosearch:begin (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- egosearch:end (?P=name) -->)",
+                   re.DOTALL)
+
+
+def _missing(root: Path, path: Path) -> str:
+    return f"*Not generated yet: `{path.relative_to(root)}` is missing (run `snakemake --cores 2 all`).*\n"
+
+
+def _fmt(x: float, digits: int = 2) -> str:
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
+
+
+def block_table1(root: Path, profile: str) -> str:
+    path = root / "paper_figs" / profile / "table1.md"
+    if not path.exists():
+        return _missing(root, path)
+    return path.read_text(encoding="utf-8").rstrip("\n") + "\n"
+
+
+def block_fig6(root: Path, profile: str) -> str:
+    """Per variant: success at the first and the last evaluation and the best mean along the way."""
+    path = root / "paper_figs" / profile / "fig6.csv"
+    if not path.exists():
+        return _missing(root, path)
+    df = pd.read_csv(path)
+    lines = ["| variant | seeds | success at step 0 | success at the last step (95% CI over seeds) | best mean |",
+             "|---|---|---|---|---|"]
+    for variant, g in df.groupby("variant", sort=False):
+        g = g.sort_values("env_steps")
+        first, last = g.iloc[0], g.iloc[-1]
+        best = g.loc[g["success_rate"].idxmax()]
+        lines.append(f"| {variant} | {int(last.n_seeds)} | {_fmt(first.success_rate)} | "
+                     f"{_fmt(last.success_rate)} [{_fmt(last.low)}, {_fmt(last.high)}] at {int(last.env_steps):,} | "
+                     f"{_fmt(best.success_rate)} at {int(best.env_steps):,} |")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
+def block_fig7(root: Path, profile: str) -> str:
+    path = root / "paper_figs" / profile / "fig7.csv"
+    if not path.exists():
+        return _missing(root, path)
+    df = pd.read_csv(path)
+    lines = ["| character / MG | method | episodes | success | SPL (95% CI) | attempts (95% CI) | penetration rate |",
+             "|---|---|---|---|---|---|---|"]
+    for r in df.itertuples():
+        lines.append(f"| {r.mg} | {r.label} | {r.n_episodes} | {_fmt(r.success_rate)} | "
+                     f"{_fmt(r.spl, 3)} [{_fmt(r.spl_low, 3)}, {_fmt(r.spl_high, 3)}] | "
+                     f"{_fmt(r.attempts, 1)} [{_fmt(r.attempts_low, 1)}, {_fmt(r.attempts_high, 1)}] | "
+                     f"{_fmt(r.penetration_rate, 3)} |")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
+def block_provenance(root: Path, profile: str) -> str:
+    path = root / "results" / profile / "provenance.json"
+    if not path.exists():
+        return _missing(root, path)
+    record = json.loads(path.read_text(encoding="utf-8"))
+    machine = record.get("machine", {})
+    per_rule = record.get("wall_s_per_rule_summed", {})
+    lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
+             f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}, "
+             f"{machine.get('cores', '?')} cores, torch {machine.get('torch', '?')}.",
+             f"- {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed: "
+             + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + "."]
+    if record.get("note"):
+        lines.append(f"- Note kept in the record: {record['note']}")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
+BLOCKS: dict[str, Callable[[Path, str], str]] = {
+    "table1": block_table1,
+    "fig6": block_fig6,
+    "fig7": block_fig7,
+    "provenance": block_provenance,
+}
+
+
+def render_readme(text: str, root: Path, profile: str) -> str:
+    """``text`` with every marked block replaced by what the stored files give."""
+    def replace(match: re.Match) -> str:
+        name = match.group("name")
+        if name not in BLOCKS:
+            raise ValueError(f"README block {name!r} is unknown; known: {', '.join(BLOCKS)}")
+        return match.group(1) + BLOCKS[name](root, profile) + match.group(4)
+
+    return BLOCK.sub(replace, text)
+
+
+def update_readme(readme: Path, profile: str, check: bool = False) -> bool:
+    """Rewrite the marked blocks of ``readme`` (or with ``check`` only compare); True when it was up to date."""
+    readme = Path(readme)
+    text = readme.read_text(encoding="utf-8")
+    rendered = render_readme(text, readme.resolve().parent, profile)
+    if rendered == text:
+        return True
+    if not check:
+        readme.write_text(rendered, encoding="utf-8")
+    return False

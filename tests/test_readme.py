@@ -1,0 +1,76 @@
+"""The README's results blocks are generated from the stored files, never typed."""
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from egosearch.cli import main
+from egosearch.report.readme import render_readme, update_readme
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _stored_results(root: Path) -> None:
+    figs, results = root / "paper_figs" / "p", root / "results" / "p"
+    figs.mkdir(parents=True)
+    results.mkdir(parents=True)
+    (figs / "table1.md").write_text("| a | b |\n|---|---|\n| 0.42 | 0.17 |\n\n")
+    pd.DataFrame({"variant": ["v", "v", "w"], "label": ["v", "v", "w"], "env_steps": [0, 4000, 0],
+                  "n_seeds": [3, 3, 1], "success_rate": [0.1, 0.3, 0.05], "low": [0.0, 0.2, float("nan")],
+                  "high": [0.2, 0.4, float("nan")]}).to_csv(figs / "fig6.csv", index=False)
+    (results / "provenance.json").write_text(json.dumps({
+        "profile": "p", "commit": "0123456789abcdef", "date_utc": "2026-01-02T03:04:05+00:00",
+        "machine": {"cpu": "X", "cores": 2, "torch": "2"}, "wall_s_per_rule_summed": {"train": 7200.0, "eval": 60.0},
+        "wall_s_all_jobs_summed": 7260.0, "jobs": [{}, {}], "note": "resumed once"}))
+
+
+README = """# t
+<!-- egosearch:begin table1 -->
+stale
+<!-- egosearch:end table1 -->
+text kept
+<!-- egosearch:begin fig6 -->
+<!-- egosearch:end fig6 -->
+<!-- egosearch:begin provenance -->
+<!-- egosearch:end provenance -->
+<!-- egosearch:begin fig7 -->
+<!-- egosearch:end fig7 -->
+"""
+
+
+def test_blocks_are_filled_from_the_stored_files(tmp_path):
+    _stored_results(tmp_path)
+    out = render_readme(README, tmp_path, "p")
+    assert "stale" not in out and "| 0.42 | 0.17 |" in out and "text kept" in out
+    # fig6: first, last (with its seed CI) and best evaluation of each variant
+    assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | 0.30 at 4,000 |" in out
+    assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | 0.05 at 0 |" in out
+    assert "commit `0123456`" in out and "2.02 h" in out and "eval 1.0 min, train 120.0 min" in out
+    assert "resumed once" in out
+    assert "*Not generated yet: `paper_figs/p/fig7.csv` is missing" in out     # never invented when the file is absent
+    assert render_readme(out, tmp_path, "p") == out         # idempotent
+
+
+def test_check_mode_reports_stale_blocks_without_writing(tmp_path):
+    _stored_results(tmp_path)
+    readme = tmp_path / "README.md"
+    readme.write_text(README)
+    assert update_readme(readme, "p", check=True) is False
+    assert readme.read_text() == README
+    assert update_readme(readme, "p") is False              # rewritten now
+    assert update_readme(readme, "p", check=True) is True
+    assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 0
+    (tmp_path / "paper_figs" / "p" / "table1.md").write_text("| a |\n|---|\n| 0.43 |\n")
+    assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 2
+
+
+def test_unknown_block_is_an_error(tmp_path):
+    with pytest.raises(ValueError, match="'tabel1' is unknown"):
+        render_readme("<!-- egosearch:begin tabel1 -->\n<!-- egosearch:end tabel1 -->", tmp_path, "p")
+
+
+def test_the_repository_readme_matches_the_stored_cpu_results():
+    assert update_readme(REPO / "README.md", "cpu", check=True), (
+        "README.md results blocks differ from results/cpu + paper_figs/cpu: run `egosearch report readme`")
