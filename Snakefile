@@ -25,5 +25,6 @@ rule all:
         rules.table2_paper.output,
         rules.fig6.output,
         rules.fig7.output,
+        rules.fig7_oracle.output,
         rules.pictures.output,
         provenance_file(),

@@ -91,17 +91,16 @@ def _cmd_train(args) -> None:
 def _cmd_fullbody(args) -> None:
     _acting_threads(args.threads)
     from egosearch.motion.replan import evaluate_fullbody, parse_setting, write_fullbody
-    from egosearch.rl.train import ActorPolicy
     from egosearch.scenarios import read_scenarios
 
     method, m, mg = parse_setting(args.setting)
-    policy = ActorPolicy(args.weights)
+    make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
     scenarios = read_scenarios(args.scenarios)[: args.limit or None]
-    rows = evaluate_fullbody(policy.env_id or "EgoSearch-v0", lambda env: policy, scenarios, method=method,
-                             mg_name=mg, M=m, T=args.T, seed=args.seed, progress=True)
+    rows = evaluate_fullbody(env_id, make_policy, scenarios, method=method, mg_name=mg, M=m, T=args.T,
+                             seed=args.seed, progress=True)
     write_fullbody(args.out, rows)
     rate = sum(r["success"] for r in rows) / len(rows)
-    print(f"{args.setting}: success {rate:.3f} over {len(rows)} episodes -> {args.out}")
+    print(f"{args.setting} ({args.policy}): success {rate:.3f} over {len(rows)} episodes -> {args.out}")
 
 
 def _group_curves(paths: list[str]) -> dict[str, list[str]]:
@@ -126,7 +125,7 @@ def _cmd_report(args) -> None:
     elif args.what == "fig6":
         report.cmd_fig6(_group_curves(args.files), args.out_prefix)
     elif args.what == "fig7":
-        report.cmd_fig7(args.files, args.out_prefix)
+        report.cmd_fig7(args.files, args.out_prefix, planner=args.planner)
     elif args.what == "compare":
         if not args.reference or not args.candidate:
             raise ValueError("compare needs --reference CSV... and --candidate CSV...")
@@ -162,7 +161,8 @@ def _regenerate(profile: str, reference: str) -> None:
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
     curves = sorted(str(p) for p in (results / "train").glob("*/seed*/curve.csv"))
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
-    if not (evals or curves or fullbody):
+    fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
+    if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
     figs.mkdir(parents=True, exist_ok=True)
     if evals:
@@ -171,6 +171,8 @@ def _regenerate(profile: str, reference: str) -> None:
         report.cmd_fig6(_group_curves(curves), figs / "fig6")
     if fullbody:
         report.cmd_fig7(fullbody, figs / "fig7")
+    if fullbody_oracle:
+        report.cmd_fig7(fullbody_oracle, figs / "fig7_oracle", planner="oracle")
     learner = {"smoke": "smoke", "cpu": "cpu", "paper": "paper"}[profile]
     report.cmd_table2(table2_rows(load_config(learner)), figs / "table2")
 
@@ -250,7 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fullbody", help="full-body search (Algorithm 1 or a baseline) -> per-episode CSV")
     p.add_argument("--setting", required=True,
                    help="ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> or noisy_search-<mg>")
-    p.add_argument("--weights", required=True, help="actor.pt of the search policy")
+    p.add_argument("--policy", default="actor",
+                   help="the planner: actor (with --weights), or oracle (privileged: knows the target) or random")
+    p.add_argument("--weights", help="actor.pt of the search policy (for --policy actor)")
     p.add_argument("--scenarios", required=True)
     p.add_argument("--limit", type=int, default=0, help="use the first N scenarios (0: all)")
     p.add_argument("--T", type=int, default=20, help="planning horizon")
@@ -293,6 +297,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--results", default="results/cpu", help="provenance: the results folder")
     p.add_argument("--out", help="compare/provenance: output file")
     p.add_argument("--note", help="provenance: free text kept in the record (e.g. how the run was resumed)")
+    p.add_argument("--planner", default="actor", choices=("actor", "oracle"),
+                   help="fig7: which planner drove the full-body runs (oracle figures say so in a title)")
     p.add_argument("--readme", default="README.md", help="readme: the file whose marked results blocks are rewritten")
     p.add_argument("--check", action="store_true", help="readme: only check that the blocks are up to date")
     p.set_defaults(func=_cmd_report)

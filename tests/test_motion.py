@@ -334,3 +334,13 @@ def test_search_video(tmp_path, scenarios):
     assert still.shape[0] == 384 and still.shape[1] == 384 + 512
     frames = imageio.mimread(tmp_path / "search.gif")
     assert len(frames) == row["steps"] + 1
+
+
+def test_fullbody_command_with_an_actor_needs_its_weights(tmp_path, capsys):
+    from egosearch.cli import main
+
+    scen = tmp_path / "s.csv"
+    code = main(["fullbody", "--setting", "ours-M5-humanoid_phase", "--scenarios", str(scen), "--out",
+                 str(tmp_path / "out.csv")])
+    assert code == 2 and "--weights" in capsys.readouterr().err
+    assert not (tmp_path / "out.csv").exists()

@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -34,7 +35,8 @@ def checkout(tmp_path):
 def test_dry_run_of_all_lists_every_stage():
     out = run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"])
     assert out.returncode == 0, out.stderr
-    for rule in ("scenarios", "train", "evaluate", "fullbody", "table1", "table2", "fig6", "fig7", "provenance"):
+    for rule in ("scenarios", "train", "evaluate", "fullbody", "fullbody_oracle", "table1", "table2", "fig6", "fig7",
+                 "fig7_oracle", "provenance"):
         assert rule in out.stdout, rule
 
 
@@ -74,6 +76,20 @@ def test_smoke_table1_end_to_end(checkout):
                             "--seed", "2021", "--out", str(checkout / "again.csv")], capture_output=True, text=True)
     assert again.returncode == 0, again.stderr
     assert scen.read_text() == (checkout / "again.csv").read_text()
+
+
+def test_smoke_fig7_with_the_oracle_planner_end_to_end(checkout):
+    out = run(["--cores", "2", "fig7_oracle", "--config", "profile=smoke"], cwd=checkout, timeout=900)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert not (checkout / "results/smoke/train").exists()   # the oracle planner needs no training
+    fig = pd.read_csv(checkout / "paper_figs/smoke/fig7_oracle.csv")
+    assert set(fig["method"]) == {"ours", "one_step_short", "one_step_long", "noisy_search"}
+    ours = fig[fig["method"] == "ours"].set_index("M")
+    assert sorted(ours.index) == [5, 20] and (ours["n_episodes"] == 2).all()
+    # The oracle finds the target through Algorithm 1; fewer steps per plan means more plans.
+    assert ours["success_rate"].min() > 0
+    assert ours.loc[5, "attempts"] > ours.loc[20, "attempts"]
+    assert (checkout / "paper_figs/smoke/fig7_oracle.png").stat().st_size > 10_000
 
 
 def test_cluster_generic_executor_runs_the_same_dag(checkout):

@@ -14,7 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from egosearch.report.data import _with, cells_from_paths, group_eval_paths, output_base
-from egosearch.report.figures import figure6, figure7
+from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
 from egosearch.report.tables import compare_report, format_compare, table1, table2
 
 PathLike = str | os.PathLike
@@ -51,9 +51,9 @@ def cmd_fig6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike,
     return outs
 
 
-def cmd_fig7(fullbody_files: Iterable[PathLike], out_prefix: PathLike) -> list[Path]:
-    """Figure 7 from a list of full-body CSVs (all settings and seeds)."""
-    outs = figure7(fullbody_files, out_prefix)
+def cmd_fig7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, planner: str = "actor") -> list[Path]:
+    """Figure 7 from a list of full-body CSVs (all settings and seeds) planned by ``planner``."""
+    outs = figure7(fullbody_files, out_prefix, title=PLANNER_TITLES[planner])
     _say(outs)
     return outs
 

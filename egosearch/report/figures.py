@@ -51,6 +51,8 @@ METHOD_LABELS = {"one_step_short": "1-step short", "one_step_long": "1-step long
 MG_LABELS = {"humanoid_phase": "Humanoid, phase MG", "humanoid_matching": "Humanoid, matching MG",
              "fetch": "Fetch"}
 MG_ORDER = ("humanoid_phase", "humanoid_matching", "fetch")
+PLANNER_TITLES = {"actor": None, "oracle": "Planner: privileged oracle (knows the target; not the learned policy)"}
+"""Figure 7's title per planner: the paper's figure (the learned policy) has none."""
 
 FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "success_rate", "low", "high")
 FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
@@ -202,9 +204,10 @@ def _yerr(mean, lo, hi) -> np.ndarray:
 
 
 def figure7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, confidence: float = 0.95,
-            n_resamples: int = 10_000, seed: int = 0) -> list[Path]:
+            n_resamples: int = 10_000, seed: int = 0, title: str | None = None) -> list[Path]:
     """Figure 7: left, SPL per method (bars, bootstrap CI over scenarios; baselines left of a dashed line,
-    then ours for each M); right, abstract-trajectory attempts vs M for ours (mean and CI).
+    then ours for each M); right, abstract-trajectory attempts vs M for ours (mean and CI). ``title``
+    goes above both panels (e.g. which planner drove the search).
 
     Several motion generators (``mg``) are shown as grouped bars / separate lines with one colour each.
     Writes ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (:func:`figure7_frame`; a
@@ -274,6 +277,8 @@ def figure7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, confidence
             ax2.set_ylim(0, top * 1.08 if np.isfinite(top) and top > 0 else 1.0)
         ax2.set_xlabel("M (executed steps per plan)")
         ax2.set_ylabel("Attempts (abstract trajectories)")
+        if title:
+            fig.suptitle(title, y=1.08)
         outs = _save(fig, base)
     return [*outs, _with(base, ".csv")]
 

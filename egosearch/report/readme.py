@@ -58,8 +58,8 @@ def block_fig6(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def block_fig7(root: Path, profile: str) -> str:
-    path = root / "paper_figs" / profile / "fig7.csv"
+def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
+    path = root / "paper_figs" / profile / f"{name}.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
@@ -94,6 +94,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "table1": block_table1,
     "fig6": block_fig6,
     "fig7": block_fig7,
+    "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
     "provenance": block_provenance,
 }
 

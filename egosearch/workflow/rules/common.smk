@@ -55,8 +55,11 @@ def fullbody_settings():
     return out
 
 
-def fullbody_files():
-    return expand(f"{RESULTS}/fullbody/{{setting}}/seed{{seed}}.csv",
+def fullbody_files(planner="actor"):
+    """Full-body CSVs of every setting: planner ``actor`` (the reference variant's policy, paper
+    Figure 7) or ``oracle`` (the privileged planner)."""
+    stage = "fullbody" if planner == "actor" else f"fullbody_{planner}"
+    return expand(f"{RESULTS}/{stage}/{{setting}}/seed{{seed}}.csv",
                   setting=fullbody_settings(), seed=FULLBODY["seeds"])
 
 

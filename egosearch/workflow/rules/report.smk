@@ -88,6 +88,24 @@ rule fig7:
         "egosearch report fig7 {input} --out-prefix {params.prefix} > {log} 2>&1"
 
 
+rule fig7_oracle:
+    """Figure 7 again with the privileged oracle as planner (not in the paper)."""
+    input:
+        ancient(fullbody_files("oracle")),
+    output:
+        expand(f"{FIGS}/fig7_oracle.{{ext}}", ext=["png", "pdf", "csv"]),
+    log:
+        f"{RESULTS}/logs/report/fig7_oracle.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/fig7_oracle.tsv"
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report fig7 {input} --out-prefix {params.prefix} --planner oracle > {log} 2>&1"
+
+
 rule pictures:
     """The world's pictures: top-down map, placements, first/third-person views."""
     output:
@@ -128,6 +146,7 @@ rule provenance:
         rules.table2.output,
         rules.fig6.output,
         rules.fig7.output,
+        rules.fig7_oracle.output,
     output:
         provenance_file(),
     log:
