@@ -137,7 +137,7 @@ def _cmd_report(args) -> None:
         record = write_provenance(args.profile, args.results, args.out, note=args.note or "")
         print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
     elif args.what == "regenerate":
-        _regenerate(args.profile, args.variant or "head_on")
+        _regenerate(args.profile, args.variant)
     elif args.what == "readme":
         from egosearch.report.readme import update_readme
 
@@ -150,16 +150,26 @@ def _cmd_report(args) -> None:
             print(f"rewrote the results blocks of {args.readme} from the {args.profile} results")
 
 
-def _regenerate(profile: str, reference: str) -> None:
-    """Tables and figures from the CSVs already in results/<profile>/: seconds, no training."""
+def _regenerate(profile: str, reference: str | None) -> None:
+    """Tables and figures from the CSVs already in results/<profile>/: seconds, no training. The
+    variants and the reference come from the workflow config, as in the DAG, so regenerating gives
+    the files `snakemake all` would."""
     from pathlib import Path
+
+    import yaml
 
     from egosearch.report import cli as report
     from egosearch.rl.config import load_config, table2_rows
 
+    config = yaml.safe_load((Path(__file__).resolve().parent / "workflow" / "config.yaml").read_text())
+    if profile not in config["profiles"]:
+        raise ValueError(f"--profile={profile!r}; allowed: {', '.join(config['profiles'])}")
+    reference = reference or config["reference_variant"]
     results, figs = Path("results") / profile, Path("paper_figs") / profile
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
-    curves = sorted(str(p) for p in (results / "train").glob("*/seed*/curve.csv"))
+    variants = dict.fromkeys(config["variants"] + [config["reference_variant"]])   # the fig6 rule's order
+    curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv")) for v in variants}
+    curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
     if not (evals or curves or fullbody or fullbody_oracle):
@@ -168,12 +178,12 @@ def _regenerate(profile: str, reference: str) -> None:
     if evals:
         report.cmd_table1(evals, figs / "table1", variant=reference)
     if curves:
-        report.cmd_fig6(_group_curves(curves), figs / "fig6")
+        report.cmd_fig6(curves, figs / "fig6")
     if fullbody:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:
         report.cmd_fig7(fullbody_oracle, figs / "fig7_oracle", planner="oracle")
-    learner = {"smoke": "smoke", "cpu": "cpu", "paper": "paper"}[profile]
+    learner = config["profiles"][profile]["learner"]
     report.cmd_table2(table2_rows(load_config(learner)), figs / "table2")
 
 
@@ -290,7 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
                                         "readme"))
     p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
     p.add_argument("--out-prefix", help="output path without extension")
-    p.add_argument("--variant", help="table1/regenerate: the variant the files belong to (default head_on)")
+    p.add_argument("--variant", help="table1/regenerate: the variant of the evaluation CSVs (regenerate: default the "
+                        "config's reference)")
     p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate/readme: smoke, cpu or paper")
     p.add_argument("--reference", nargs="*", help="compare: the reference variant's evaluation CSVs")
     p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")

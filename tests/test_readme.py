@@ -1,6 +1,7 @@
 """The README's results blocks are generated from the stored files, never typed."""
 
 import json
+import shutil
 from pathlib import Path
 
 import pandas as pd
@@ -48,6 +49,7 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | 0.30 at 4,000 |" in out
     assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | 0.05 at 0 |" in out
     assert "commit `0123456`" in out and "2.02 h" in out and "eval 1.0 min, train 120.0 min" in out
+    assert "`snakemake --cores 2 all` from a fresh clone (summed job time / 2, one-thread jobs): 1.01 h" in out
     assert "resumed once" in out
     assert "*Not generated yet: `paper_figs/p/fig7.csv` is missing" in out     # never invented when the file is absent
     assert render_readme(out, tmp_path, "p") == out         # idempotent
@@ -74,3 +76,15 @@ def test_unknown_block_is_an_error(tmp_path):
 def test_the_repository_readme_matches_the_stored_cpu_results():
     assert update_readme(REPO / "README.md", "cpu", check=True), (
         "README.md results blocks differ from results/cpu + paper_figs/cpu: run `egosearch report readme`")
+
+
+def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, monkeypatch):
+    """`egosearch report regenerate` from the stored CSVs gives the numbers the DAG stored."""
+    shutil.copytree(REPO / "results" / "cpu", tmp_path / "results" / "cpu")
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    stored, again = REPO / "paper_figs" / "cpu", tmp_path / "paper_figs" / "cpu"
+    names = ["table1.csv", "table1.md", "table2.md", "fig6.csv", "fig7.csv", "fig7_oracle.csv"]
+    assert [n for n in names if not (stored / n).exists()] == []
+    for name in names:
+        assert (again / name).read_text() == (stored / name).read_text(), name

@@ -84,7 +84,13 @@ def block_provenance(root: Path, profile: str) -> str:
              f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}, "
              f"{machine.get('cores', '?')} cores, torch {machine.get('torch', '?')}.",
              f"- {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed: "
-             + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + "."]
+             + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + ".",
+             # Every cpu-profile job is one thread, so `--cores N` runs N at a time: the summed
+             # time over N is what `snakemake --cores N all` takes from a fresh clone, give or take
+             # the tail where fewer than N jobs are ready.
+             f"- Estimated wall time of `snakemake --cores {machine.get('cores', '?')} all` from a fresh clone "
+             f"(summed job time / {machine.get('cores', '?')}, one-thread jobs): "
+             f"{record['wall_s_all_jobs_summed'] / max(1, int(machine.get('cores') or 1)) / 3600:.2f} h."]
     if record.get("note"):
         lines.append(f"- Note kept in the record: {record['note']}")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
