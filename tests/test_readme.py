@@ -68,6 +68,22 @@ def test_check_mode_reports_stale_blocks_without_writing(tmp_path):
     assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 2
 
 
+def test_compare_block_lists_every_stored_comparison(tmp_path):
+    folder = tmp_path / "results" / "p" / "compare"
+    folder.mkdir(parents=True)
+    row = dict(height=1.05, placement="everywhere", metric="success", reference=0.01, candidate=0.1, difference=0.09,
+               ci_low=0.05, ci_high=0.13, p_value=0.0001, p_holm=0.001, significant=True, n_scenarios=100,
+               n_seeds_ref=3, n_seeds_cand=3)
+    pd.DataFrame([row, {**row, "metric": "spl", "p_value": 0.03, "p_holm": 0.06}]).to_csv(
+        folder / "my_new_variant_vs_head_on.csv", index=False)
+    text = "<!-- egosearch:begin compare -->\n<!-- egosearch:end compare -->"
+    assert "No stored comparison yet" in render_readme(text, tmp_path, "p2")
+    out = render_readme(text, tmp_path, "p")
+    assert "`my_new_variant` vs `head_on`" in out
+    assert "| 1.05 | everywhere | success | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.0001 | 0.001 * |" in out
+    assert "| 1.05 | everywhere | spl | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.03 | 0.06 |" in out
+
+
 def test_unknown_block_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="'tabel1' is unknown"):
         render_readme("<!-- egosearch:begin tabel1 -->\n<!-- egosearch:end tabel1 -->", tmp_path, "p")

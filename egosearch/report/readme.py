@@ -96,12 +96,37 @@ def block_provenance(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+def block_compare(root: Path, profile: str) -> str:
+    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``)."""
+    folder = root / "results" / profile / "compare"
+    paths = sorted(folder.glob("*_vs_*.csv"))
+    if not paths:
+        return (f"*No stored comparison yet under `{folder.relative_to(root)}/` "
+                "(`snakemake --cores 2 compare --config variant=NAME`).*\n")
+    parts = []
+    for path in paths:
+        candidate, reference = path.stem.split("_vs_", 1)
+        df = pd.read_csv(path)
+        lines = [f"`{candidate}` vs `{reference}` (difference = {candidate} - {reference}; from "
+                 f"`{path.relative_to(root)}`):", "",
+                 "| height | placement | metric | reference | candidate | difference (95% CI) | p | p (Holm) |",
+                 "|---|---|---|---|---|---|---|---|"]
+        for r in df.itertuples():
+            lines.append(f"| {r.height:g} | {r.placement} | {r.metric} | {r.reference:.3f} | {r.candidate:.3f} | "
+                         f"{r.difference:+.3f} [{r.ci_low:+.3f}, {r.ci_high:+.3f}] | {r.p_value:.3g} | "
+                         f"{r.p_holm:.3g}{' *' if r.p_holm < 0.05 else ''} |")
+        parts.append("\n".join(lines) + "\n")
+    note = "\\* Holm-adjusted p < 0.05. CI: paired bootstrap over scenarios; p: paired sign-flip test."
+    return "\n".join(parts) + "\n" + note + "\n"
+
+
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "table1": block_table1,
     "fig6": block_fig6,
     "fig7": block_fig7,
     "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
     "provenance": block_provenance,
+    "compare": block_compare,
 }
 
 
