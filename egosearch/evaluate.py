@@ -76,7 +76,9 @@ def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
 def scenario_evaluator(env_id: str, layout: str, placement: str, n: int, seed: int = 7):
     """``evaluate(policy) -> {success_rate, spl, episode_return}`` on ``n`` fixed held-out
     scenarios of the training home (the three evaluation heights in turn). The learner calls it
-    every ``eval_every`` steps: these rows are Figure 6's data."""
+    every ``eval_every`` steps: these rows are Figure 6's data. ``episode_return`` is always the
+    paper's reward (the env's default r_d), whatever reward a variant trains with, so that the
+    curves of variants are on one scale."""
     from egosearch.agent import EVAL_HEIGHTS
     from egosearch.metrics import spl
     from egosearch.scenarios import generate_scenarios
