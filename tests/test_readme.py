@@ -23,8 +23,11 @@ def _stored_results(root: Path) -> None:
                   "high": [0.2, 0.4, float("nan")]}).to_csv(figs / "fig6.csv", index=False)
     (results / "provenance.json").write_text(json.dumps({
         "profile": "p", "commit": "0123456789abcdef", "date_utc": "2026-01-02T03:04:05+00:00",
-        "machine": {"cpu": "X", "cores": 2, "torch": "2"}, "wall_s_per_rule_summed": {"train": 7200.0, "eval": 60.0},
-        "wall_s_all_jobs_summed": 7260.0, "jobs": [{}, {}], "note": "resumed once"}))
+        "machine": {"cpu": "X", "cores": 2, "torch": "2"}, "wall_s_per_rule_summed": {"train": 10800.0, "eval": 60.0},
+        "wall_s_all_jobs_summed": 10860.0, "note": "resumed once",
+        "jobs": [{"rule": "train", "job": "head_on/seed0", "wall_s": 7200.0},
+                 {"rule": "eval", "job": "head_off/seed0/kitchen_living/everywhere/h1.05", "wall_s": 60.0},
+                 {"rule": "train", "job": "my_variant/seed0", "wall_s": 3600.0}]}))
 
 
 README = """# t
@@ -48,8 +51,9 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     # fig6: first, last (with its seed CI) and best evaluation of each variant
     assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | 0.30 at 4,000 |" in out
     assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | 0.05 at 0 |" in out
-    assert "commit `0123456`" in out and "2.02 h" in out and "eval 1.0 min, train 120.0 min" in out
-    assert "`snakemake --cores 2 all` from a fresh clone (summed job time / 2, one-thread jobs): 1.01 h" in out
+    assert "commit `0123456`" in out and "3 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
+    # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it
+    assert "summed time / 2, one-thread jobs): 1.01 h; the other 1.00 h are variant comparisons" in out
     assert "resumed once" in out
     assert "*Not generated yet: `paper_figs/p/fig7.csv` is missing" in out     # never invented when the file is absent
     assert render_readme(out, tmp_path, "p") == out         # idempotent
