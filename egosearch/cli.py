@@ -156,19 +156,18 @@ def _regenerate(profile: str, reference: str | None) -> None:
     the files `snakemake all` would."""
     from pathlib import Path
 
-    import yaml
-
     from egosearch.report import cli as report
+    from egosearch.report.readme import variants_of_all, workflow_config
     from egosearch.rl.config import load_config, table2_rows
 
-    config = yaml.safe_load((Path(__file__).resolve().parent / "workflow" / "config.yaml").read_text())
+    config = workflow_config()
     if profile not in config["profiles"]:
         raise ValueError(f"--profile={profile!r}; allowed: {', '.join(config['profiles'])}")
     reference = reference or config["reference_variant"]
     results, figs = Path("results") / profile, Path("paper_figs") / profile
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
-    variants = dict.fromkeys(config["variants"] + [config["reference_variant"]])   # the fig6 rule's order
-    curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv")) for v in variants}
+    curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv"))
+              for v in variants_of_all(config)}
     curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
@@ -297,11 +296,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
     p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate",
-                                        "readme"))
+                                    "readme"))
     p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
     p.add_argument("--out-prefix", help="output path without extension")
-    p.add_argument("--variant", help="table1/regenerate: the variant of the evaluation CSVs (regenerate: default the "
-                        "config's reference)")
+    p.add_argument("--variant", help="table1/regenerate: the variant of the evaluation CSVs (regenerate: default "
+                                     "the config's reference)")
     p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate/readme: smoke, cpu or paper")
     p.add_argument("--reference", nargs="*", help="compare: the reference variant's evaluation CSVs")
     p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")

@@ -74,10 +74,15 @@ def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def variants_of_all() -> set[str]:
-    """The variants `snakemake all` trains, from the workflow config (comparisons train others)."""
-    config = yaml.safe_load((Path(__file__).resolve().parent.parent / "workflow" / "config.yaml").read_text())
-    return set(config["variants"]) | {config["reference_variant"]}
+def workflow_config() -> dict:
+    """The experiment list the Snakefile reads (``egosearch/workflow/config.yaml``)."""
+    return yaml.safe_load((Path(__file__).resolve().parent.parent / "workflow" / "config.yaml").read_text())
+
+
+def variants_of_all(config: dict | None = None) -> list[str]:
+    """The variants `snakemake all` trains, in the DAG's order (comparisons train others)."""
+    config = config or workflow_config()
+    return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
 
 
 def _job_of_all(job: dict, variants: set[str]) -> bool:
@@ -92,7 +97,7 @@ def block_provenance(root: Path, profile: str) -> str:
     machine = record.get("machine", {})
     per_rule = record.get("wall_s_per_rule_summed", {})
     cores = int(machine.get("cores") or 1)
-    variants = variants_of_all()
+    variants = set(variants_of_all())
     of_all = sum(job["wall_s"] for job in record["jobs"] if _job_of_all(job, variants))
     others = record["wall_s_all_jobs_summed"] - of_all
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
