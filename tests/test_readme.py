@@ -110,3 +110,20 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
     assert [n for n in names if not (stored / n).exists()] == []
     for name in names:
         assert (again / name).read_text() == (stored / name).read_text(), name
+
+
+def test_regenerate_twice_gives_byte_identical_files(tmp_path, monkeypatch):
+    """A second regenerate rewrites every output with the same bytes (PDFs included: no date stamped)."""
+    shutil.copytree(REPO / "results" / "cpu", tmp_path / "results" / "cpu",
+                    ignore=shutil.ignore_patterns("ckpt", "partial", "*.pt", "logs", "benchmarks"))
+    monkeypatch.chdir(tmp_path)
+    figs = tmp_path / "paper_figs" / "cpu"
+    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    first = {p.name: p.read_bytes() for p in sorted(figs.iterdir())}
+    assert {"fig6.pdf", "fig7.pdf", "fig6.png", "table1.tex"} <= set(first)
+    for p in figs.iterdir():    # a stale file left in place must not pass for a rewritten one
+        p.unlink()
+    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    second = {p.name: p.read_bytes() for p in sorted(figs.iterdir())}
+    assert sorted(second) == sorted(first)
+    assert [name for name in first if first[name] != second[name]] == []

@@ -70,11 +70,16 @@ def _steps_formatter(x: float, _pos=None) -> str:
     return f"{x:g}"
 
 
+PDF_METADATA = {"CreationDate": None}
+"""The PDF writer stamps the time by default: without it, regenerating a figure from the same CSV
+changed the tracked PDF on every run (the PNG writer stamps none)."""
+
+
 def _save(fig: Figure, base: Path) -> list[Path]:
     FigureCanvasAgg(fig)
     outs = [_with(base, ".png"), _with(base, ".pdf")]
     fig.savefig(outs[0], dpi=300)
-    fig.savefig(outs[1])
+    fig.savefig(outs[1], metadata=PDF_METADATA)
     return outs
 
 
