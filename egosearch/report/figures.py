@@ -221,71 +221,84 @@ def figure7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, confidence
     df = figure7_frame(fullbody_files, confidence, n_resamples, seed)
     base = output_base(out_prefix, "fig7")
     df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    with matplotlib.rc_context(STYLE):
+        outs = _save(figure7_figure(df, title), base)
+    return [*outs, _with(base, ".csv")]
+
+
+ALL_ZERO_NOTE = "every SPL is 0: no method found the target in any episode"
+"""Said on Figure 7 when every bar is 0, so that an empty-looking axis is not read as a broken plot."""
+
+
+def figure7_figure(df: pd.DataFrame, title: str | None = None) -> Figure:
+    """The Figure 7 plot of a :func:`figure7_frame`; call it inside ``matplotlib.rc_context(STYLE)``."""
     mgs = sorted(df["mg"].unique(), key=lambda m: (MG_ORDER.index(m) if m in MG_ORDER else len(MG_ORDER), m))
     cats = list(dict.fromkeys(df["label"]))
     n_base = int(df.drop_duplicates("label")["baseline"].sum())
     single = len(mgs) == 1
-    with matplotlib.rc_context(STYLE):
-        fig = Figure(figsize=(7.0, 2.7))
-        gs = fig.add_gridspec(1, 2, width_ratios=[1.9, 1.0], wspace=0.28)
-        ax, ax2 = fig.add_subplot(gs[0]), fig.add_subplot(gs[1])
-        width = 0.8 / len(mgs)
-        for j, mg in enumerate(mgs):
-            g = df[df["mg"] == mg].set_index("label").reindex(cats)
-            present = g["spl"].notna().to_numpy()
-            x = np.arange(len(cats)) + (j - (len(mgs) - 1) / 2) * width
-            if single:
-                colours = ["#a6a6a6" if b else OKABE_ITO[0] for b in g["baseline"].fillna(True)]
-            else:
-                colours = [OKABE_ITO[j % len(OKABE_ITO)]] * len(cats)
-            spl = g["spl"].to_numpy(dtype=float)
-            err = _yerr(spl, g["spl_low"].to_numpy(dtype=float), g["spl_high"].to_numpy(dtype=float))
-            ax.bar(x[present], spl[present], width * 0.92, color=np.array(colours)[present],
-                   yerr=err[:, present], ecolor="#333333", error_kw={"elinewidth": 0.8}, edgecolor="none")
-        if 0 < n_base < len(cats):
-            ax.axvline(n_base - 0.5, color="#333333", linestyle="--", linewidth=0.9)
-        ax.set_xticks(np.arange(len(cats)), [c.replace(" ", "\n", 1) for c in cats])
-        ax.tick_params(axis="x", length=0)
-        ax.set_ylabel("SPL")
-        ax.set_xlim(-0.6, len(cats) - 0.4)
-        top = float(np.nanmax(np.r_[df["spl_high"].to_numpy(dtype=float), df["spl"].to_numpy(dtype=float)]))
-        ax.set_ylim(0, max(0.1, min(1.0, top * 1.15)) if np.isfinite(top) else 1.0)
-        ax.grid(axis="x", visible=False)
+    fig = Figure(figsize=(7.0, 2.7))
+    gs = fig.add_gridspec(1, 2, width_ratios=[1.9, 1.0], wspace=0.28)
+    ax, ax2 = fig.add_subplot(gs[0]), fig.add_subplot(gs[1])
+    width = 0.8 / len(mgs)
+    for j, mg in enumerate(mgs):
+        g = df[df["mg"] == mg].set_index("label").reindex(cats)
+        present = g["spl"].notna().to_numpy()
+        x = np.arange(len(cats)) + (j - (len(mgs) - 1) / 2) * width
         if single:
-            handles = [Patch(color="#a6a6a6", label="baselines")] if n_base else []
-            if n_base < len(cats):
-                handles.append(Patch(color=OKABE_ITO[0], label=f"ours ({MG_LABELS.get(mgs[0], mgs[0])})"))
+            colours = ["#a6a6a6" if b else OKABE_ITO[0] for b in g["baseline"].fillna(True)]
         else:
-            handles = [Patch(color=OKABE_ITO[j % len(OKABE_ITO)], label=MG_LABELS.get(m, m))
-                       for j, m in enumerate(mgs)]
-        ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.01), ncol=len(handles),
-                  borderaxespad=0.0, handlelength=1.2, columnspacing=1.2)
+            colours = [OKABE_ITO[j % len(OKABE_ITO)]] * len(cats)
+        spl = g["spl"].to_numpy(dtype=float)
+        err = _yerr(spl, g["spl_low"].to_numpy(dtype=float), g["spl_high"].to_numpy(dtype=float))
+        ax.bar(x[present], spl[present], width * 0.92, color=np.array(colours)[present],
+               yerr=err[:, present], ecolor="#333333", error_kw={"elinewidth": 0.8}, edgecolor="none")
+    if 0 < n_base < len(cats):
+        ax.axvline(n_base - 0.5, color="#333333", linestyle="--", linewidth=0.9)
+    ax.set_xticks(np.arange(len(cats)), [c.replace(" ", "\n", 1) for c in cats])
+    ax.tick_params(axis="x", length=0)
+    ax.set_ylabel("SPL")
+    ax.set_xlim(-0.6, len(cats) - 0.4)
+    top = float(np.nanmax(np.r_[df["spl_high"].to_numpy(dtype=float), df["spl"].to_numpy(dtype=float)]))
+    ax.set_ylim(0, max(0.1, min(1.0, top * 1.15)) if np.isfinite(top) else 1.0)
+    ax.grid(axis="x", visible=False)
+    spl_all = df["spl"].to_numpy(dtype=float)
+    if np.isfinite(spl_all).any() and np.nanmax(np.abs(spl_all)) == 0:
+        ax.text(0.5, 0.5, ALL_ZERO_NOTE, ha="center", va="center", transform=ax.transAxes,
+                bbox={"facecolor": "white", "edgecolor": "#333333", "linewidth": 0.6, "boxstyle": "round"})
+    if single:
+        handles = [Patch(color="#a6a6a6", label="baselines")] if n_base else []
+        if n_base < len(cats):
+            handles.append(Patch(color=OKABE_ITO[0], label=f"ours ({MG_LABELS.get(mgs[0], mgs[0])})"))
+    else:
+        handles = [Patch(color=OKABE_ITO[j % len(OKABE_ITO)], label=MG_LABELS.get(m, m))
+                   for j, m in enumerate(mgs)]
+    ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.01), ncol=len(handles),
+              borderaxespad=0.0, handlelength=1.2, columnspacing=1.2)
 
-        ours = df[df["method"] == "ours"]
-        ms = sorted(ours["M"].unique()) if not ours.empty else [0]
-        dodge = 0.015 * (max(ms) - min(ms)) if len(ms) > 1 else 0.1  # x offset between MGs' markers
-        if ours.empty:
-            ax2.text(0.5, 0.5, "no 'ours' runs", ha="center", va="center", transform=ax2.transAxes)
-        else:
-            for j, mg in enumerate(mgs):
-                g = ours[ours["mg"] == mg].groupby("M", sort=True).first().reset_index()
-                if g.empty:
-                    continue
-                colour = OKABE_ITO[0] if single else OKABE_ITO[j % len(OKABE_ITO)]
-                m = g["M"].to_numpy(dtype=float)
-                a = g["attempts"].to_numpy(dtype=float)
-                err = _yerr(a, g["attempts_low"].to_numpy(dtype=float), g["attempts_high"].to_numpy(dtype=float))
-                shift = 0.0 if single else (j - (len(mgs) - 1) / 2) * dodge
-                ax2.errorbar(m + shift, a, yerr=err, color=colour, marker="o", markersize=3.5, ecolor=colour)
-            ax2.set_xticks(ms, [f"{v:g}" for v in ms])
-            top = np.nanmax(np.r_[ours["attempts_high"].to_numpy(dtype=float), ours["attempts"].to_numpy(dtype=float)])
-            ax2.set_ylim(0, top * 1.08 if np.isfinite(top) and top > 0 else 1.0)
-        ax2.set_xlabel("M (executed steps per plan)")
-        ax2.set_ylabel("Attempts (abstract trajectories)")
-        if title:
-            fig.suptitle(title, y=1.08)
-        outs = _save(fig, base)
-    return [*outs, _with(base, ".csv")]
+    ours = df[df["method"] == "ours"]
+    ms = sorted(ours["M"].unique()) if not ours.empty else [0]
+    dodge = 0.015 * (max(ms) - min(ms)) if len(ms) > 1 else 0.1  # x offset between MGs' markers
+    if ours.empty:
+        ax2.text(0.5, 0.5, "no 'ours' runs", ha="center", va="center", transform=ax2.transAxes)
+    else:
+        for j, mg in enumerate(mgs):
+            g = ours[ours["mg"] == mg].groupby("M", sort=True).first().reset_index()
+            if g.empty:
+                continue
+            colour = OKABE_ITO[0] if single else OKABE_ITO[j % len(OKABE_ITO)]
+            m = g["M"].to_numpy(dtype=float)
+            a = g["attempts"].to_numpy(dtype=float)
+            err = _yerr(a, g["attempts_low"].to_numpy(dtype=float), g["attempts_high"].to_numpy(dtype=float))
+            shift = 0.0 if single else (j - (len(mgs) - 1) / 2) * dodge
+            ax2.errorbar(m + shift, a, yerr=err, color=colour, marker="o", markersize=3.5, ecolor=colour)
+        ax2.set_xticks(ms, [f"{v:g}" for v in ms])
+        top = np.nanmax(np.r_[ours["attempts_high"].to_numpy(dtype=float), ours["attempts"].to_numpy(dtype=float)])
+        ax2.set_ylim(0, top * 1.08 if np.isfinite(top) and top > 0 else 1.0)
+    ax2.set_xlabel("M (executed steps per plan)")
+    ax2.set_ylabel("Attempts (abstract trajectories)")
+    if title:
+        fig.suptitle(title, y=1.08)
+    return fig
 
 
 fig6 = figure6
