@@ -196,7 +196,15 @@ def test_corrupted_or_foreign_checkpoint_is_a_clear_error(tmp_path):
 def test_bad_actor_file_is_a_clear_error(tmp_path):
     bad = tmp_path / "actor.pt"
     bad.write_bytes(b"\x00" * 100)
-    with pytest.raises(AgentStateError, match="cannot read actor file"):
+    with pytest.raises(AgentStateError, match="is not an egosearch actor file") as err:
+        ActorPolicy(bad)
+    assert "weights_only" not in str(err.value) and "\n" not in str(err.value)
+    text = tmp_path / "README.md"
+    text.write_text("# not weights\n")
+    with pytest.raises(AgentStateError, match=r"README.md is not an egosearch actor file; an actor file is"):
+        ActorPolicy(text)
+    torch.save({"a": 1}, bad)
+    with pytest.raises(AgentStateError, match="is not an egosearch actor file"):
         ActorPolicy(bad)
     torch.save({"format": "something-else"}, bad)
     with pytest.raises(AgentStateError, match="not an actor file"):

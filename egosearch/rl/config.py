@@ -27,6 +27,11 @@ from typing import Any
 ACTIVATIONS = ("relu", "elu", "leaky_relu", "gelu", "tanh")
 """Activation names the networks understand (Table 2 uses ReLU everywhere)."""
 
+ALGORITHMS = ("sac_curl", "sac_drq")
+"""Learners :mod:`egosearch.rl.train` can run (see ``SacCurlConfig.algorithm``)."""
+DISTANCE_REWARDS = ("distance", "progress")
+"""Forms of r_d (the env's ``egosearch.env.DISTANCE_REWARDS``; a test keeps them equal)."""
+
 _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
                       "tanh": "Tanh"}
 
@@ -154,6 +159,38 @@ class SacCurlConfig:
     curl_update_freq: int = 1
     """CURL (``cpc_update_freq``): the contrastive loss is applied every this many updates."""
 
+    # ---- the learner and its training-only aids (the cpu profile's departures) -----------
+    algorithm: str = "sac_curl"
+    """Paper 4.2 / Table 2: "sac_curl" = SAC + CURL (:mod:`egosearch.rl.sac_curl`).
+    "sac_drq" = ours, after DrQ-v2 (Yarats et al. 2021): SAC with ONE conv encoder trained by
+    the critic only, random-shift augmentation, no contrastive loss and no target encoder
+    (:mod:`egosearch.rl.sac_drq`); an update costs ~3 conv passes instead of CURL's ~9. This
+    CHANGES THE ALGORITHM: the cpu profile uses it, the paper profile never."""
+    num_envs: int = 1
+    """Ours (CURL: 1): environments stepped in lockstep in one process, their actions computed
+    in one batched forward pass (acting cost per env step falls ~N-fold). Each env has its own
+    replay ring of ``replay_capacity / num_envs`` transitions; ``total_env_steps`` counts the
+    steps of all envs."""
+    n_step: int = 1
+    """CURL: 1 (one-step TD targets). DrQ-v2: 3. Rewards summed over up to ``n_step`` steps of
+    one episode with the target bootstrapped gamma^n later (sampled from the replay)."""
+    obs_downsample: int = 1
+    """Ours ("sac_drq" only; the paper: 1): the 100 x 100 depth frames are average-pooled by this
+    factor before the encoder (2 -> 50 x 50), as PointNav learners train from 64 x 64 depth
+    (Shacklett et al., bps-nav, ICLR 2021). The env, its mask and success test stay at 100 x 100."""
+    encoder_stride2_layers: int = 1
+    """CURL: 1 (the first conv has stride 2, the rest stride 1). "sac_drq" only: the first this
+    many convs have stride 2 (smaller maps, far fewer FLOPs)."""
+    aug_pad: int = 4
+    """DrQ-v2: 4 ("sac_drq" only): the random shift pads by this many pixels (replicating the
+    border) and crops back to the pooled size. "sac_curl" uses Table 2's random crop instead."""
+    train_distance_reward: str = "distance"
+    """Paper eq. 2 text: "distance" = r_d is minus the distance to the target while it is seen.
+    "progress" = the decrease of that distance since the last step while seen (Savva et al.
+    2019's form, which the paper cites; potential-based shaping as in habitat-lab). TRAINING
+    ONLY: evaluation always scores the paper's task (success, SPL), whatever the training
+    reward. A variant's ``train_env: distance_reward`` takes precedence."""
+
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
     """CURL: environment steps of uniformly random actions before the first update."""
@@ -231,8 +268,28 @@ class SacCurlConfig:
             bad("encoder_num_layers", "an integer >= 1")
         if self.crop_size > self.image_size:
             bad("crop_size", f"1..image_size={self.image_size}")
+        if self.algorithm not in ALGORITHMS:
+            bad("algorithm", ", ".join(ALGORITHMS))
+        if self.train_distance_reward not in DISTANCE_REWARDS:
+            bad("train_distance_reward", ", ".join(DISTANCE_REWARDS))
+        for name in ("num_envs", "n_step", "obs_downsample"):
+            if getattr(self, name) < 1:
+                bad(name, "an integer >= 1")
+        if self.aug_pad < 0:
+            bad("aug_pad", "an integer >= 0")
+        if not 0 <= self.encoder_stride2_layers <= self.encoder_num_layers:
+            bad("encoder_stride2_layers", f"0..encoder_num_layers={self.encoder_num_layers}")
+        if self.num_envs > self.replay_capacity:
+            bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
+        if self.algorithm == "sac_drq":
+            side = self.image_size // self.obs_downsample
+            for i in range(self.encoder_num_layers):
+                side = (side - 3) // (2 if i < self.encoder_stride2_layers else 1) + 1
+            if side < 1:
+                bad("encoder_num_layers", f"fewer layers or stride-2 layers for image_size={self.image_size} "
+                    f"and obs_downsample={self.obs_downsample} (the conv output would be empty)")
         # 3x3 convs: first stride 2, then stride 1; the last map must keep at least 1 pixel.
-        if (self.crop_size - 3) // 2 + 1 - 2 * (self.encoder_num_layers - 1) < 1:
+        elif (self.crop_size - 3) // 2 + 1 - 2 * (self.encoder_num_layers - 1) < 1:
             bad("encoder_num_layers", f"1..{((self.crop_size - 3) // 2 + 1 - 1) // 2 + 1} "
                 f"for crop_size={self.crop_size} (the conv output would be empty)")
         if not 0.0 < self.gamma <= 1.0:

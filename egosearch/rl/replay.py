@@ -294,3 +294,104 @@ def _rng_state_from_plain(plain: dict) -> dict:
     return {"bit_generator": plain["bit_generator"],
             "state": {k: int(v) for k, v in plain["state"].items()},
             "has_uint32": int(plain["has_uint32"]), "uinteger": int(plain["uinteger"])}
+
+
+class MultiReplay:
+    """One :class:`ReplayBuffer` ring per env of a lockstep batch of envs, sampled as one buffer,
+    with optional n-step returns.
+
+    ``add(i, ...)`` appends env ``i``'s transition to its own ring (so each ring holds whole
+    episodes and the frame deduplication works). ``sample(B)`` draws B transitions spread evenly
+    over the rings (the first ``B % N`` rings give one more). With ``n_step`` > 1, transition t's
+    reward becomes sum_{j<m} gamma^j r_{t+j} over the m <= n_step steps left in its episode (fewer
+    only at the episode's end or at the newest transitions), next_obs is that of step t+m-1,
+    ``not_done`` is that step's, and a ``discount`` column holds gamma^m for the bootstrap.
+    With one env and ``n_step`` 1 it samples exactly as its single ring does.
+    """
+
+    def __init__(self, num_envs: int, capacity: int, image_size: int = 100, frame_history: int = 5,
+                 mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5, n_step: int = 1,
+                 gamma: float = 0.99, device: str | torch.device = "cpu", seed: int | None = None):
+        if num_envs < 1 or n_step < 1:
+            raise ValueError(f"MultiReplay num_envs={num_envs}, n_step={n_step}; allowed: >= 1 each")
+        self.n_step, self.gamma = int(n_step), float(gamma)
+        per_env = max(1, int(capacity) // int(num_envs))
+        self.buffers = [ReplayBuffer(per_env, image_size, frame_history, mask_dim, proprio_dim, action_dim,
+                                     device=device, seed=None if seed is None else seed + 104_729 * i)
+                        for i in range(num_envs)]
+        self.device = torch.device(device)
+
+    def __len__(self) -> int:
+        return sum(len(b) for b in self.buffers)
+
+    def add(self, env_index: int, obs: dict, action, reward: float, next_obs: dict, terminated: bool,
+            truncated: bool) -> None:
+        self.buffers[env_index].add(obs, action, reward, next_obs, terminated, truncated)
+
+    def new_episode(self) -> None:
+        for b in self.buffers:
+            b.new_episode()
+
+    def sample(self, batch_size: int) -> dict[str, torch.Tensor]:
+        """A batch (see :meth:`ReplayBuffer.sample`, plus ``discount`` when n-step or several rings)."""
+        if len(self.buffers) == 1 and self.n_step == 1:
+            return self.buffers[0].sample(batch_size)
+        n = len(self.buffers)
+        sizes = [batch_size // n + (1 if i < batch_size % n else 0) for i in range(n)]
+        parts = [self._sample_n_step(b, s) for b, s in zip(self.buffers, sizes) if s > 0 and len(b) > 0]
+        if not parts:
+            raise ValueError("cannot sample from an empty MultiReplay")
+        return {k: torch.cat([p[k] for p in parts]) for k in parts[0]}
+
+    def sample_at(self, env_index: int, indices) -> dict[str, torch.Tensor]:
+        """The n-step transitions starting at absolute ``indices`` of ring ``env_index``."""
+        return self._sample_n_step(self.buffers[env_index], 0, indices)
+
+    def _sample_n_step(self, buf: ReplayBuffer, batch_size: int,
+                       indices: np.ndarray | None = None) -> dict[str, torch.Tensor]:
+        first = buf.sample_indices(batch_size) if indices is None else np.asarray(indices, np.int64)
+        batch_size = len(first)
+        last = first.copy()
+        reward = np.zeros(batch_size, np.float64)
+        discount = np.ones(batch_size, np.float64)
+        open_ = np.ones(batch_size, bool)  # the episode goes on after step `last`
+        for j in range(self.n_step):
+            idx = first + j
+            use = open_ & (idx < buf.n_added)
+            i = idx[use] % buf.capacity
+            reward[use] += discount[use] * buf.reward[i]
+            discount[use] *= self.gamma
+            last[use] = idx[use]
+            ended = np.zeros(batch_size, bool)
+            ended[use] = buf.terminated[i] | buf.truncated[i]
+            open_ &= use & ~ended
+        obs_stack, _ = buf.stacks(first)
+        _, next_stack = buf.stacks(last)
+        i0, i1 = first % buf.capacity, last % buf.capacity
+
+        def put(a: np.ndarray) -> torch.Tensor:
+            return torch.from_numpy(np.ascontiguousarray(a)).to(self.device)
+
+        return {
+            "obs_depth": put(obs_stack), "next_obs_depth": put(next_stack),
+            "mask": put(buf.mask[i0]), "proprio": put(buf.proprio[i0]),
+            "next_mask": put(buf.next_mask[i1]), "next_proprio": put(buf.next_proprio[i1]),
+            "action": put(buf.action[i0]), "reward": put(reward.astype(np.float32)[:, None]),
+            "not_done": put((~buf.terminated[i1]).astype(np.float32)[:, None]),
+            "discount": put(discount.astype(np.float32)[:, None]),
+            "index": torch.from_numpy(first),
+        }
+
+    def state_dict(self) -> dict:
+        if len(self.buffers) == 1:
+            return self.buffers[0].state_dict()
+        return {"format": "egosearch-multi-replay-v1", "buffers": [b.state_dict() for b in self.buffers]}
+
+    def load_state_dict(self, state: dict) -> None:
+        if len(self.buffers) == 1:
+            self.buffers[0].load_state_dict(state)
+            return
+        if state.get("format") != "egosearch-multi-replay-v1" or len(state["buffers"]) != len(self.buffers):
+            raise ValueError(f"replay state does not hold {len(self.buffers)} env rings")
+        for b, s in zip(self.buffers, state["buffers"]):
+            b.load_state_dict(s)

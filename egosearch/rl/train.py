@@ -37,7 +37,7 @@ import numpy as np
 import torch
 
 from egosearch.rl.config import SacCurlConfig
-from egosearch.rl.replay import ReplayBuffer
+from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_curl import (
     METRIC_KEYS,
     AgentStateError,
@@ -55,6 +55,7 @@ CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_l
 TRAIN_COLUMNS = ("env_steps", "episodes", "updates", "train_return", "train_success", "critic_loss",
                  "actor_loss", "alpha_loss", "curl_loss", "alpha", "entropy", "q_mean", "steps_per_s",
                  "updates_per_s", "wall_s")
+_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ"}
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
@@ -163,7 +164,7 @@ class _Mean:
 class AgentPolicy:
     """The live agent behind the shared policy interface (deterministic actions)."""
 
-    def __init__(self, agent: SacCurlAgent):
+    def __init__(self, agent):
         self.agent = agent
 
     def reset(self, seed: int | None = None) -> None:
@@ -173,6 +174,15 @@ class AgentPolicy:
         return self.agent.act(obs, deterministic=True)
 
 
+def load_any_actor_net(state: dict, device) -> torch.nn.Module:
+    """An actor file's network, SAC+CURL's or SAC-DrQ's (by its ``format``)."""
+    from egosearch.rl import sac_drq
+
+    if isinstance(state, dict) and state.get("format") == sac_drq.ACTOR_FORMAT:
+        return sac_drq.load_drq_actor_net(state, device)
+    return load_actor_net(state, device)
+
+
 class ActorPolicy:
     """A trained actor (``actor.pt``) behind the project's policy interface:
     ``reset(seed=None)`` (no-op: the actor is memoryless given the env's frame history) and
@@ -180,15 +190,22 @@ class ActorPolicy:
 
     def __init__(self, path: str | os.PathLike, device: str = "auto"):
         path = Path(path)
+        # torch's own message for a non-torch file advises weights_only=False, which is wrong here.
+        not_actor = (f"{path} is not an egosearch actor file; an actor file is the actor.pt that "
+                     "`egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt)")
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such actor file" if not path.exists() else not_actor)
         try:
             state = torch.load(path, map_location="cpu", weights_only=True)
-        except FileNotFoundError:
-            raise
         except Exception as err:  # noqa: BLE001 - any unreadable file gets one line
-            raise AgentStateError(f"cannot read actor file {path}: {type(err).__name__}: "
-                                  f"{str(err).splitlines()[0] if str(err) else ''}") from None
+            raise AgentStateError(f"{not_actor} (torch cannot read it: {type(err).__name__})") from None
+        if not isinstance(state, dict) or "format" not in state:
+            raise AgentStateError(not_actor)
         self.device = resolve_device(device)
-        self.net = load_actor_net(state, self.device)
+        try:
+            self.net = load_any_actor_net(state, self.device)
+        except AgentStateError as err:
+            raise AgentStateError(f"{path}: {err}") from None
         self.arch = state["arch"]
         self.metadata = state.get("metadata", {})
         self.variant = self.metadata.get("variant")
@@ -247,6 +264,8 @@ def _to_tensors(obj: Any) -> Any:
         return torch.from_numpy(np.ascontiguousarray(obj))
     if isinstance(obj, dict):
         return {k: _to_tensors(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_to_tensors(v) for v in obj]
     return obj
 
 
@@ -255,6 +274,8 @@ def _to_numpy(obj: Any) -> Any:
         return obj.numpy()
     if isinstance(obj, dict):
         return {k: _to_numpy(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_to_numpy(v) for v in obj]
     return obj
 
 
@@ -283,28 +304,32 @@ def _from_plain_bitgen_state(state: dict) -> dict:
     return out
 
 
-def _rng_states(env) -> dict:
+def _rng_states(envs) -> dict:
     np_state = np.random.get_state()
     states = {
         "torch": torch.get_rng_state(),
         "numpy": {"key": torch.from_numpy(np_state[1].astype(np.int64)), "pos": int(np_state[2]),
                   "has_gauss": int(np_state[3]), "cached_gaussian": float(np_state[4])},
         "python": random.getstate(),
-        "action_space": _plain_bitgen_state(env.action_space.np_random.bit_generator.state),
+        "action_space": _plain_bitgen_state(envs[0].action_space.np_random.bit_generator.state),
     }
+    if len(envs) > 1:
+        states["action_spaces"] = [_plain_bitgen_state(e.action_space.np_random.bit_generator.state) for e in envs]
     if torch.cuda.is_available():
         states["cuda"] = torch.cuda.get_rng_state_all()
     return states
 
 
-def _restore_rng_states(states: dict, env) -> None:
+def _restore_rng_states(states: dict, envs) -> None:
     torch.set_rng_state(states["torch"])
     n = states["numpy"]
     np.random.set_state(("MT19937", n["key"].numpy().astype(np.uint32), n["pos"], n["has_gauss"],
                          n["cached_gaussian"]))
     version, internal, gauss = states["python"]
     random.setstate((version, tuple(internal), gauss))
-    env.action_space.np_random.bit_generator.state = _from_plain_bitgen_state(states["action_space"])
+    envs[0].action_space.np_random.bit_generator.state = _from_plain_bitgen_state(states["action_space"])
+    for e, state in zip(envs[1:], states.get("action_spaces", [])[1:]):
+        e.action_space.np_random.bit_generator.state = _from_plain_bitgen_state(state)
     if "cuda" in states and torch.cuda.is_available():
         torch.cuda.set_rng_state_all(states["cuda"])
 
@@ -422,17 +447,43 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
 
     threads_before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
-    env = None
+    envs: list = []
     try:
-        env = _make_env(env_id, env_kwargs)
-        return _train(env, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt)
+        for _ in range(cfg.num_envs):
+            envs.append(_make_env(env_id, train_env_kwargs(cfg, env_kwargs)))
+        return _train(envs, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt)
     finally:
-        if env is not None:
+        for env in envs:
             env.close()
         torch.set_num_threads(threads_before)
 
 
-def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
+def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
+    """The training envs' keyword arguments: the variant's, with r_d's form from the learner config
+    (``train_distance_reward``) unless the variant sets ``distance_reward`` itself. The paper's
+    form is the env's default, so it is not passed (envs without the option still train)."""
+    if cfg.train_distance_reward == "distance":
+        return dict(env_kwargs)
+    return {"distance_reward": cfg.train_distance_reward, **env_kwargs}
+
+
+def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: int, device):
+    """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state)."""
+    if cfg.algorithm == "sac_drq":
+        from egosearch.rl.sac_drq import SacDrqAgent
+
+        return SacDrqAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
+    return SacCurlAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
+
+
+def _act_batch(agent, observations: list[dict]) -> list[np.ndarray]:
+    if len(observations) == 1 or not hasattr(agent, "act_batch"):
+        return [agent.act(o, deterministic=False) for o in observations]
+    stacked = {k: np.stack([o[k] for o in observations]) for k in observations[0]}
+    return list(agent.act_batch(stacked, deterministic=False))
+
+
+def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
            progress: bool, on_step, ckpt: dict | None) -> dict:
     ckpt_path = out_dir / CHECKPOINT_NAME
     done_path = out_dir / "done.json"
@@ -440,11 +491,15 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
     random.seed(cfg.seed)
     np.random.seed(cfg.seed)
     torch.manual_seed(cfg.seed)
+    env = envs[0]
     action_dim, mask_dim, proprio_dim = _env_spaces(env, cfg)
-    env.action_space.seed(cfg.seed)
-    agent = SacCurlAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
-    replay = ReplayBuffer(cfg.replay_capacity, cfg.image_size, cfg.frame_history, mask_dim,
-                          proprio_dim, action_dim, device=device, seed=cfg.seed)
+    for i, e in enumerate(envs):
+        e.action_space.seed(cfg.seed + 7 * i)
+    agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, device)
+    to_replay = getattr(agent, "replay_obs", lambda o: o)
+    replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, getattr(agent, "replay_image_size", cfg.image_size),
+                         cfg.frame_history, mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
+                         device=device, seed=cfg.seed)
     curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
     train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
 
@@ -454,19 +509,22 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
         try:
             agent.load_state_dict(ckpt["agent"])
             replay.load_state_dict(_to_numpy(ckpt["replay"]))
-            _restore_rng_states(ckpt["rng"], env)
+            _restore_rng_states(ckpt["rng"], envs)
         except (AgentStateError, ValueError, KeyError, RuntimeError) as err:
             raise CheckpointError(f"checkpoint {ckpt_path} does not fit this run ({_describe(err)})") from None
         step, episodes, wall_before = int(ckpt["env_steps"]), int(ckpt["episodes"]), float(ckpt["wall_s"])
         recent.extend((float(r), float(s)) for r, s in ckpt["recent"])
         curve.truncate(int(ckpt["csv_rows"]["curve"]))
         train_log.truncate(int(ckpt["csv_rows"]["train"]))
-        replay.new_episode()  # the env is reset below, mid-episode
-        obs, _ = env.reset(seed=cfg.seed + 7919 * step)
+        replay.new_episode()  # the envs are reset below, mid-episode
+        reset_seeds = [cfg.seed + 7919 * step + 104_729 * i for i in range(len(envs))]
     else:
         curve.truncate(0)
         train_log.truncate(0)
-        obs, _ = env.reset(seed=cfg.seed)
+        reset_seeds = [cfg.seed + 104_729 * i for i in range(len(envs))]
+    observations = [e.reset(seed=sd)[0] for e, sd in zip(envs, reset_seeds)]
+    stored = [to_replay(o) for o in observations]  # as the replay stores them, each computed once
+    ep_returns = [0.0] * len(envs)
     del ckpt
     atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
                                           "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict()})
@@ -483,7 +541,8 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
         bar = tqdm(total=cfg.total_env_steps, initial=step, unit="step", dynamic_ncols=True,
                    mininterval=1.0, desc=f"{variant} seed {cfg.seed}")
         say = bar.write
-    say(f"SAC+CURL {variant} on {env_id} -> {out_dir} | device {device}, {threads} torch threads | "
+    say(f"{_ALGORITHM_NAMES[cfg.algorithm]} {variant} on {env_id} -> {out_dir} | device {device}, "
+        f"{threads} torch threads, {cfg.num_envs} env(s) | "
         f"{'resuming at step ' + str(step) if step else 'fresh start'}")
     say("config: " + json.dumps(cfg.to_dict(), sort_keys=True))
 
@@ -491,7 +550,6 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
     marks = {"curve": (step, agent.num_updates, t_start, 0.0), "train": (step, agent.num_updates, t_start, 0.0)}
     eval_time = 0.0
     means = {"curve": _Mean(), "train": _Mean()}
-    ep_return, ep_len = 0.0, 0
 
     def wall() -> float:
         return wall_before + time.perf_counter() - t_start
@@ -529,7 +587,7 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
             "env_steps": step, "episodes": episodes, "wall_s": wall(),
             "csv_rows": {"curve": curve.rows(), "train": train_log.rows()},
             "recent": [list(x) for x in recent],
-            "agent": agent.state_dict(), "replay": _to_tensors(replay.state_dict()), "rng": _rng_states(env),
+            "agent": agent.state_dict(), "replay": _to_tensors(replay.state_dict()), "rng": _rng_states(envs),
         }
         atomic_write(ckpt_path, lambda f: torch.save(state, f))
 
@@ -537,29 +595,37 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
     try:
         if step == 0 and curve.rows() == 0:
             last_row = do_eval()
+        def crossed(every: int, before: int) -> bool:
+            return step // every > before // every or step == cfg.total_env_steps
+
         while step < cfg.total_env_steps:
+            before = step
+            live = envs[: cfg.total_env_steps - step]  # the last round may need fewer envs
             if step < cfg.init_steps:
-                action = env.action_space.sample()
+                actions = [e.action_space.sample() for e in live]
             else:
-                action = agent.act(obs, deterministic=False)
-            next_obs, reward, terminated, truncated, info = env.step(action)
-            replay.add(obs, action, reward, next_obs, terminated, truncated)
-            step += 1
-            ep_return += float(reward)
-            ep_len += 1
-            if terminated or truncated:
-                episodes += 1
-                recent.append((ep_return, float(terminated)))
-                ep_return, ep_len = 0.0, 0
-                obs, _ = env.reset()
-            else:
-                obs = next_obs
-            if step >= cfg.init_steps and step % cfg.update_every == 0:
-                for _ in range(cfg.updates_per_step):
+                actions = _act_batch(agent, observations[: len(live)])
+            for i, (e, action) in enumerate(zip(live, actions)):
+                next_obs, reward, terminated, truncated, info = e.step(action)
+                next_stored = to_replay(next_obs)
+                replay.add(i, stored[i], action, reward, next_stored, terminated, truncated)
+                step += 1
+                ep_returns[i] += float(reward)
+                if terminated or truncated:
+                    episodes += 1
+                    recent.append((ep_returns[i], float(terminated)))
+                    ep_returns[i] = 0.0
+                    observations[i], _ = e.reset()
+                    stored[i] = to_replay(observations[i])
+                else:
+                    observations[i], stored[i] = next_obs, next_stored
+            if step >= cfg.init_steps:
+                first_due = max(before, cfg.init_steps - 1)
+                for _ in range((step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step):
                     metrics = agent.update(replay.sample(cfg.batch_size))
                     means["curve"].add(metrics)
                     means["train"].add(metrics)
-            if step % cfg.log_every == 0:
+            if step // cfg.log_every > before // cfg.log_every:
                 sps, ups = rates("train")
                 m = means["train"].mean()
                 means["train"] = _Mean()
@@ -570,12 +636,12 @@ def _train(env, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict
                                  "steps_per_s": sps, "updates_per_s": ups, "wall_s": wall()})
                 if bar is not None:
                     bar.set_postfix(success=f"{succ:.2f}", ret=f"{ret:.1f}", ups=f"{ups:.1f}", refresh=False)
-            if step % cfg.eval_every == 0 or step == cfg.total_env_steps:
+            if crossed(cfg.eval_every, before):
                 last_row = do_eval()
-            if step % cfg.checkpoint_every == 0 or step == cfg.total_env_steps:
+            if crossed(cfg.checkpoint_every, before):
                 save_checkpoint()
             if bar is not None:
-                bar.update(1)
+                bar.update(step - before)
             if on_step is not None:
                 on_step(step)
     finally:

@@ -1,0 +1,154 @@
+"""The cpu profile's learner (SAC with a DrQ-v2-style update) and the lockstep-env replay."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from egosearch.rl.config import load_config
+from egosearch.rl.replay import MultiReplay
+from egosearch.rl.sac_drq import PooledConvEncoder, SacDrqAgent, conv_sides, pool_depth, random_shift
+from egosearch.rl.train import ActorPolicy, default_evaluator, train
+
+TESTS = Path(__file__).parent
+sys.path.insert(0, str(TESTS))
+from test_rl_fake_env import FAKE_ENV_ID, register_fake_envs  # noqa: E402
+
+register_fake_envs()
+DRQ = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2,
+       "encoder_stride2_layers": 2, "aug_pad": 2}
+
+
+def test_pooling_rounds_half_up_and_acting_pools_like_the_replay():
+    block = np.array([[1, 2], [3, 4]], np.uint8)  # mean 2.5 -> 3
+    assert pool_depth(block, 2).tolist() == [[3]]
+    assert pool_depth(np.array([[0, 0], [1, 1]], np.uint8), 2).tolist() == [[1]]  # 0.5 -> 1
+    assert pool_depth(np.array([[255, 255], [255, 254]], np.uint8), 2).tolist() == [[255]]
+    frames = np.random.default_rng(0).integers(0, 256, (2, 5, 100, 100), dtype=np.uint8)
+    encoder = PooledConvEncoder(5, 100, 2, 2, 4, 2, "relu")
+    assert np.array_equal(encoder.pool(torch.from_numpy(frames)).numpy().astype(np.uint8), pool_depth(frames, 2))
+
+
+def test_conv_sides_and_random_shift():
+    assert conv_sides(50, 3, 2) == [24, 11, 9]
+    assert conv_sides(84, 4, 1) == [41, 39, 37, 35]  # CURL's encoder
+    x = torch.arange(2 * 1 * 6 * 6, dtype=torch.float32).reshape(2, 1, 6, 6)
+    torch.manual_seed(0)
+    y = random_shift(x, 2)
+    assert y.shape == x.shape
+    for i in range(2):  # each sample is a window of the replicate-padded image
+        padded = torch.nn.functional.pad(x[i:i + 1], (2, 2, 2, 2), mode="replicate")[0, 0]
+        assert any(torch.equal(padded[a:a + 6, b:b + 6], y[i, 0]) for a in range(5) for b in range(5))
+    assert torch.equal(random_shift(x, 0), x)
+
+
+def _obs(value: int, size: int = 8) -> dict:
+    return {"depth": np.full((3, size, size), value, np.uint8), "mask": np.full(30, value, np.float32),
+            "proprio": np.zeros(4, np.float32)}
+
+
+def _fill_episode(replay: MultiReplay, env: int, rewards: list[float], start: int, terminated: bool) -> None:
+    for t, r in enumerate(rewards):
+        last = t == len(rewards) - 1
+        obs = _obs(start + t)
+        obs["depth"][:] = start + t  # the whole stack: only the newest frame matters to the ring
+        replay.add(env, obs, np.zeros(5), r, _obs(start + t + 1), terminated and last, last and not terminated)
+
+
+def test_n_step_returns_hand_worked():
+    replay = MultiReplay(1, 100, image_size=8, frame_history=3, n_step=3, gamma=0.5)
+    _fill_episode(replay, 0, [1, 2, 3, 4, 5], start=10, terminated=True)
+    b = replay.sample_at(0, [0, 3, 4])
+    # t=0: 1 + 0.5*2 + 0.25*3; bootstrap gamma^3 from the obs after step 2 (frame 13)
+    assert b["reward"][:, 0].tolist() == [2.75, 6.5, 5.0]
+    assert b["discount"][:, 0].tolist() == [0.125, 0.25, 0.5]
+    assert b["not_done"][:, 0].tolist() == [1.0, 0.0, 0.0]  # steps 3 and 4 reach the terminal step
+    assert b["next_obs_depth"][0, -1, 0, 0].item() == 13 and b["next_mask"][0, 0].item() == 13
+    assert b["obs_depth"][1, -1, 0, 0].item() == 13 and b["next_obs_depth"][1, -1, 0, 0].item() == 15
+
+
+def test_n_step_stops_at_truncation_but_still_bootstraps_and_rings_stay_apart():
+    replay = MultiReplay(2, 200, image_size=8, frame_history=3, n_step=3, gamma=0.5)
+    _fill_episode(replay, 0, [1, 1], start=10, terminated=False)  # truncated after 2 steps
+    _fill_episode(replay, 0, [7, 7, 7, 7], start=50, terminated=False)
+    _fill_episode(replay, 1, [100, 100, 100], start=90, terminated=True)
+    b = replay.sample_at(0, [0, 1, 2])
+    assert b["reward"][:, 0].tolist() == [1.5, 1.0, 7 + 3.5 + 1.75]  # never crosses into the next episode
+    assert b["not_done"][:, 0].tolist() == [1.0, 1.0, 1.0]
+    assert b["next_obs_depth"][0, -1, 0, 0].item() == 12  # the truncated episode's last obs
+    batch = replay.sample(64)
+    assert batch["reward"].shape == (64, 1)
+    # each ring gave half the batch; no transition mixes the two envs' rewards
+    rewards = set(batch["reward"][:, 0].tolist())
+    assert rewards <= {1.5, 1.0, 12.25, 10.5, 7.0, 175.0, 150.0, 100.0}, rewards
+
+
+def test_one_ring_one_step_samples_like_the_plain_buffer():
+    replay = MultiReplay(1, 100, image_size=8, frame_history=3, n_step=1, seed=3)
+    _fill_episode(replay, 0, [1, 2, 3], start=10, terminated=True)
+    b = replay.sample(4)
+    assert "discount" not in b and set(b["reward"][:, 0].tolist()) <= {1.0, 2.0, 3.0}
+
+
+def test_drq_update_moves_the_critic_toward_a_fixed_target():
+    cfg = load_config("smoke", {**DRQ, "batch_size": 16, "actor_update_freq": 1})
+    agent = SacDrqAgent(cfg, 5)
+    replay = MultiReplay(1, 64, image_size=agent.replay_image_size, frame_history=5, n_step=1)
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        o = {"depth": rng.integers(0, 256, (5, 100, 100), dtype=np.uint8), "mask": np.zeros(30, np.float32),
+             "proprio": np.zeros(4, np.float32)}
+        o2 = {**o, "depth": np.concatenate([o["depth"][1:], rng.integers(0, 256, (1, 100, 100), dtype=np.uint8)])}
+        replay.add(0, agent.replay_obs(o), rng.uniform(-1, 1, 5), 1.0, agent.replay_obs(o2), True, False)
+    batch = replay.sample(16)
+    losses = [agent.update(batch)["critic_loss"] for _ in range(60)]
+    # every transition is terminal with reward 1: Q -> 1, so the TD loss must shrink a lot
+    assert losses[-1] < 0.1 * losses[0], (losses[0], losses[-1])
+    m = agent.update(batch)
+    assert np.isnan(m["curl_loss"]) and np.isfinite(m["actor_loss"]) and agent.num_updates == 61
+
+
+def test_drq_training_with_lockstep_envs_resumes_and_writes_a_loadable_actor(tmp_path):
+    cfg = load_config("smoke", {**DRQ, "num_envs": 3, "n_step": 3, "update_every": 3, "total_env_steps": 300,
+                                "checkpoint_every": 150, "eval_every": 150, "log_every": 50})
+
+    class Stop(Exception):
+        pass
+
+    def stop_at(step):
+        if step >= 200:
+            raise Stop
+
+    with pytest.raises(Stop):
+        train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=stop_at)
+    seen = []
+    done = train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=seen.append)
+    assert seen[0] == 153 and seen[-1] == 300  # resumed at the checkpoint at 150, 3 env steps a round
+    # one update per multiple of update_every from init_steps on: 102, 105, ..., 300
+    assert done["env_steps"] == 300 and done["updates"] == 300 // 3 - 99 // 3
+    rows = (tmp_path / "train.csv").read_text().splitlines()[1:]
+    assert [int(r.split(",")[0]) for r in rows] == [51, 102, 150, 201, 252, 300]
+    policy = ActorPolicy(tmp_path / "actor.pt")
+    obs = {"depth": np.zeros((5, 100, 100), np.uint8), "mask": np.zeros(30, np.float32),
+           "proprio": np.zeros(4, np.float32)}
+    assert policy.act(obs).shape == (5,) and np.array_equal(policy.act(obs), policy.act(obs))
+
+
+def test_drq_learns_the_fake_env(tmp_path):
+    from egosearch.policies import RandomPolicy
+
+    cfg = load_config("smoke", {**DRQ, "num_envs": 4, "n_step": 3, "batch_size": 64, "update_every": 2,
+                                "actor_update_freq": 1, "critic_target_update_freq": 1,
+                                "total_env_steps": 1200, "init_steps": 200, "eval_every": 1200,
+                                "checkpoint_every": 1200, "log_every": 200, "eval_episodes": 5, "seed": 0})
+    train(FAKE_ENV_ID, cfg, tmp_path, progress=False)
+    evaluate = default_evaluator(FAKE_ENV_ID, {}, episodes=20)
+    trained = evaluate(ActorPolicy(tmp_path / "actor.pt"))
+    random = evaluate(RandomPolicy(5, seed=0))
+    evaluate.close()
+    assert trained["success_rate"] >= 0.8, trained
+    assert random["success_rate"] <= 0.2, random
