@@ -16,6 +16,8 @@ over the episode's collision count.
 Two ways to start an episode:
 - training (no scenario given): a random target on the placement scheme's surfaces, a random
   collision-free start, camera height U[1.0, 1.8] m per episode plus U[-0.1, 0.1] m per step;
+  ``reset(options={"start_radius": r})`` draws the start within r m of the target (a training
+  curriculum: ``SacCurlConfig.curriculum_steps``);
 - evaluation: ``reset(options={"scenario": s})`` with an :class:`egosearch.scenarios.Scenario`,
   at its fixed height without noise.
 """
@@ -145,7 +147,7 @@ class SearchEnv(gymnasium.Env):
         else:
             self.target = sample_target(self.scene, get_object(self.objects[int(rng.integers(len(self.objects)))]),
                                         self.placement, rng)
-            x, y, theta = self._random_start(rng)
+            x, y, theta = self._random_start(rng, (options or {}).get("start_radius"))
             lo, hi = spec.train_height_range
             self.base_height = self.fixed_height if self.fixed_height is not None else float(rng.uniform(lo, hi))
             self.scenario_id = -1
@@ -162,9 +164,16 @@ class SearchEnv(gymnasium.Env):
         self._seen_distance = target_distance(self.state, self.target, spec.body_radius) if mask.any() else None
         return self._observation(mask), self._info(mask.any(), False)
 
-    def _random_start(self, rng) -> tuple[float, float, float]:
+    def _random_start(self, rng, start_radius: float | None = None) -> tuple[float, float, float]:
+        """A collision-free start in the home's main free region; with ``start_radius`` (a training
+        curriculum) only cells within that horizontal distance of the target are drawn, when any is."""
         grid = navgrid_for(self.layout)
         rows, cols = np.nonzero(grid.main_region)
+        if start_radius is not None:
+            xs, ys = grid.xs[cols], grid.ys[rows]
+            near = np.hypot(xs - self.target.center[0], ys - self.target.center[1]) <= float(start_radius)
+            if near.any():
+                rows, cols = rows[near], cols[near]
         for _ in range(1000):
             i = int(rng.integers(len(rows)))
             x, y = grid.center(rows[i], cols[i])

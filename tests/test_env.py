@@ -97,3 +97,20 @@ def test_evaluation_env_uses_the_scenario():
         _, _, _, _, info = env.step(env.action_space.sample())
         assert info["camera_height"] == 0.45  # no noise in evaluation
     env.close()
+
+
+def test_start_radius_curriculum_starts_near_the_target():
+    import math
+
+    from egosearch.env import SearchEnv
+
+    env = SearchEnv(layout="kitchen_living")
+    far = []
+    for seed in range(12):
+        env.reset(seed=seed, options={"start_radius": 1.5})
+        t, s = env.target.center, env.state
+        assert math.hypot(t[0] - s.x, t[1] - s.y) <= 1.5 + 1e-9
+        env.reset(seed=seed)
+        far.append(math.hypot(env.target.center[0] - env.state.x, env.target.center[1] - env.state.y))
+    assert max(far) > 3.0  # without the option, starts come from the whole home
+    env.close()

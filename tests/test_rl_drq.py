@@ -152,3 +152,9 @@ def test_drq_learns_the_fake_env(tmp_path):
     evaluate.close()
     assert trained["success_rate"] >= 0.8, trained
     assert random["success_rate"] <= 0.2, random
+
+
+def test_curriculum_radius_grows_linearly_then_stops():
+    cfg = load_config("smoke", {"curriculum_steps": 1000})
+    assert cfg.start_radius(0) == 1.0 and cfg.start_radius(500) == 6.5 and cfg.start_radius(1000) is None
+    assert load_config("smoke", {}).start_radius(0) is None  # off by default (the paper has none)

@@ -13,11 +13,16 @@ from pathlib import Path
 
 import pandas as pd
 
-from egosearch.report.data import _with, cells_from_paths, group_eval_paths, output_base
+from egosearch.report.data import _with, cells_from_paths, group_eval_paths, output_base, parse_eval_path
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
-from egosearch.report.tables import compare_report, format_compare, table1, table2
+from egosearch.report.provenance import check_stored
+from egosearch.report.tables import BOUNDS, compare_report, format_compare, table1, table2
 
 PathLike = str | os.PathLike
+
+
+def _flat(groups: Iterable) -> list:
+    return [p for g in groups for p in ([g] if isinstance(g, (str, os.PathLike)) else g)]
 
 
 def _say(paths: Iterable[Path]) -> None:
@@ -25,28 +30,45 @@ def _say(paths: Iterable[Path]) -> None:
         print(f"wrote {p}")
 
 
-def cmd_table1(episode_files: Mapping | Iterable[PathLike], out_prefix: PathLike,
-               variant: str | None = None) -> pd.DataFrame:
-    """Table 1 from ``{(seed, height, placement): path(s)}`` or a flat list of one variant's evaluation CSVs."""
+def group_bounds(paths: Iterable[PathLike]) -> dict[str, dict]:
+    """Evaluation CSVs of the bound searchers (``.../eval/{random|oracle}/seed{N}/...``) ->
+    ``{bound: {(seed, height, placement): [paths]}}``, every bound present (empty when not run)."""
+    out: dict[str, list] = {bound: [] for bound in BOUNDS}
+    for path in paths:
+        bound = parse_eval_path(path)["variant"]
+        if bound not in out:
+            raise ValueError(f"{path}: not a bound searcher's evaluation (expected .../eval/{{random|oracle}}/...)")
+        out[bound].append(path)
+    return {bound: group_eval_paths(files) for bound, files in out.items()}
+
+
+def cmd_table1(episode_files: Mapping | Iterable[PathLike], out_prefix: PathLike, variant: str | None = None,
+               bounds: Iterable[PathLike] | None = None) -> pd.DataFrame:
+    """Table 1 from ``{(seed, height, placement): path(s)}`` or a flat list of one variant's evaluation CSVs;
+    ``bounds`` (a list, possibly empty) of the random searcher's and the oracle's evaluation CSVs puts the
+    policy between them."""
     if not isinstance(episode_files, Mapping):
         episode_files = group_eval_paths(episode_files, variant=variant)
-    df = table1(episode_files, out_prefix)
+    df = table1(episode_files, out_prefix, bounds=None if bounds is None else group_bounds(bounds), variant=variant)
     base = output_base(out_prefix, "table1")
     _say(_with(base, e) for e in (".csv", ".md", ".tex"))
     return df
 
 
-def cmd_table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike) -> None:
-    """Table 2 from (parameter, setting) rows, e.g. ``egosearch.rl.config.table2_rows(cfg)``."""
-    table2(rows, out_prefix)
+def cmd_table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike,
+               departures: Iterable[tuple[str, str, str, str]] = ()) -> None:
+    """Table 2 from (parameter, setting) rows, e.g. ``egosearch.rl.config.table2_rows(cfg)``, and the
+    profile's departures from the paper (``egosearch.rl.config.departure_rows(cfg)``)."""
+    table2(rows, out_prefix, departures=departures)
     base = output_base(out_prefix, "table2")
     _say(_with(base, e) for e in (".md", ".tex"))
 
 
 def cmd_fig6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike,
-             labels: Mapping[str, str] | None = None) -> list[Path]:
-    """Figure 6 from ``{variant: [curve.csv per seed]}``."""
-    outs = figure6(curves, out_prefix, labels=labels)
+             labels: Mapping[str, str] | None = None, random_files: Iterable[PathLike] | None = None) -> list[Path]:
+    """Figure 6 from ``{variant: [curve.csv per seed]}``; ``random_files``: the random searcher's evaluations
+    on the training home's cells (a dashed line)."""
+    outs = figure6(curves, out_prefix, labels=labels, random_files=random_files)
     _say(outs)
     return outs
 
@@ -62,7 +84,13 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
                 out_csv: PathLike | None = None, reference_name: str = "reference",
                 candidate_name: str = "candidate") -> pd.DataFrame:
     """Candidate vs reference per (height, placement) cell; each side a ``{cell: [paths]}`` dict or a flat
-    list of one variant's evaluation CSVs. Prints the table; writes ``out_csv`` when given."""
+    list of one variant's evaluation CSVs. Prints the table; writes ``out_csv`` when given.
+
+    Refuses (:class:`~egosearch.report.provenance.StoredFileError`) a stored file that differs from
+    the sha256 its results folder's provenance recorded; files the record does not list (a new
+    candidate's) are used as they are."""
+    check_stored([p for side in (reference_files, candidate_files)
+                  for p in (_flat(side.values()) if isinstance(side, Mapping) else side)], require_record=False)
     if not isinstance(reference_files, Mapping):
         reference_files = cells_from_paths(reference_files)
     if not isinstance(candidate_files, Mapping):

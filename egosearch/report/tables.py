@@ -25,6 +25,14 @@ PLACEMENT_LABELS = {"no_low_cabinets": "Excluding cabinets", "everywhere": "Ever
 TABLE1_COLUMNS = ("height", "placement", "n_episodes", "n_seeds", "success_rate", "wilson_low", "wilson_high",
                   "seed_boot_low", "seed_boot_high", "spl", "paper_success_rate")
 
+BOUNDS = ("random", "oracle")
+"""The searchers Table 1 puts each policy between, on the same scenario sets: uniform random actions,
+and the privileged oracle (knows the target and walks the shortest path to it)."""
+BOUND_LABELS = {"random": "random searcher", "oracle": "privileged oracle"}
+BOUND_COLUMNS = tuple(f"{b}_{c}" for b in BOUNDS for c in ("n_episodes", "success_rate", "wilson_low",
+                                                            "wilson_high", "spl"))
+NOT_RUN = "not run"
+
 TABLE2_CAPTION = "A complete set of CURL hyperparameters used to conduct all of the training experiments."
 
 PathLike = str | os.PathLike
@@ -57,8 +65,29 @@ def _md_escape(s: str) -> str:
 
 
 # --------------------------------------------------------------------------------------------- Table 1
+def _read_cells(episode_files: Mapping, what: str) -> dict[tuple, pd.DataFrame]:
+    """``{(seed, height, placement): paths}`` -> ``{(height, placement): episodes pooled over seeds}``."""
+    cells: dict[tuple, list[pd.DataFrame]] = {}
+    for key, paths in episode_files.items():
+        if not (isinstance(key, tuple) and len(key) == 3):
+            raise ValueError(f"{what}: key {key!r} is not (seed, height, placement)")
+        s, h, pl = key
+        cells.setdefault((round(float(h), 4), str(pl)), []).append(read_episodes(paths, seed=int(s)))
+    return {cell: pd.concat(frames, ignore_index=True) for cell, frames in cells.items()}
+
+
+def _bound_row(df: pd.DataFrame | None, bound: str, confidence: float) -> dict:
+    if df is None:
+        return {f"{bound}_n_episodes": 0, f"{bound}_success_rate": math.nan, f"{bound}_wilson_low": math.nan,
+                f"{bound}_wilson_high": math.nan, f"{bound}_spl": math.nan}
+    n, k = len(df), int(df["success"].astype(int).sum())
+    lo, hi = wilson_ci(k, n, confidence)
+    return {f"{bound}_n_episodes": n, f"{bound}_success_rate": k / n, f"{bound}_wilson_low": lo,
+            f"{bound}_wilson_high": hi, f"{bound}_spl": float(df["spl"].mean())}
+
+
 def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: int = 10_000,
-                 seed: int = 0) -> pd.DataFrame:
+                 seed: int = 0, bounds: Mapping[str, Mapping] | None = None) -> pd.DataFrame:
     """The numbers of Table 1, one row per (height, placement) with :data:`TABLE1_COLUMNS`.
 
     ``episode_files``: ``{(seed, height, placement): path or [paths]}``; several paths per key are
@@ -66,19 +95,26 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
     episodes pooled over seeds; ``wilson_*`` the Wilson interval of the pooled successes;
     ``seed_boot_*`` a percentile bootstrap of the mean over the per-seed success rates (NaN with one
     seed); ``paper_success_rate`` the paper's value (NaN where the paper has none).
+
+    ``bounds`` (``{"random" | "oracle": {(seed, height, placement): paths}}``, either side possibly
+    empty) adds :data:`BOUND_COLUMNS`: the bound searchers' pooled success rate, Wilson interval and
+    SPL on each cell (NaN and 0 episodes where a bound was not run). They must have run on the
+    policy's scenario sets: a cell the policy lacks is an error.
     """
     if not episode_files:
         raise ValueError("table1: no evaluation files given")
-    cells: dict[tuple, list[pd.DataFrame]] = {}
-    for key, paths in episode_files.items():
-        if not (isinstance(key, tuple) and len(key) == 3):
-            raise ValueError(f"table1: key {key!r} is not (seed, height, placement)")
-        s, h, pl = key
-        df = read_episodes(paths, seed=int(s))
-        cells.setdefault((round(float(h), 4), str(pl)), []).append(df)
+    cells = _read_cells(episode_files, "table1")
+    bound_cells = {}
+    for bound, files in (bounds or {}).items():
+        if bound not in BOUNDS:
+            raise ValueError(f"table1: bound {bound!r}; allowed: {', '.join(BOUNDS)}")
+        bound_cells[bound] = _read_cells(files, f"table1 {bound}")
+        extra = set(bound_cells[bound]) - set(cells)
+        if extra:
+            raise ValueError(f"table1: the {bound} files have cells the policy has not: {sorted(extra)}")
     rows = []
     for h, pl in _sorted_cells(cells):
-        df = pd.concat(cells[(h, pl)], ignore_index=True)
+        df = cells[(h, pl)]
         n, k = len(df), int(df["success"].astype(int).sum())
         lo, hi = wilson_ci(k, n, confidence)
         per_seed = df.groupby("seed")["success"].mean().to_numpy(dtype=float)
@@ -87,7 +123,11 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
                      "success_rate": k / n, "wilson_low": lo, "wilson_high": hi,
                      "seed_boot_low": blo, "seed_boot_high": bhi, "spl": float(df["spl"].mean()),
                      "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
-    return pd.DataFrame(rows, columns=list(TABLE1_COLUMNS))
+        if bounds is not None:
+            for bound in BOUNDS:
+                rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((h, pl)), bound, confidence))
+    columns = list(TABLE1_COLUMNS) + (list(BOUND_COLUMNS) if bounds is not None else [])
+    return pd.DataFrame(rows, columns=columns)
 
 
 def _table1_grid(df: pd.DataFrame) -> tuple[list[float], list[str]]:
@@ -110,16 +150,80 @@ def _table1_cell(df: pd.DataFrame, h: float, pl: str, tex: bool = False) -> str:
     return f"ours {ours}{sep}paper {paper_s}"
 
 
+def _searcher_cell(df: pd.DataFrame, h: float, pl: str, who: str) -> str:
+    """One searcher on one cell: ``0.83 [0.76, 0.88]`` (Wilson), the paper's value, or "not run"."""
+    row = df[(df["height"] == h) & (df["placement"] == pl)]
+    if who == "paper":
+        return _fmt(PAPER_TABLE1.get((round(h, 2), pl), math.nan))
+    if row.empty:
+        return "–"
+    r = row.iloc[0]
+    prefix = "" if who == "ours" else f"{who}_"
+    if who != "ours" and not r[f"{prefix}n_episodes"]:
+        return NOT_RUN
+    return f"{r[prefix + 'success_rate']:.2f} [{r[prefix + 'wilson_low']:.2f}, {r[prefix + 'wilson_high']:.2f}]"
+
+
+def _table1_with_bounds(df: pd.DataFrame, base: Path, out_csv: Path, variant: str | None, seeds_s: str, eps_s: str,
+                        pct: str) -> None:
+    """Table 1 with, per height, four rows: random searcher, the policy, privileged oracle, paper."""
+    heights, placements = _table1_grid(df)
+    heads = [PLACEMENT_LABELS.get(p, p) for p in placements]
+    ours = f"ours ({variant})" if variant else "ours"
+    searchers = [("random", "random searcher"), ("ours", ours), ("oracle", "privileged oracle"), ("paper", "paper")]
+    bound_eps = {b: "/".join(str(int(n)) for n in sorted(set(df[f"{b}_n_episodes"])) if n) or "0" for b in BOUNDS}
+    what = {"random": "uniform random actions", "oracle": "knows the target and walks the shortest path to it"}
+    notes = "; ".join(
+        f"{BOUND_LABELS[b]}: {what[b]}, "
+        + (f"{bound_eps[b]} episodes per cell on the same scenario sets" if bound_eps[b] != "0"
+           else f"{NOT_RUN} (no stored per-episode CSVs; rule `bound`)") for b in BOUNDS)
+    notes = notes[0].upper() + notes[1:]
+    pct_tex = pct.replace("%", r"\%")
+
+    md = ["Table 1: Success rate by head height and object placement: the search policy between the random "
+          "searcher and the privileged oracle, and the paper's policy.", "",
+          "| Head height | Searcher | " + " | ".join(heads) + " |", "|---|---|" + "---|" * len(heads)]
+    for h in heights:
+        for who, label in searchers:
+            md.append(f"| {_height_label(h)} | {label} | "
+                      + " | ".join(_searcher_cell(df, h, p, who) for p in placements) + " |")
+    md += ["", f"Success rate over all episodes of a cell (ours: pooled over {seeds_s} seed(s), {eps_s} episodes per "
+               f"cell); brackets: {pct} Wilson score interval. {notes}. The {pct} percentile bootstrap over ours' "
+               f"per-seed success rates and every SPL are in {out_csv.name}. Paper: Table 1 of Sorokin et al. 2021.",
+           ""]
+    _with(base, ".md").write_text("\n".join(md), encoding="utf-8")
+
+    cap = (f"Success rate by head height and object placement: the search policy between the random searcher and "
+           f"the privileged oracle, and the paper's Table 1. Ours: pooled over {seeds_s} seed(s) ({eps_s} episodes "
+           f"per cell); brackets: {pct_tex} Wilson score interval. {_tex_escape(notes)}.")
+    tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{ll" + "c" * len(heads) + "}",
+           r"\toprule", "Head height & Searcher & " + " & ".join(_tex_escape(x) for x in heads) + r" \\",
+           r"\midrule"]
+    for i, h in enumerate(heights):
+        if i:
+            tex.append(r"\midrule")
+        for j, (who, label) in enumerate(searchers):
+            tex.append(f"{_height_label(h) if j == 0 else ''} & {_tex_escape(label)} & "
+                       + " & ".join(_tex_escape(_searcher_cell(df, h, p, who)) for p in placements) + r" \\")
+    tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + cap + "}", r"\label{tab:table1}", r"\end{table}",
+            ""]
+    _with(base, ".tex").write_text("\n".join(tex), encoding="utf-8")
+
+
 def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.95, n_resamples: int = 10_000,
-           seed: int = 0) -> pd.DataFrame:
+           seed: int = 0, bounds: Mapping[str, Mapping] | None = None, variant: str | None = None) -> pd.DataFrame:
     """Write ``{prefix}.csv``, ``.md`` and ``.tex`` (see :func:`output_base`; a directory gets ``table1.*``); return
     the frame.
 
     See :func:`table1_frame` for ``episode_files`` and the numbers. The Markdown/LaTeX tables are
     laid out like the paper (rows: head height; columns: Excluding cabinets / Everywhere), each
     cell ``ours 0.83 [0.76, 0.88] · paper 0.92`` with the Wilson interval in brackets.
+
+    With ``bounds`` (see :func:`table1_frame`; ``{}`` when none is stored) each height gets four
+    rows instead: random searcher, ours (``variant``), privileged oracle and paper, a bound that was
+    not run saying so.
     """
-    df = table1_frame(episode_files, confidence, n_resamples, seed)
+    df = table1_frame(episode_files, confidence, n_resamples, seed, bounds=bounds)
     base = output_base(out_prefix, "table1")
     out_csv = _with(base, ".csv")
     df.to_csv(out_csv, index=False, float_format="%.6g")
@@ -131,6 +235,9 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
     eps_s = "/".join(str(s) for s in n_eps)
     pct = f"{confidence * 100:g}%"
     pct_tex = pct.replace("%", r"\%")
+    if bounds is not None:
+        _table1_with_bounds(df, base, out_csv, variant, seeds_s, eps_s, pct)
+        return df
 
     md = ["Table 1: Success rate of the search policy by head height and object placement (ours vs. paper).", "",
           "| Head height | " + " | ".join(heads) + " |", "|---|" + "---|" * len(heads)]
@@ -158,23 +265,37 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
 
 
 # --------------------------------------------------------------------------------------------- Table 2
-def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str = TABLE2_CAPTION) -> None:
+def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str = TABLE2_CAPTION,
+           departures: Iterable[tuple[str, str, str, str]] = ()) -> None:
     """Write ``{prefix}.md`` and ``{prefix}.tex`` (a directory gets ``table2.*``): Parameter | Setting, rows in the
     order given.
 
     ``rows`` are (parameter, setting) pairs, e.g. ``egosearch.rl.config.table2_rows(cfg)`` (the caller
-    passes them: the report layer does not import the config).
+    passes them: the report layer does not import the config). ``departures`` (field, this profile,
+    paper, field documentation), e.g. ``egosearch.rl.config.departure_rows(cfg)``, add a second
+    table: every learner setting of this profile that is not the paper's.
     """
+    departures = [tuple(str(x) for x in d) for d in departures]
     rows = [(str(a), str(b)) for a, b in rows]
     if not rows:
         raise ValueError("table2: no rows")
     base = output_base(out_prefix, "table2")
     md = [f"Table 2: {caption}", "", "| Parameter | Setting |", "|---|---|"]
     md += [f"| {_md_escape(a)} | {_md_escape(b)} |" for a, b in rows]
+    if departures:
+        md += ["", f"Where this profile departs from the paper ({len(departures)} learner settings; the paper "
+               "profile is Table 2 exactly):", "",
+               "| Field | This profile | Paper | Source and meaning (the field's docstring) |", "|---|---|---|---|"]
+        md += [f"| `{f}` | {_md_escape(mine)} | {_md_escape(paper)} | {_md_escape(doc)} |"
+               for f, mine, paper, doc in departures]
     _with(base, ".md").write_text("\n".join(md) + "\n", encoding="utf-8")
     tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{ll}", r"\toprule",
            r"Parameter & Setting \\", r"\midrule"]
     tex += [f"{_tex_escape(a)} & {_tex_escape(b)} " + r"\\" for a, b in rows]
+    if departures:
+        tex += [r"\midrule", r"\multicolumn{2}{l}{\emph{Departures from the paper (this profile / paper)}} \\"]
+        tex += [f"{_tex_escape(f)} & {_tex_escape(mine)} / {_tex_escape(paper)} " + r"\\"
+                for f, mine, paper, _ in departures]
     tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + _tex_escape(caption) + "}", r"\label{tab:table2}",
             r"\end{table}", ""]
     _with(base, ".tex").write_text("\n".join(tex), encoding="utf-8")

@@ -13,7 +13,10 @@ Keys:
 - ``updates_per_s_table2_shared``: same, with ``share_encoder_forward=True`` (not CURL's math);
 - ``updates_per_s_naive``: CURL's update transcribed line by line (``impl="reference"``);
 - ``updates_per_s_table2_1thread``: the optimised update at Table 2 sizes on ONE thread;
-- ``updates_per_s_cpu_profile``: the ``cpu`` profile's update on its thread count (one);
+- ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
+  thread count (one);
+- ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
+  the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details);
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
 - ``torch_threads``, ``device``, ``cpu``.
 """
@@ -30,7 +33,7 @@ import torch
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent, resolve_device
-from egosearch.rl.train import torch_threads
+from egosearch.rl.train import make_agent, torch_threads
 
 
 def _cpu_seconds_all() -> float | None:
@@ -42,13 +45,13 @@ def _cpu_seconds_all() -> float | None:
         return None
 
 
-def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0) -> ReplayBuffer:
+def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0, size: int = 100) -> ReplayBuffer:
     rng = np.random.default_rng(seed)
-    buf = ReplayBuffer(n, 100, 5, 30, 4, action_dim, device=device, seed=seed)
-    frames = np.repeat(rng.integers(0, 256, (1, 100, 100), dtype=np.uint8), 5, axis=0)
+    buf = ReplayBuffer(n, size, 5, 30, 4, action_dim, device=device, seed=seed)
+    frames = np.repeat(rng.integers(0, 256, (1, size, size), dtype=np.uint8), 5, axis=0)
     obs = {"depth": frames, "mask": np.zeros(30, np.float32), "proprio": np.zeros(4, np.float32)}
     for t in range(n):
-        frames = np.concatenate([frames[1:], rng.integers(0, 256, (1, 100, 100), dtype=np.uint8)])
+        frames = np.concatenate([frames[1:], rng.integers(0, 256, (1, size, size), dtype=np.uint8)])
         nxt = {"depth": frames, "mask": rng.normal(size=30).astype(np.float32),
                "proprio": rng.normal(size=4).astype(np.float32)}
         end = (t + 1) % 100 == 0
@@ -68,8 +71,11 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
         torch.manual_seed(0)
         device = resolve_device(cfg.device)
-        agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
-        replay = _filled_replay(action_dim, device)
+        if cfg.algorithm == "sac_curl":
+            agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
+        else:
+            agent = make_agent(cfg, action_dim, 30, 4, device)
+        replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size))
         sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
         for _ in range(warmup):
             agent.update(replay.sample(cfg.batch_size))
@@ -85,6 +91,27 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         torch.set_num_threads(before)
 
 
+def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: dict | None = None) -> dict:
+    """Env steps per core-second of a short REAL training run of ``profile`` (head-on,
+    kitchen_living, everywhere): env stepping, acting and updates all in, its own evaluations
+    left out. Core-seconds are this process's CPU time (user + system), so the figure holds on
+    a busy machine too. Warm-up is cut to a tenth of the run so that updates weigh as in a long run."""
+    import tempfile
+
+    from egosearch.rl.train import train
+
+    cfg = load_config(profile, {**(overrides or {}), "total_env_steps": env_steps,
+                                "init_steps": max(1, env_steps // 10), "eval_every": env_steps,
+                                "checkpoint_every": env_steps, "log_every": env_steps})
+    with tempfile.TemporaryDirectory() as out:
+        cpu0, wall0 = time.process_time(), time.perf_counter()
+        train("EgoSearch-v0", cfg, out, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},
+              evaluate_fn=lambda policy: {}, progress=False, variant="bench")
+        cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+    return {"env_steps": env_steps, "core_s": round(cpu, 2), "wall_s": round(wall, 2),
+            "env_steps_per_core_s": round(env_steps / cpu, 1), "threads": torch_threads(cfg.num_threads)}
+
+
 def bench_learner(quick: bool = False) -> dict:
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds)."""
     torch.set_num_threads(torch_threads(0))
@@ -98,6 +125,7 @@ def bench_learner(quick: bool = False) -> dict:
     }
     cpu_cfg = load_config("cpu", {})
     runs["cpu_profile"] = time_updates("cpu", threads=torch_threads(cpu_cfg.num_threads), updates=2 * n)
+    throughput = training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
     wall = time.perf_counter() - wall0
     cpu1 = _cpu_seconds_all()
     own = time.process_time() - own0
@@ -106,6 +134,8 @@ def bench_learner(quick: bool = False) -> dict:
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
         result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
     result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
+    result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
+    result["cpu_profile_run"] = throughput
     result["replay_gb_100k"] = round(replay_gb(100_000), 3)
     result["torch_threads"] = torch.get_num_threads()
     result["cpu_profile_threads"] = torch_threads(cpu_cfg.num_threads)

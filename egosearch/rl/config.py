@@ -27,6 +27,10 @@ from typing import Any
 ACTIVATIONS = ("relu", "elu", "leaky_relu", "gelu", "tanh")
 """Activation names the networks understand (Table 2 uses ReLU everywhere)."""
 
+CURRICULUM_START_RADIUS = 1.0
+"""Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
+CURRICULUM_END_RADIUS = 12.0
+"""Radius (m) the curriculum reaches at its end: more than any home's extent."""
 ALGORITHMS = ("sac_curl", "sac_drq")
 """Learners :mod:`egosearch.rl.train` can run (see ``SacCurlConfig.algorithm``)."""
 DISTANCE_REWARDS = ("distance", "progress")
@@ -190,6 +194,13 @@ class SacCurlConfig:
     2019's form, which the paper cites; potential-based shaping as in habitat-lab). TRAINING
     ONLY: evaluation always scores the paper's task (success, SPL), whatever the training
     reward. A variant's ``train_env: distance_reward`` takes precedence."""
+    curriculum_steps: int = 0
+    """Paper: 0 (no curriculum). Otherwise a start-distance curriculum after the reverse
+    curriculum of Florensa et al. 2017, simplified: training episodes start within a radius of
+    the target that grows linearly from ``CURRICULUM_START_RADIUS`` (1 m) to
+    ``CURRICULUM_END_RADIUS`` (12 m, the whole home) over the first this many env steps; after
+    that, starts are drawn from the whole home as in the paper. TRAINING ONLY: evaluation always
+    uses the stored scenarios."""
 
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
@@ -258,7 +269,7 @@ class SacCurlConfig:
                      "log_every", "checkpoint_every"):
             if getattr(self, name) < 1:
                 bad(name, "an integer >= 1")
-        for name in ("head_history", "init_steps", "seed", "num_threads"):
+        for name in ("head_history", "init_steps", "seed", "num_threads", "curriculum_steps"):
             if getattr(self, name) < 0:
                 bad(name, "an integer >= 0")
         for name in ("actor_num_layers", "critic_num_layers"):
@@ -317,6 +328,13 @@ class SacCurlConfig:
                 or self.device == "mps"):
             bad("device", "auto, cpu, cuda, cuda:N or mps")
         return self
+
+    def start_radius(self, env_steps: int) -> float | None:
+        """The curriculum's start radius (m) at ``env_steps``; None once it is over (or off)."""
+        if env_steps >= self.curriculum_steps:
+            return None
+        frac = env_steps / self.curriculum_steps
+        return CURRICULUM_START_RADIUS + frac * (CURRICULUM_END_RADIUS - CURRICULUM_START_RADIUS)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-python dict (JSON / ``torch.load(weights_only=True)`` safe)."""
@@ -448,7 +466,9 @@ def table2_rows(cfg: SacCurlConfig) -> list[tuple[str, str]]:
     act = _ACTIVATION_LABELS
     return [
         ("Image Size", f"{cfg.image_size}x{cfg.image_size}"),
-        ("Augmentation", f"Random Crop ({cfg.crop_size}x{cfg.crop_size})"),
+        ("Augmentation", f"Random Crop ({cfg.crop_size}x{cfg.crop_size})" if cfg.algorithm == "sac_curl" else
+         f"Random Shift (±{cfg.aug_pad} px at {cfg.image_size // cfg.obs_downsample}x"
+         f"{cfg.image_size // cfg.obs_downsample})"),
         ("Image History Buffer Size", str(cfg.frame_history)),
         ("Head History Buffer Size", str(cfg.head_history)),
         ("Replay buffer", str(cfg.replay_capacity)),
@@ -481,8 +501,41 @@ def table2_rows(cfg: SacCurlConfig) -> list[tuple[str, str]]:
     ]
 
 
+HOUSEKEEPING_FIELDS = frozenset({"eval_every", "eval_episodes", "log_every", "checkpoint_every", "seed", "device",
+                                  "num_threads", "channels_last", "compile", "keep_checkpoint"})
+"""Fields that change how a run is watched, saved or placed on the machine, never what it learns."""
+
+
+def field_docs() -> dict[str, str]:
+    """Each config field's docstring (the string literal under it in this module's source)."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(SacCurlConfig))
+    body = tree.body[0].body
+    docs = {}
+    for node, after in zip(body, body[1:]):
+        if (isinstance(node, ast.AnnAssign) and isinstance(after, ast.Expr)
+                and isinstance(after.value, ast.Constant) and isinstance(after.value.value, str)):
+            docs[node.target.id] = " ".join(after.value.value.split())
+    return docs
+
+
+def departure_rows(cfg: SacCurlConfig) -> list[tuple[str, str, str, str]]:
+    """(field, this config's value, the paper's value, where each comes from) for every field that
+    differs from the paper profile, housekeeping fields excepted: what a profile changes, generated."""
+    paper, docs = SacCurlConfig(), field_docs()
+    rows = []
+    for f in fields(cfg):
+        mine, theirs = getattr(cfg, f.name), getattr(paper, f.name)
+        if f.name in HOUSEKEEPING_FIELDS or mine == theirs:
+            continue
+        rows.append((f.name, str(mine), str(theirs), docs.get(f.name, "")))
+    return rows
+
+
 TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(SacCurlConfig()))
 """Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
 
-__all__ = ["ACTIVATIONS", "PROFILES", "SacCurlConfig", "TABLE2_PAPER", "cpu_profile",
-           "load_config", "paper_profile", "smoke_profile", "table2_rows"]
+__all__ = ["ACTIVATIONS", "ALGORITHMS", "PROFILES", "SacCurlConfig", "TABLE2_PAPER", "cpu_profile", "departure_rows",
+           "field_docs", "load_config", "paper_profile", "smoke_profile", "table2_rows"]

@@ -392,6 +392,26 @@ def _env_spaces(env, cfg: SacCurlConfig) -> tuple[int, int, int]:
     return int(act.shape[0]), int(mask.shape[0]), int(proprio.shape[0])
 
 
+def keep_freed_memory() -> bool:
+    """Ask glibc to keep freed blocks of up to 32 MB instead of returning them to the OS.
+
+    Every update allocates and frees the same few-MB tensors; with glibc's defaults each one is a
+    fresh mmap whose pages fault in again, which measured ~1/3 of a small update's time here
+    (page faults 4x fewer with this). Same numbers either way. False where glibc is absent."""
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("c")
+    if not name or os.name != "posix":
+        return False
+    try:
+        libc = ctypes.CDLL(name)
+        m_trim_threshold, m_mmap_threshold = -1, -3
+        return bool(libc.mallopt(m_mmap_threshold, 32 * 1024 * 1024) and libc.mallopt(m_trim_threshold, 1 << 30))
+    except (OSError, AttributeError):
+        return False
+
+
 def torch_threads(requested: int = 0) -> int:
     """``requested`` or, for 0, every core this process may run on."""
     if requested:
@@ -447,6 +467,7 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
 
     threads_before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
+    keep_freed_memory()
     envs: list = []
     try:
         for _ in range(cfg.num_envs):
@@ -522,7 +543,11 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
         curve.truncate(0)
         train_log.truncate(0)
         reset_seeds = [cfg.seed + 104_729 * i for i in range(len(envs))]
-    observations = [e.reset(seed=sd)[0] for e, sd in zip(envs, reset_seeds)]
+    def reset(e, seed=None):
+        radius = cfg.start_radius(step)
+        return e.reset(seed=seed, options=None if radius is None else {"start_radius": radius})[0]
+
+    observations = [reset(e, sd) for e, sd in zip(envs, reset_seeds)]
     stored = [to_replay(o) for o in observations]  # as the replay stores them, each computed once
     ep_returns = [0.0] * len(envs)
     del ckpt
@@ -615,7 +640,7 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
                     episodes += 1
                     recent.append((ep_returns[i], float(terminated)))
                     ep_returns[i] = 0.0
-                    observations[i], _ = e.reset()
+                    observations[i] = reset(e)
                     stored[i] = to_replay(observations[i])
                 else:
                     observations[i], stored[i] = next_obs, next_stored
