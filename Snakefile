@@ -30,3 +30,12 @@ rule all:
         rules.fig7_oracle.output,
         rules.pictures.output,
         provenance_file(),
+
+
+# A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other
+# snakemake runs here, then --rerun-incomplete (profiles/default) reruns the killed jobs.
+if workflow.is_main_process:
+    from egosearch.stale_lock import clear_stale_locks
+
+    if clear_stale_locks():
+        print("Removed the lock of a snakemake run that was killed (no snakemake process runs here).")

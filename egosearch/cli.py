@@ -81,10 +81,14 @@ def _cmd_train(args) -> None:
     env = variant.train_env
     evaluator = scenario_evaluator(variant.env_id, env["layout"], env["placement"], n=cfg.eval_episodes)
     try:
-        summary = train(variant.env_id, cfg, args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
+        summary = train(variant.env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
                         variant=variant.name)
     finally:
         evaluator.close()
+    if args.work_dir:
+        from egosearch.staging import publish_run
+
+        publish_run(args.work_dir, args.out_dir)
     print(json.dumps(summary))
 
 
@@ -117,13 +121,13 @@ def _cmd_report(args) -> None:
     from egosearch.report import cli as report
 
     if args.what == "table1":
-        report.cmd_table1(args.files, args.out_prefix, variant=args.variant)
+        report.cmd_table1(args.files, args.out_prefix, variant=args.variant, bounds=args.bounds)
     elif args.what == "table2":
         from egosearch.rl.config import load_config, table2_rows
 
         report.cmd_table2(table2_rows(load_config(args.profile)), args.out_prefix)
     elif args.what == "fig6":
-        report.cmd_fig6(_group_curves(args.files), args.out_prefix)
+        report.cmd_fig6(_group_curves(args.files), args.out_prefix, random_files=args.random)
     elif args.what == "fig7":
         report.cmd_fig7(args.files, args.out_prefix, planner=args.planner)
     elif args.what == "compare":
@@ -138,6 +142,17 @@ def _cmd_report(args) -> None:
         print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
     elif args.what == "regenerate":
         _regenerate(args.profile, args.variant)
+    elif args.what == "verify":
+        from egosearch.report.provenance import verify
+
+        results = f"results/{args.profile}"
+        ok, problems = verify(results)
+        for problem in problems:
+            print(problem, file=sys.stderr)
+        if problems:
+            raise ValueError(f"{len(problems)} stored file(s) of {results} differ from the sha256 list of "
+                             f"{results}/provenance.json ({ok} match)")
+        print(f"{results}: all {ok} stored files match the sha256 recorded in {results}/provenance.json")
     elif args.what == "readme":
         from egosearch.report.readme import update_readme
 
@@ -157,8 +172,11 @@ def _regenerate(profile: str, reference: str | None) -> None:
     from pathlib import Path
 
     from egosearch.report import cli as report
+    from egosearch.report.provenance import check_stored
     from egosearch.report.readme import variants_of_all, workflow_config
+    from egosearch.report.tables import BOUNDS
     from egosearch.rl.config import load_config, table2_rows
+    from egosearch.variants import load_variant
 
     config = workflow_config()
     if profile not in config["profiles"]:
@@ -171,13 +189,20 @@ def _regenerate(profile: str, reference: str | None) -> None:
     curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
+    bounds = sorted(str(p) for b in BOUNDS for p in (results / "eval" / b).glob("seed*/*/*/h*.csv"))
+    # Figure 6's random level: the cells of the scheme the reference is evaluated in while training (as in the DAG).
+    train_placement = load_variant(reference).train_env["placement"]
+    fig6_random = [p for p in bounds if Path(p).parts[-2] == train_placement and Path(p).parts[-5] == "random"]
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
+    read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle]
+    if check_stored(read, require_record=True):
+        print(f"note: {results}/provenance.json has no sha256 list: the stored files are used unverified")
     figs.mkdir(parents=True, exist_ok=True)
     if evals:
-        report.cmd_table1(evals, figs / "table1", variant=reference)
+        report.cmd_table1(evals, figs / "table1", variant=reference, bounds=bounds)
     if curves:
-        report.cmd_fig6(curves, figs / "fig6")
+        report.cmd_fig6(curves, figs / "fig6", random_files=fig6_random)
     if fullbody:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:
@@ -256,6 +281,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
     p.add_argument("--out-dir", required=True)
+    p.add_argument("--work-dir", help="train (and resume) here, and copy the files to --out-dir only once the run "
+                                      "is complete (the DAG does: a killed job never leaves a partial output)")
     p.set_defaults(func=_cmd_train)
 
     p = sub.add_parser("fullbody", help="full-body search (Algorithm 1 or a baseline) -> per-episode CSV")
@@ -296,9 +323,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
     p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate",
-                                    "readme"))
+                                    "readme", "verify"))
     p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
     p.add_argument("--out-prefix", help="output path without extension")
+    p.add_argument("--bounds", nargs="*", help="table1: evaluation CSVs of the random searcher and the oracle")
+    p.add_argument("--random", nargs="*", help="fig6: evaluation CSVs of the random searcher (a dashed level)")
     p.add_argument("--variant", help="table1/regenerate: the variant of the evaluation CSVs (regenerate: default "
                                      "the config's reference)")
     p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate/readme: smoke, cpu or paper")

@@ -127,3 +127,22 @@ def test_regenerate_twice_gives_byte_identical_files(tmp_path, monkeypatch):
     second = {p.name: p.read_bytes() for p in sorted(figs.iterdir())}
     assert sorted(second) == sorted(first)
     assert [name for name in first if first[name] != second[name]] == []
+
+
+def test_regenerate_refuses_a_stored_csv_edited_after_its_provenance(tmp_path, monkeypatch, capsys):
+    from egosearch.report.provenance import write_provenance
+
+    results = tmp_path / "results" / "cpu"
+    shutil.copytree(REPO / "results" / "cpu", results, ignore=shutil.ignore_patterns("ckpt", "partial", "*.pt"))
+    monkeypatch.chdir(tmp_path)
+    write_provenance("cpu", results, results / "provenance.json")
+    assert main(["report", "verify", "--profile", "cpu"]) == 0
+    stored = sorted((results / "eval" / "head_on").rglob("h1.05.csv"))[0]
+    text = stored.read_text()
+    stored.write_text(text[: len(text) // 3])
+    capsys.readouterr()
+    assert main(["report", "regenerate", "--profile", "cpu"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{stored.relative_to(tmp_path)} was truncated" in err
+    assert not (tmp_path / "paper_figs").exists()          # refused before writing anything
+    assert main(["report", "verify", "--profile", "cpu"]) == 2

@@ -4,6 +4,7 @@ when every bar is 0."""
 from pathlib import Path
 
 import pandas as pd
+import pytest
 
 from egosearch.report.data import FULLBODY_COLUMNS
 from egosearch.report.figures import ALL_ZERO_NOTE, figure7, figure7_figure, figure7_frame
@@ -35,3 +36,117 @@ def test_figure7_says_so_when_every_bar_is_zero(tmp_path):
     # One bar above 0 is a plot to read, not an empty one.
     some = _fullbody(tmp_path / "some", lambda method, M: 0.5 if M == 20 else 0.0)
     assert ALL_ZERO_NOTE not in _texts(figure7_figure(figure7_frame(some, n_resamples=50)))
+
+
+EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
+                   "episode_return")
+
+
+def _eval_csv(root: Path, who: str, placement: str, height: float, successes: list[int], seed: int = 0) -> Path:
+    path = root / "eval" / who / f"seed{seed}" / "home" / placement / f"h{height:g}.csv"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame([dict(zip(EPISODE_COLUMNS, (i, s, 10, 4.0, 2.0, 0.5 * s, 0, -1.0)))
+                  for i, s in enumerate(successes)]).to_csv(path, index=False)
+    return path
+
+
+def test_table1_puts_the_policy_between_the_random_searcher_and_the_oracle(tmp_path):
+    from egosearch.report.cli import cmd_table1
+
+    cells = [("everywhere", 1.05), ("no_low_cabinets", 1.05)]
+    ours = [_eval_csv(tmp_path, "head_on", pl, h, [1, 0, 0, 0], seed) for pl, h in cells for seed in (0, 1)]
+    rand = [_eval_csv(tmp_path, "random", pl, h, [0, 0, 0, 1, 0]) for pl, h in cells]
+    oracle = [_eval_csv(tmp_path, "oracle", "everywhere", 1.05, [1, 1, 1, 1, 0])]   # one cell only
+    df = cmd_table1(ours, tmp_path / "out" / "table1", variant="head_on", bounds=rand + oracle).set_index("placement")
+    # 2 of 8 pooled episodes for ours, 1 of 5 for random, 4 of 5 for the oracle
+    assert df.loc["everywhere", "success_rate"] == 0.25
+    assert df.loc["everywhere", "random_success_rate"] == 0.2 and df.loc["everywhere", "random_n_episodes"] == 5
+    assert df.loc["everywhere", "oracle_success_rate"] == 0.8 and df.loc["everywhere", "oracle_spl"] == 0.4
+    assert df.loc["no_low_cabinets", "oracle_n_episodes"] == 0 and pd.isna(df.loc["no_low_cabinets",
+                                                                                  "oracle_success_rate"])
+    md = (tmp_path / "out" / "table1.md").read_text()
+    assert "| Head height | Searcher | Excluding cabinets | Everywhere |" in md
+    assert "| 1.05m | random searcher | 0.20 [0.04, 0.62] | 0.20 [0.04, 0.62] |" in md
+    assert "| 1.05m | ours (head_on) | 0.25 [0.07, 0.59] | 0.25 [0.07, 0.59] |" in md
+    assert "| 1.05m | privileged oracle | not run | 0.80 [0.38, 0.96] |" in md
+    assert "| 1.05m | paper | 0.92 | 0.75 |" in md
+    assert "privileged oracle" in (tmp_path / "out" / "table1.tex").read_text()
+    # Bounds of a cell the policy was not evaluated on were not run on its scenarios.
+    stray = [_eval_csv(tmp_path, "random", "everywhere", 0.45, [0])]
+    with pytest.raises(ValueError, match="cells the policy has not"):
+        cmd_table1(ours, tmp_path / "out2", variant="head_on", bounds=stray)
+
+
+def test_figure6_draws_the_random_searcher_as_a_dashed_level(tmp_path):
+    from egosearch.report.figures import RANDOM, figure6, figure6_frame
+
+    curve = tmp_path / "train" / "head_on" / "seed0" / "curve.csv"
+    curve.parent.mkdir(parents=True)
+    pd.DataFrame({"env_steps": [0, 100, 200], "success_rate": [0.0, 0.5, 0.75]}).to_csv(curve, index=False)
+    rand = [_eval_csv(tmp_path, "random", "everywhere", h, s) for h, s in ((0.45, [1, 0, 0, 0]), (1.65, [0, 0, 0, 0]))]
+    df = figure6_frame({"head_on": [curve]}, random_files=rand, n_resamples=50)
+    level = df[df["variant"] == RANDOM]
+    assert list(level["env_steps"]) == [0, 100, 200] and (level["success_rate"] == 1 / 8).all()
+    png, _pdf, _csv = figure6({"head_on": [curve]}, tmp_path / "fig6", random_files=rand, n_resamples=50)
+    assert png.stat().st_size > 10_000
+    with pytest.raises(ValueError, match="may not be called 'random'"):
+        figure6_frame({"random": [curve]}, random_files=rand)
+
+
+# --------------------------------------------------------------------------------------------- provenance
+def _stored_run(root: Path) -> tuple[Path, list[Path]]:
+    from egosearch.report.provenance import write_provenance
+
+    results = root / "results" / "p"
+    files = [_eval_csv(results, "head_on", "everywhere", 1.05, [1, 0, 1, 0], seed) for seed in (0, 1)]
+    files += [_eval_csv(results, "head_off", "everywhere", 1.05, [0, 0, 1, 0], seed) for seed in (0, 1)]
+    (results / "train" / "head_on" / "seed0" / "ckpt").mkdir(parents=True)
+    (results / "train" / "head_on" / "seed0" / "ckpt" / "train_state.ckpt").write_bytes(b"in progress")
+    (results / "logs").mkdir()
+    (results / "logs" / "x.log").write_text("log")
+    write_provenance("p", results, results / "provenance.json")
+    return results, files
+
+
+def test_provenance_records_the_sha256_of_every_stored_file(tmp_path):
+    import hashlib
+    import json
+
+    results, files = _stored_run(tmp_path)
+    record = json.loads((results / "provenance.json").read_text())["files"]
+    # Results only: not the logs, not a checkpoint of a run in progress, not the record itself.
+    assert sorted(record) == sorted(p.relative_to(results).as_posix() for p in files)
+    first = files[0].relative_to(results).as_posix()
+    assert record[first] == {"sha256": hashlib.sha256(files[0].read_bytes()).hexdigest(),
+                             "bytes": files[0].stat().st_size}
+
+
+def test_verify_and_compare_refuse_a_truncated_or_edited_csv(tmp_path, capsys):
+    from egosearch.cli import main
+    from egosearch.report.cli import cmd_compare
+    from egosearch.report.provenance import StoredFileError, verify
+
+    results, files = _stored_run(tmp_path)
+    ref, cand = files[:2], files[2:]
+    assert verify(results) == (4, [])
+    cmd_compare(ref, cand)                                          # intact: used
+    text = files[0].read_text()
+    files[0].write_text(text[: len(text) // 2])                     # truncated by hand
+    with pytest.raises(StoredFileError, match=r"h1.05.csv was truncated: \d+ bytes, \d+ recorded"):
+        cmd_compare(ref, cand)
+    files[0].write_text(text)
+    assert verify(results) == (4, [])
+    files[3].write_text(files[3].read_text().replace("\n0,0,", "\n0,1,", 1))   # a failure made a success
+    with pytest.raises(StoredFileError, match="h1.05.csv was edited: its sha256 differs"):
+        cmd_compare(ref, cand)
+    ok, problems = verify(results)
+    assert ok == 3 and len(problems) == 1 and "seed1" in problems[0] and "head_off" in problems[0]
+    # The CLI: one line on stderr, exit 2, no traceback.
+    capsys.readouterr()
+    assert main(["report", "compare", "--reference", *map(str, ref), "--candidate", *map(str, cand)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "was edited" in err and "Traceback" not in err
+    # A new candidate that the record does not list is a comparison's normal input.
+    new = [_eval_csv(results, "new", "everywhere", 1.05, [1, 1, 1, 1], seed) for seed in (0, 1)]
+    cmd_compare(ref, new)
+    assert any("new/seed0" in p and "not in the sha256 list" in p for p in verify(results)[1])

@@ -20,8 +20,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
-from egosearch.report.data import _with, output_base, read_curves, read_fullbody
-from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean
+from egosearch.report.data import _with, output_base, read_curves, read_episodes, read_fullbody
+from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, wilson_ci
 
 PathLike = str | os.PathLike
 
@@ -54,6 +54,9 @@ MG_ORDER = ("humanoid_phase", "humanoid_matching", "fetch")
 PLANNER_TITLES = {"actor": None, "oracle": "Planner: privileged oracle (knows the target; not the learned policy)"}
 """Figure 7's title per planner: the paper's figure (the learned policy) has none."""
 
+RANDOM = "random"
+"""Figure 6's row name of the random searcher (a dashed line: the level a policy must rise above)."""
+RANDOM_LABEL = "random searcher"
 FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "success_rate", "low", "high")
 FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
                 "success_rate", "spl", "spl_low", "spl_high", "attempts", "attempts_low", "attempts_high",
@@ -85,11 +88,15 @@ def _save(fig: Figure, base: Path) -> list[Path]:
 
 # --------------------------------------------------------------------------------------------- Figure 6
 def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str, str] | None = None,
-                  confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> pd.DataFrame:
+                  confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
+                  random_files: Iterable[PathLike] | None = None) -> pd.DataFrame:
     """Numbers behind Figure 6: per variant and evaluation step, the mean success rate over seeds and a
     percentile bootstrap band over seeds (NaN where fewer than 2 seeds were evaluated at that step).
 
     Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
+    ``random_files``: per-episode CSVs of the random searcher (``.../seed{N}/...``); their pooled
+    success rate and Wilson interval become rows of variant :data:`RANDOM`, one at every step of the
+    curves (it does not train: the same level throughout).
     """
     labels = {**FIG6_LABELS, **(labels or {})}
     if not curves:
@@ -107,11 +114,22 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
             lo, hi = bootstrap_ci(v, np.mean, confidence, n_resamples, seed) if v.size >= 2 else (math.nan, math.nan)
             rows.append({"variant": variant, "label": labels.get(variant, variant), "env_steps": int(step),
                          "n_seeds": int(v.size), "success_rate": float(v.mean()), "low": lo, "high": hi})
+    random_files = list(random_files or [])
+    if random_files:
+        if RANDOM in curves:
+            raise ValueError(f"figure6: a variant may not be called {RANDOM!r}, the random searcher's row")
+        eps = read_episodes(random_files)
+        k, n = int(eps["success"].astype(int).sum()), len(eps)
+        lo, hi = wilson_ci(k, n, confidence)
+        for step in sorted({r["env_steps"] for r in rows}):
+            rows.append({"variant": RANDOM, "label": RANDOM_LABEL, "env_steps": step,
+                         "n_seeds": int(eps["seed"].nunique()), "success_rate": k / n, "low": lo, "high": hi})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
 
 
 def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,
-            confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> list[Path]:
+            confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
+            random_files: Iterable[PathLike] | None = None) -> list[Path]:
     """Figure 6: evaluation success rate vs environment steps, one line per variant (mean over seeds) with a
     bootstrap band over seeds where at least 2 seeds were evaluated.
 
@@ -119,14 +137,19 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     ``head_on`` -> "with head movement", ``head_off`` -> "without head movement"). Writes
     ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (the plotted numbers; a directory
     prefix gets ``fig6.*``) and returns the paths. ValueError on no curves / no evaluated rows.
+    ``random_files`` (see :func:`figure6_frame`) add the random searcher as a dashed line.
     """
-    df = figure6_frame(curves, labels, confidence, n_resamples, seed)
+    df = figure6_frame(curves, labels, confidence, n_resamples, seed, random_files=random_files)
     base = output_base(out_prefix, "fig6")
     df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(3.5, 2.5))
         ax = fig.add_subplot()
-        for i, (_variant, g) in enumerate(df.groupby("variant", sort=False)):
+        level = df[df["variant"] == RANDOM]
+        if not level.empty:
+            ax.axhline(level["success_rate"].iloc[0], color="#555555", linestyle="--", linewidth=1.1,
+                       label=RANDOM_LABEL)
+        for i, (_variant, g) in enumerate(df[df["variant"] != RANDOM].groupby("variant", sort=False)):
             colour = OKABE_ITO[i % len(OKABE_ITO)]
             x, y = g["env_steps"].to_numpy(), g["success_rate"].to_numpy()
             n_seeds = int(g["n_seeds"].max())

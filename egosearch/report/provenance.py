@@ -1,4 +1,5 @@
-"""Where results came from: commit, profile, machine, date and the wall time of every rule.
+"""Where results came from: commit, profile, machine, date and the wall time of every rule, and
+the sha256 of every stored result file, so that a file edited or truncated by hand is caught.
 
 Reads the ``benchmark:`` files Snakemake writes per job (tab-separated, seconds in column ``s``).
 """
@@ -7,10 +8,12 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import hashlib
 import json
 import os
 import platform
 import subprocess
+from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
@@ -54,6 +57,41 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
     return rows
 
 
+PROVENANCE_NAME = "provenance.json"
+NOT_RESULTS = ("logs", "benchmarks")
+"""Top-level folders of ``results/<profile>/`` that hold no results (job logs and timings)."""
+WORK_PARTS = ("ckpt", "partial")
+"""Folders of a run in progress (checkpoints, a training not yet finished): never a stored result."""
+
+
+def stored_files(results: Path) -> list[Path]:
+    """Every result file under ``results``: what the tables, figures and comparisons read (scenario
+    sets, evaluations, curves, full-body runs, comparisons) and the rest of each run (actor.pt...)."""
+    results = Path(results)
+    out = []
+    for path in sorted(results.rglob("*")):
+        rel = path.relative_to(results)
+        if (not path.is_file() or rel.parts[0] in NOT_RESULTS or rel == Path(PROVENANCE_NAME)
+                or any(part in WORK_PARTS for part in rel.parts[:-1]) or path.name.startswith(".")):
+            continue
+        out.append(path)
+    return out
+
+
+def file_record(path: Path) -> dict:
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return {"sha256": digest.hexdigest(), "bytes": Path(path).stat().st_size}
+
+
+def record_files(results: Path) -> dict[str, dict]:
+    """``{path relative to results: {sha256, bytes}}`` of :func:`stored_files`."""
+    results = Path(results)
+    return {path.relative_to(results).as_posix(): file_record(path) for path in stored_files(results)}
+
+
 def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> dict:
     results = Path(results)
     jobs = rule_times(results / "benchmarks")
@@ -72,6 +110,7 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
         "wall_s_per_rule_summed": per_rule,
         "wall_s_all_jobs_summed": round(sum(per_rule.values()), 1),
         "jobs": jobs,
+        "files": record_files(results),
     }
     if note:
         record["note"] = note
@@ -81,3 +120,92 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
     tmp.write_text(json.dumps(record, indent=2) + "\n")
     os.replace(tmp, out)
     return record
+
+
+# --------------------------------------------------------------------------------------------- verify
+class StoredFileError(ValueError):
+    """A stored result file differs from the sha256 its provenance recorded."""
+
+
+def _provenance_of(path: Path) -> Path | None:
+    """The nearest ``provenance.json`` above ``path``: the record of the results folder it is in."""
+    for folder in Path(path).resolve().parents:
+        candidate = folder / PROVENANCE_NAME
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _load_record(provenance: Path) -> dict[str, dict] | None:
+    try:
+        record = json.loads(Path(provenance).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as err:
+        raise StoredFileError(f"cannot read {provenance}: {err}") from None
+    files = record.get("files")
+    return files if isinstance(files, dict) else None
+
+
+def file_problem(path: Path, recorded: dict | None, provenance: Path) -> str | None:
+    """What is wrong with ``path`` against its record, in words; None when it matches."""
+    if recorded is None:
+        return f"{path} is not in the sha256 list of {provenance} (written after it?)"
+    if not Path(path).is_file():
+        return f"{path} is missing (recorded in {provenance})"
+    now = file_record(path)
+    if now["sha256"] == recorded.get("sha256"):
+        return None
+    if now["bytes"] < int(recorded.get("bytes", 0)):
+        return f"{path} was truncated: {now['bytes']} bytes, {recorded['bytes']} recorded in {provenance}"
+    return f"{path} was edited: its sha256 differs from the one recorded in {provenance}"
+
+
+def check_stored(paths: Iterable[str | os.PathLike], require_record: bool = True) -> list[str]:
+    """Raise :class:`StoredFileError` (one line) if a file differs from the sha256 that the
+    provenance of its results folder recorded. ``require_record``: a file the record does not list
+    is an error too (a stored result read by a table); else it passes (a comparison's new candidate).
+    Returns the provenance files that vouched for nothing, i.e. results folders without a record."""
+    problems, unrecorded, cache = [], [], {}
+    for path in map(Path, paths):
+        provenance = _provenance_of(path)
+        if provenance is None:
+            unrecorded.append(str(path))
+            continue
+        if provenance not in cache:
+            cache[provenance] = _load_record(provenance)
+        files = cache[provenance]
+        if files is None:
+            unrecorded.append(str(path))
+            continue
+        key = path.resolve().relative_to(provenance.parent.resolve()).as_posix()
+        if key not in files and not require_record:
+            continue
+        problem = file_problem(path, files.get(key), provenance)
+        if problem:
+            problems.append(problem)
+    if problems:
+        more = f" ({len(problems) - 1} more file(s) too)" if len(problems) > 1 else ""
+        raise StoredFileError(f"{problems[0]}{more}; refusing to use stored results that differ from their "
+                              "record: restore them (git checkout), or rerun the jobs that write them and then "
+                              "the `provenance` rule; `egosearch report verify` lists every file")
+    return unrecorded
+
+
+def verify(results: Path) -> tuple[int, list[str]]:
+    """(files that match, problems): every file recorded in ``results/provenance.json`` is there with
+    its sha256, and every stored file is recorded."""
+    results = Path(results)
+    provenance = results / PROVENANCE_NAME
+    if not provenance.is_file():
+        raise FileNotFoundError(f"{provenance} not found: nothing to verify against")
+    files = _load_record(provenance)
+    if files is None:
+        raise StoredFileError(f"{provenance} has no sha256 list (written before records had one): rerun the "
+                              "`provenance` rule to write one")
+    problems, ok = [], 0
+    for rel in sorted(set(files) | {p.relative_to(results).as_posix() for p in stored_files(results)}):
+        problem = file_problem(results / rel, files.get(rel), provenance)
+        if problem:
+            problems.append(problem)
+        else:
+            ok += 1
+    return ok, problems

@@ -87,3 +87,23 @@ def compare_candidate(wildcards):
         raise ValueError("compare needs a variant: snakemake compare --config variant=NAME")
     load_variant(config["variant"])
     return eval_files(config["variant"])
+
+
+# The floor and the ceiling of Table 1 on the very scenario sets the policies are evaluated on.
+# Their CSVs sit beside the variants' (eval/random, eval/oracle): a variant may not take those names.
+BOUNDS = ["random", "oracle"]
+# One seed: the oracle is deterministic, and the random searcher's spread over 100 scenarios per
+# cell is far wider than its spread over seeds.
+BOUND_SEEDS = [0]
+
+
+def bound_files(bounds=BOUNDS, placements=None):
+    return expand(f"{RESULTS}/eval/{{bound}}/seed{{seed}}/{LAYOUT}/{{placement}}/h{{height}}.csv",
+                  bound=bounds, seed=BOUND_SEEDS, placement=placements or PLACEMENTS, height=HEIGHTS)
+
+
+def fig6_random_files():
+    """The random searcher on the Table 1 cells of the placement scheme the reference trains and
+    is evaluated in during training (Figure 6's curves): its level in that figure."""
+    placement = VARIANTS[REF].train_env["placement"]
+    return bound_files(["random"], [placement]) if placement in PLACEMENTS else []

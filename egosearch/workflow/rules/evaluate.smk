@@ -18,3 +18,30 @@ rule evaluate:
     shell:
         "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in common.smk), not variants.
+ruleorder: bound > evaluate
+
+
+rule bound:
+    """The random searcher or the privileged oracle (it knows the target) on one Table 1 cell."""
+    input:
+        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+    output:
+        "results/{profile}/eval/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    wildcard_constraints:
+        bound="random|oracle",
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --policy {wildcards.bound} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output} > {log} 2>&1"

@@ -1,9 +1,11 @@
 # Tables and figures: CSV in, files out; seconds, no torch, no simulator.
 
 rule table1:
-    """Success rate per camera height x placement scheme, pooled over seeds (paper Table 1)."""
+    """Success rate per camera height x placement scheme, pooled over seeds (paper Table 1), with
+    the random searcher and the privileged oracle on the same scenarios."""
     input:
-        ancient(eval_files(REF)),
+        policy=ancient(eval_files(REF)),
+        bounds=ancient(bound_files()),
     output:
         expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
     log:
@@ -16,7 +18,8 @@ rule table1:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table1 {input} --variant {params.variant} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report table1 {input.policy} --variant {params.variant} --bounds {input.bounds} "
+        "--out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule table2:
@@ -53,9 +56,11 @@ rule table2_paper:
 
 
 rule fig6:
-    """Success rate vs environment steps, head on vs head off (paper Figure 6)."""
+    """Success rate vs environment steps, head on vs head off (paper Figure 6); the random
+    searcher a dashed line."""
     input:
-        ancient([curve_files(v) for v in VARIANTS]),
+        curves=ancient([curve_files(v) for v in VARIANTS]),
+        random=ancient(fig6_random_files()),
     output:
         expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
@@ -67,7 +72,7 @@ rule fig6:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig6 {input} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report fig6 {input.curves} --random {input.random} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig7:
@@ -140,8 +145,12 @@ rule compare:
 
 
 rule provenance:
-    """Commit, profile, machine, date and the wall time of every rule, next to the results."""
+    """Commit, profile, machine, date, the wall time of every rule and the sha256 of every stored
+    result file, next to the results. Every result of `all` is an input, so that the record is
+    rewritten whenever one of them is."""
     input:
+        ancient([eval_files(v) for v in VARIANTS]),
+        ancient(bound_files()),
         rules.table1.output,
         rules.table2.output,
         rules.fig6.output,

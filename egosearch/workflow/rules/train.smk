@@ -1,5 +1,7 @@
 rule train:
-    """SAC+CURL on the abstract searcher (paper 4.2). Resumes from its checkpoint if killed."""
+    """SAC+CURL on the abstract searcher (paper 4.2). Trains in partial/ (checkpoint and growing
+    CSVs, which Snakemake does not delete when it reruns a killed job), resumes there if killed, and
+    publishes the outputs only when the run is complete."""
     output:
         actor="results/{profile}/train/{variant}/seed{seed}/actor.pt",
         curve="results/{profile}/train/{variant}/seed{seed}/curve.csv",
@@ -10,6 +12,7 @@ rule train:
     params:
         learner=lambda wc: config["profiles"][wc.profile]["learner"],
         out_dir=lambda wc, output: str(Path(output.actor).parent),
+        work_dir=lambda wc, output: str(Path(output.actor).parent / "partial"),
     threads: 1
     resources:
         **train_resources(PROFILE),
@@ -17,4 +20,4 @@ rule train:
         CONDA_ENV
     shell:
         "egosearch train --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--threads {threads} --out-dir {params.out_dir} > {log} 2>&1"
+        "--threads {threads} --work-dir {params.work_dir} --out-dir {params.out_dir} > {log} 2>&1"
