@@ -67,9 +67,15 @@ def test_smoke_table1_end_to_end(checkout):
     out = run(["--cores", "2", "table1", "--config", "profile=smoke"], cwd=checkout, timeout=900)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     md = (checkout / "paper_figs/smoke/table1.md").read_text()
-    assert "paper 0.92" in md and "0.45m" in md
+    assert "| 1.05m | paper | 0.92 | 0.75 |" in md and "| 0.45m | ours (head_on) | " in md
     evals = sorted((checkout / "results/smoke/eval/head_on/seed0/kitchen_living").rglob("h*.csv"))
     assert len(evals) == 6
+    # The bounds ran on the same scenario sets, and Table 1 shows them: the oracle finds targets.
+    for bound in ("random", "oracle"):
+        assert len(list((checkout / f"results/smoke/eval/{bound}/seed0/kitchen_living").rglob("h*.csv"))) == 6
+    table = pd.read_csv(checkout / "paper_figs/smoke/table1.csv")
+    assert (table["oracle_n_episodes"] == 4).all() and table["oracle_success_rate"].mean() > 0.5
+    assert "not run" not in md
     # The scenario sets are fixed: the same rows on a second generation.
     scen = checkout / "results/smoke/scenarios/kitchen_living/everywhere/h1.65.csv"
     again = subprocess.run(["egosearch", "scenarios", "--placement", "everywhere", "--height", "1.65", "--n", "4",
