@@ -5,9 +5,14 @@
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
 from snakemake.utils import min_version, validate
 
+from egosearch.workflow_check import checked_variants
+
 min_version("9.0")
 
 configfile: "egosearch/workflow/config.yaml"
+# A bad key or value, or a typo in a variant's name or file (its learner fields included), is one
+# line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
+CHECKED_VARIANTS = checked_variants(config)
 validate(config, "egosearch/workflow/config.schema.json")
 
 include: "egosearch/workflow/rules/common.smk"

@@ -14,6 +14,8 @@ import sys
 def _cmd_scenarios(args) -> None:
     from egosearch.scenarios import generate_scenarios, write_scenarios
 
+    if args.n < 1:
+        raise ValueError(f"--n={args.n}: a scenario set needs at least 1 scenario")
     scenarios = generate_scenarios(args.layout, args.placement, args.height, args.n, args.seed,
                                    progress=True)
     write_scenarios(args.out, scenarios)
@@ -51,12 +53,15 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int):
 
 def _cmd_evaluate(args) -> None:
     _acting_threads(args.threads)
+    from egosearch.envs import ENV_IDS
     from egosearch.evaluate import evaluate, write_episodes
     from egosearch.metrics import spl
     from egosearch.scenarios import read_scenarios
 
-    scenarios = read_scenarios(args.scenarios)
+    if args.env_id and args.env_id not in ENV_IDS:
+        raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
     make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
+    scenarios = read_scenarios(args.scenarios)
     env_id = args.env_id or env_id
     rows = evaluate(env_id, make_policy, scenarios, seed=args.seed, progress=True,
                     desc=f"evaluate {args.policy} on {env_id}")
@@ -131,8 +136,6 @@ def _cmd_report(args) -> None:
     elif args.what == "fig7":
         report.cmd_fig7(args.files, args.out_prefix, planner=args.planner)
     elif args.what == "compare":
-        if not args.reference or not args.candidate:
-            raise ValueError("compare needs --reference CSV... and --candidate CSV...")
         report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
                            candidate_name="candidate")
     elif args.what == "provenance":
@@ -249,103 +252,176 @@ def _cmd_pictures(args) -> None:
         print(path)
 
 
+def _cmd_variant(args) -> None:
+    from egosearch.variants import check_learner_config, load_variant, new_variant
+
+    if args.what == "new":
+        path = new_variant(args.name, template=args.template)
+        print(f"wrote {path}: edit it, then `snakemake --cores 2 compare --config variant={args.name}`")
+        return
+    for name in args.names:
+        variant = load_variant(name)
+        for profile in args.profile:
+            check_learner_config(variant, profile)
+        print(f"{variant.path}: valid at the {', '.join(args.profile)} learner profile(s)")
+
+
+def _report_parsers(sub) -> None:
+    """One sub-command per report, each with its own options and ``--help``."""
+    p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
+    reports = p.add_subparsers(dest="what", required=True, metavar="REPORT")
+    profile = dict(default="cpu", help="profile: smoke, cpu or paper (default: cpu)")
+    prefix = "output path without extension, or a folder (writes {})"
+
+    r = reports.add_parser("table1", help="Table 1 (success per height and placement) from evaluation CSVs")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{layout}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .csv and .tex"))
+    r.add_argument("--variant", help="the variant of the files (default: read from their paths)")
+    r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the random searcher and the oracle "
+                                               "(.../eval/{random,oracle}/...): rows that bound the policy")
+
+    r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md and .tex"))
+
+    r = reports.add_parser("fig6", help="Figure 6 (success vs env steps) from training curves")
+    r.add_argument("files", nargs="+", help="curve.csv files: .../train/{variant}/seed{seed}/curve.csv")
+    r.add_argument("--random", nargs="*", help="evaluation CSVs of the random searcher: its level, dashed")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+
+    r = reports.add_parser("fig7", help="Figure 7 (SPL and attempts per method) from full-body CSVs")
+    r.add_argument("files", nargs="+", help="full-body CSVs: .../{setting}/seed{seed}.csv")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+    r.add_argument("--planner", default="actor", choices=("actor", "oracle"),
+                   help="which planner drove the full-body runs (oracle figures say so in a title)")
+
+    r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell")
+    r.add_argument("--reference", nargs="+", required=True, help="the reference variant's evaluation CSVs")
+    r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
+    r.add_argument("--out", help="write the comparison to this CSV as well as printing it")
+
+    r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
+    r.add_argument("--out", required=True, help="the provenance JSON to write")
+    r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
+
+    r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a profile (seconds)")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--variant", help="the variant of Table 1 (default: the workflow config's reference_variant)")
+
+    r = reports.add_parser("verify", help="check every stored result file against the sha256 in its provenance")
+    r.add_argument("--profile", **profile)
+
+    r = reports.add_parser("readme", help="rewrite the README's results blocks from the stored results")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--readme", default="README.md", help="the file whose marked blocks are rewritten (default: "
+                                                         "README.md)")
+    r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")
+    p.set_defaults(func=_cmd_report)
+
+
 def build_parser() -> argparse.ArgumentParser:
+    from egosearch.agent import EVAL_HEIGHTS, HEIGHT_RANGE
     from egosearch.scene.layouts import LAYOUT_NAMES
     from egosearch.scene.placement import PLACEMENT_SCHEMES
 
     parser = argparse.ArgumentParser(prog="egosearch", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
+    layouts = f"{', '.join(LAYOUT_NAMES)} or home<seed> (a generated home)"
+    threads = "torch threads for acting (default 1; 0: all cores)"
+    policy_seed = "seed of the random policy and of the env's per-step noise (default 0)"
 
     p = sub.add_parser("scenarios", help="generate a fixed scenario set as CSV")
-    p.add_argument("--layout", default="kitchen_living", help=f"{', '.join(LAYOUT_NAMES)} or home<seed>")
-    p.add_argument("--placement", default="everywhere", choices=PLACEMENT_SCHEMES)
-    p.add_argument("--height", type=float, default=1.65, help="camera height (m)")
-    p.add_argument("--n", type=int, default=100)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True)
+    p.add_argument("--layout", default="kitchen_living", help=f"home: {layouts}")
+    p.add_argument("--placement", default="everywhere", choices=PLACEMENT_SCHEMES,
+                   help="where targets may be: every support surface, or none inside low cabinets")
+    p.add_argument("--height", type=float, default=1.65,
+                   help=f"camera height (m): any value in [{HEIGHT_RANGE[0]}, {HEIGHT_RANGE[1]}] is a valid "
+                        f"experiment; Table 1 uses {', '.join(f'{h:g}' for h in EVAL_HEIGHTS)} (default 1.65)")
+    p.add_argument("--n", type=int, default=100, help="number of scenarios (default 100)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the set: the same seed gives the same rows")
+    p.add_argument("--out", required=True, help="the scenario CSV to write")
     p.set_defaults(func=_cmd_scenarios)
 
     p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
-    p.add_argument("--scenarios", required=True)
-    p.add_argument("--policy", default="actor", help="actor, oracle or random")
-    p.add_argument("--weights", help="actor.pt written by training (for --policy actor)")
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
+                                                     "target) or random")
+    p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor)")
     p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True)
-    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
+    p.add_argument("--seed", type=int, default=0, help=policy_seed)
+    p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
+    p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_evaluate)
 
     p = sub.add_parser("train", help="train a variant's search policy with SAC+CURL (resumable)")
     p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...)")
-    p.add_argument("--profile", default="cpu", help="smoke, cpu or paper")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--profile", default="cpu", help="learner profile: smoke, cpu or paper (default: cpu)")
+    p.add_argument("--seed", type=int, default=0, help="training seed (default 0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
-    p.add_argument("--out-dir", required=True)
+    p.add_argument("--out-dir", required=True, help="run folder: actor.pt, curve.csv, train.csv, checkpoint; "
+                                                    "rerun with the same folder to resume")
     p.add_argument("--work-dir", help="train (and resume) here, and copy the files to --out-dir only once the run "
                                       "is complete (the DAG does: a killed job never leaves a partial output)")
     p.set_defaults(func=_cmd_train)
 
+    p = sub.add_parser("variant", help="create a variant file in ablations/ from a template, or check variants")
+    variants = p.add_subparsers(dest="what", required=True, metavar="ACTION")
+    v = variants.add_parser("new", help="write ablations/NAME.yaml, a copy of a template with name: NAME")
+    v.add_argument("name", help="the new variant's name (letters, digits, _ and -)")
+    v.add_argument("--from", dest="template", default="head_on", help="the variant to copy (default: head_on)")
+    v = variants.add_parser("check", help="check variant files, learner config included, before running them")
+    v.add_argument("names", nargs="+", help="variant names (files in ablations/) or paths of .yaml files")
+    v.add_argument("--profile", nargs="+", default=["smoke", "cpu", "paper"],
+                   help="learner profiles to check the config against (default: all three)")
+    p.set_defaults(func=_cmd_variant)
+
     p = sub.add_parser("fullbody", help="full-body search (Algorithm 1 or a baseline) -> per-episode CSV")
     p.add_argument("--setting", required=True,
-                   help="ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> or noisy_search-<mg>")
+                   help="ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> or noisy_search-<mg>; "
+                        "<mg>: humanoid_phase, humanoid_matching or fetch")
     p.add_argument("--policy", default="actor",
                    help="the planner: actor (with --weights), or oracle (privileged: knows the target) or random")
     p.add_argument("--weights", help="actor.pt of the search policy (for --policy actor)")
-    p.add_argument("--scenarios", required=True)
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--limit", type=int, default=0, help="use the first N scenarios (0: all)")
-    p.add_argument("--T", type=int, default=20, help="planning horizon")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True)
-    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
+    p.add_argument("--T", type=int, default=20, help="planning horizon (default 20)")
+    p.add_argument("--seed", type=int, default=0, help=policy_seed)
+    p.add_argument("--out", required=True, help="the per-episode CSV to write")
+    p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_fullbody)
 
     p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics) or learner")
-    p.add_argument("what", choices=("env", "learner"))
-    p.add_argument("--layout", default="kitchen_living")
-    p.add_argument("--frames", type=int, default=3000)
-    p.add_argument("--steps", type=int, default=3000)
+    p.add_argument("what", choices=("env", "learner"), help="env: sensor frames/s and env steps/s on one core; "
+                                                            "learner: SAC+CURL updates/s")
+    p.add_argument("--layout", default="kitchen_living", help=f"env: the home ({layouts})")
+    p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
+    p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_bench)
 
     p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
     p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch")
-    p.add_argument("--scenarios", required=True)
-    p.add_argument("--scenario-id", type=int, default=0)
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    p.add_argument("--scenario-id", type=int, default=0, help="the scenario_id of the row to search (default 0)")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
     p.add_argument("--weights", help="actor.pt of the search policy")
     p.add_argument("--M", type=int, default=5, help="steps executed per plan")
     p.add_argument("--T", type=int, default=20, help="planning horizon")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help=policy_seed)
     p.add_argument("--out", required=True, help=".mp4 or .gif")
     p.add_argument("--still", required=True, help=".png of the moment the target is found")
-    p.add_argument("--threads", type=int, default=1, help="torch threads for acting (0: all cores)")
+    p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_video)
 
-    p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
-    p.add_argument("what", choices=("table1", "table2", "fig6", "fig7", "compare", "provenance", "regenerate",
-                                    "readme", "verify"))
-    p.add_argument("files", nargs="*", help="input CSVs (table1: evaluation CSVs; fig6: curve.csv; fig7: full-body)")
-    p.add_argument("--out-prefix", help="output path without extension")
-    p.add_argument("--bounds", nargs="*", help="table1: evaluation CSVs of the random searcher and the oracle")
-    p.add_argument("--random", nargs="*", help="fig6: evaluation CSVs of the random searcher (a dashed level)")
-    p.add_argument("--variant", help="table1/regenerate: the variant of the evaluation CSVs (regenerate: default "
-                                     "the config's reference)")
-    p.add_argument("--profile", default="cpu", help="table2/provenance/regenerate/readme: smoke, cpu or paper")
-    p.add_argument("--reference", nargs="*", help="compare: the reference variant's evaluation CSVs")
-    p.add_argument("--candidate", nargs="*", help="compare: the new variant's evaluation CSVs")
-    p.add_argument("--results", default="results/cpu", help="provenance: the results folder")
-    p.add_argument("--out", help="compare/provenance: output file")
-    p.add_argument("--note", help="provenance: free text kept in the record (e.g. how the run was resumed)")
-    p.add_argument("--planner", default="actor", choices=("actor", "oracle"),
-                   help="fig7: which planner drove the full-body runs (oracle figures say so in a title)")
-    p.add_argument("--readme", default="README.md", help="readme: the file whose marked results blocks are rewritten")
-    p.add_argument("--check", action="store_true", help="readme: only check that the blocks are up to date")
-    p.set_defaults(func=_cmd_report)
+    _report_parsers(sub)
 
     p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")
-    p.add_argument("--layout", default="kitchen_living")
-    p.add_argument("--out-dir", default="paper_figs/world")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--layout", default="kitchen_living", help=f"home: {layouts}")
+    p.add_argument("--out-dir", default="paper_figs/world", help="folder of the PNGs (default: paper_figs/world)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the placement examples (default 0)")
     p.set_defaults(func=_cmd_pictures)
     return parser
 

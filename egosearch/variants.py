@@ -7,8 +7,10 @@ typo is one clear line before any job starts.
 
 from __future__ import annotations
 
+import difflib
 import json
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import yaml
@@ -34,6 +36,8 @@ class Variant:
     config: dict = field(default_factory=dict)
     """Learner config overrides on top of the profile."""
     description: str = ""
+    path: str = ""
+    """The file it was read from (for messages)."""
 
 
 def variant_names(directory: Path = ABLATIONS_DIR) -> list[str]:
@@ -43,23 +47,37 @@ def variant_names(directory: Path = ABLATIONS_DIR) -> list[str]:
 def _resolve(name_or_path: str | Path, directory: Path) -> Path:
     path = Path(name_or_path)
     if path.suffix in (".yaml", ".yml") and path.exists():
-        return path
+        return _shown(path)
     candidate = Path(directory) / f"{name_or_path}.yaml"
     if not candidate.exists():
         raise VariantError(f"variant={str(name_or_path)!r} is unknown; allowed: "
-                           f"{', '.join(variant_names(directory))} (files in {directory})")
-    return candidate
+                           f"{', '.join(variant_names(directory))} (files in {_shown(Path(directory))})")
+    return _shown(candidate)
+
+
+def _shown(path: Path) -> Path:
+    """``path`` relative to the working directory when it is under it: messages say ablations/x.yaml."""
+    try:
+        return path.resolve().relative_to(Path.cwd().resolve())
+    except ValueError:
+        return path
 
 
 def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> Variant:
-    """The variant named ``name`` (``ablations/<name>.yaml``) or stored at a path."""
+    """The variant named ``name`` (``ablations/<name>.yaml``) or stored at a path.
+
+    Its ``config`` is checked against ``SacCurlConfig`` here (names and types): a typo fails on
+    reading, wherever a variant is read, not when a training job builds its config."""
     import jsonschema
 
     path = _resolve(name_or_path, directory)
     try:
         data = yaml.safe_load(path.read_text())
     except yaml.YAMLError as err:
-        raise VariantError(f"{path}: not valid YAML ({str(err).splitlines()[0]})") from None
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise VariantError(f"{path}: not valid YAML{where} ({problem})") from None
     schema = json.loads(SCHEMA_PATH.read_text())
     try:
         jsonschema.validate(data, schema)
@@ -68,5 +86,78 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
         raise VariantError(f"{path}: {where}: {err.message}") from None
     if data["name"] != path.stem:
         raise VariantError(f"{path}: name={data['name']!r} must equal the file name {path.stem!r}")
+    _check_objects(data["train_env"].get("objects") or [], path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),
-                   config=dict(data.get("config") or {}), description=data.get("description", ""))
+                   config=_learner_overrides(data.get("config") or {}, path),
+                   description=data.get("description", ""), path=str(path))
+
+
+def check_learner_config(variant: Variant, learner_profile: str) -> None:
+    """The variant's overrides on top of ``learner_profile`` give a valid learner config (ranges and
+    cross-field rules such as ``crop_size <= image_size``), else one-line ``VariantError``."""
+    from egosearch.rl.config import load_config
+
+    try:
+        load_config(learner_profile, variant.config)
+    except ValueError as err:
+        raise VariantError(f"{variant.path or variant.name}: config (on the {learner_profile} learner profile): "
+                           f"{err}") from None
+
+
+def _learner_overrides(config: dict, path: Path) -> dict:
+    """``config`` checked field by field against ``SacCurlConfig``. PyYAML reads ``1e-4`` (no dot)
+    as a string, so a float field also takes a string that reads as a finite number."""
+    from egosearch.rl.config import SacCurlConfig
+
+    kinds = {f.name: f.type for f in fields(SacCurlConfig)}
+    out = {}
+    for key, value in config.items():
+        if key not in kinds:
+            close = difflib.get_close_matches(str(key), kinds, n=1)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            raise VariantError(f"{path}: config: {key!r} is not a SacCurlConfig field{hint}")
+        kind = kinds[key]
+        if kind == "float" and isinstance(value, str):
+            try:
+                value = float(value)
+            except ValueError:
+                pass
+        expected = {"int": int, "float": (int, float), "str": str, "bool": bool}.get(kind)
+        if expected is not None and (isinstance(value, bool) and kind != "bool" or not isinstance(value, expected)):
+            raise VariantError(f"{path}: config: {key}={value!r} is not {'an' if kind == 'int' else 'a'} {kind}")
+        if kind == "float" and not math.isfinite(value):
+            raise VariantError(f"{path}: config: {key}={value!r} is not a finite number")
+        out[key] = value
+    return out
+
+
+def _check_objects(names: list[str], path: Path) -> None:
+    if not names:
+        return
+    from egosearch.scene.objects import TARGET_OBJECTS
+
+    unknown = [n for n in names if n not in TARGET_OBJECTS]
+    if unknown:
+        raise VariantError(f"{path}: train_env/objects: {', '.join(map(repr, unknown))} unknown; "
+                           f"allowed: {', '.join(sorted(TARGET_OBJECTS))}")
+
+
+def new_variant(name: str, template: str = "head_on", directory: Path = ABLATIONS_DIR) -> Path:
+    """Write ``<directory>/<name>.yaml``: a copy of ``template`` with ``name:`` set, ready to edit."""
+    import re
+
+    if not re.fullmatch(r"[A-Za-z0-9_\-]+", name):
+        raise VariantError(f"variant name {name!r}: use letters, digits, '_' and '-' only (it names output folders)")
+    path = _shown(Path(directory) / f"{name}.yaml")
+    if path.exists():
+        raise VariantError(f"{path} exists already; edit it, or choose another name")
+    base = load_variant(template, directory)
+    data = {"name": name, "description": f"{template} with ... (say what this variant changes)",
+            "env_id": base.env_id, "train_env": base.train_env, "config": base.config}
+    path.write_text(
+        f"# A variant of {template}: edit what differs. env_id: EgoSearch-v0 (head on) or EgoSearchNoHead-v0;\n"
+        "# train_env: the training home and placement scheme; config: SacCurlConfig fields\n"
+        "# (egosearch/rl/config.py) overridden on top of the profile.\n"
+        + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
+    load_variant(path)
+    return path

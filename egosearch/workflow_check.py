@@ -1,0 +1,102 @@
+"""What the Snakefile checks before it builds the DAG: the config against its schema, and every
+variant the run names. A problem is one line on stderr and exit status 1, not a Snakemake
+traceback (an error raised inside an input function reaches the user as an
+``InputFunctionException`` with a traceback, after the DAG banner).
+
+Snakemake reads ``--config key=[a,b]`` list items as strings; where the schema asks for a number,
+a string that reads as one is taken as that number, so ``--config 'heights=[1.05]'`` works.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
+
+SCHEMA_PATH = Path(__file__).resolve().parent / "workflow" / "config.schema.json"
+
+
+class ConfigError(ValueError):
+    """A workflow config that does not validate; the message is one line naming the key."""
+
+
+def _number(value, kind: str):
+    if not isinstance(value, str):
+        return value
+    try:
+        number = float(value)
+    except ValueError:
+        return value
+    if kind == "integer":
+        return int(number) if number.is_integer() else value
+    return number
+
+
+def coerce_numbers(value, schema: dict, root: dict | None = None):
+    """``value`` with every string that the schema wants as a number read as one (lists and
+    objects walked, ``$ref`` into ``$defs`` followed)."""
+    root = root or schema
+    if "$ref" in schema:
+        schema = root["$defs"][schema["$ref"].rsplit("/", 1)[-1]]
+    kind = schema.get("type")
+    if kind in ("number", "integer"):
+        return _number(value, kind)
+    if isinstance(value, list) and "items" in schema:
+        return [coerce_numbers(v, schema["items"], root) for v in value]
+    if isinstance(value, dict):
+        out = {}
+        for key, v in value.items():
+            sub = schema.get("properties", {}).get(key)
+            if sub is None:
+                sub = next((s for pattern, s in schema.get("patternProperties", {}).items()
+                            if re.search(pattern, key)), None)
+            out[key] = coerce_numbers(v, sub, root) if sub is not None else v
+        return out
+    return value
+
+
+def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
+    """Coerce numbers in place, then validate; ``ConfigError`` names the key and the value."""
+    import jsonschema
+
+    schema = json.loads(Path(schema_path).read_text())
+    config.update(coerce_numbers(dict(config), schema))
+    try:
+        jsonschema.validate(config, schema)
+    except jsonschema.ValidationError as err:
+        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
+        raise ConfigError(f"config {where}: {err.message}") from None
+
+
+def workflow_variants(config: dict, compare: bool = False, directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
+    """Every variant the run may train, read and checked against the run's learner profile:
+    ``variants``, ``reference_variant``, the profile's ``budget`` variants and, when set (or when
+    ``compare`` is a target), ``variant``."""
+    budget = config["profiles"][config["profile"]].get("budget", {}).get("variants", [])
+    names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget))
+    if compare and not config.get("variant"):
+        raise VariantError("compare needs a variant: snakemake --cores 2 compare --config variant=NAME")
+    if config.get("variant"):
+        names = list(dict.fromkeys(names + [config["variant"]]))
+    learner = config["profiles"][config["profile"]]["learner"]
+    variants = {}
+    for name in names:
+        variants[name] = load_variant(name, directory)
+        check_learner_config(variants[name], learner)
+    return variants
+
+
+def checked_variants(config: dict, argv: list[str] | None = None,
+                     directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
+    """For the Snakefile: check the config and the variants, or print one line and exit 1.
+    ``compare`` among the command's targets makes ``variant`` required."""
+    argv = sys.argv[1:] if argv is None else argv
+    try:
+        check_config(config)
+        return workflow_variants(config, compare="compare" in argv, directory=directory)
+    except (ConfigError, VariantError) as err:
+        print(f"egosearch: error: {err}", file=sys.stderr)
+        sys.exit(1)
