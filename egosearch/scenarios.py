@@ -4,7 +4,10 @@ A scenario fixes everything an episode depends on (home, start pose, target obje
 camera height, placement scheme), so that every policy is evaluated on the same 100 (paper
 6.1). It also stores ℓ, the geodesic length from the start to the nearest body position that
 satisfies success (within :data:`SUCCESS_DISTANCE` of the target *and* seeing it at this
-camera height); scenarios with no such position within reach are rejected at generation.
+camera height). ℓ counts every position where the env may leave the body, in contact with
+furniture too, so that it is a lower bound on the path of every success, up to
+:data:`egosearch.navgrid.LOWER_BOUND_SLACK`. A scenario is kept only when the privileged oracle's
+route, through surely free cells, reaches a success within :data:`MAX_SHORTEST_PATH`.
 """
 
 from __future__ import annotations
@@ -36,8 +39,8 @@ MAX_STEPS = 100
 """T_max of paper 4.1."""
 
 MAX_SHORTEST_PATH = 0.6 * MAX_STEPS * AgentSpec().max_forward
-"""Longest accepted ℓ (m): 60% of what a body walking straight at full speed covers in
-T_max steps, leaving time to turn and look. Longer scenarios are rejected at generation."""
+"""Longest accepted route of the oracle (m): 60% of what a body walking straight at full speed
+covers in T_max steps, leaving time to turn and look. Longer scenarios are rejected at generation."""
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,7 @@ class Scenario:
     """Height of the target's bottom, i.e. of the surface it rests on (m)."""
     target_yaw: float
     shortest_path: float
-    """ℓ of SPL (m)."""
+    """ℓ of SPL (m): a lower bound on the path of any success (see :func:`shortest_path_length`)."""
 
     def target(self) -> Part:
         return target_part(get_object(self.target_object), self.target_x, self.target_y,
@@ -161,9 +164,9 @@ def target_probe_points(target: Part) -> np.ndarray:
 MIN_VISIBLE_PROBES = 2
 
 
-def visible_from(layout: str, cameras: np.ndarray, target: Part) -> np.ndarray:
-    """For each camera position (N x 3), whether straight lines reach at least
-    :data:`MIN_VISIBLE_PROBES` target probe points unblocked by the home."""
+def visible_from(layout: str, cameras: np.ndarray, target: Part, min_probes: int = MIN_VISIBLE_PROBES) -> np.ndarray:
+    """For each camera position (N x 3), whether straight lines reach at least ``min_probes``
+    target probe points unblocked by the home."""
     points = target_probe_points(target)
     origins = np.repeat(cameras, len(points), axis=0)
     ends = np.tile(points, (len(cameras), 1))
@@ -174,7 +177,7 @@ def visible_from(layout: str, cameras: np.ndarray, target: Part) -> np.ndarray:
     hit = np.full(len(origins), np.inf)
     hit[index_ray] = np.linalg.norm(locs - origins[index_ray], axis=1)
     clear = hit >= dist - 1e-3
-    return clear.reshape(len(cameras), len(points)).sum(axis=1) >= MIN_VISIBLE_PROBES
+    return clear.reshape(len(cameras), len(points)).sum(axis=1) >= min_probes
 
 
 def success_region(layout: str, target: Part, height: float, distance: float = SUCCESS_DISTANCE) -> np.ndarray:
@@ -189,6 +192,31 @@ def success_region(layout: str, target: Part, height: float, distance: float = S
     region = np.zeros_like(near)
     region[rows[seen], cols[seen]] = True
     return region
+
+
+def shortest_path_region(layout: str, target: Part, height: float, distance: float = SUCCESS_DISTANCE) -> np.ndarray:
+    """Grid cells holding at least one pose where the env might declare success: reachable by
+    the body (in contact with furniture too), some point of the cell within ``distance``, and
+    any probe point of the target in sight. Wider than :func:`success_region` on purpose:
+    ℓ measured to it must not exceed the path of any success."""
+    grid = navgrid_for(layout)
+    near = grid.touch_region(target.center[:2], distance)
+    rows, cols = np.nonzero(near)
+    if len(rows) == 0:
+        return near
+    cams = np.column_stack([grid.xs[cols], grid.ys[rows], np.full(len(rows), height)])
+    seen = visible_from(layout, cams, target, min_probes=1)
+    region = np.zeros_like(near)
+    region[rows[seen], cols[seen]] = True
+    return region
+
+
+def shortest_path_length(layout: str, target: Part, height: float, x: float, y: float) -> float:
+    """ℓ of SPL from a start at (x, y): a lower bound on the path of every success, up to
+    :data:`egosearch.navgrid.LOWER_BOUND_SLACK`."""
+    grid = navgrid_for(layout)
+    return grid.lower_bound_length(grid.distances_to(shortest_path_region(layout, target, height), reachable=True),
+                                   x, y)
 
 
 def _sample_start(grid: NavGrid, rng: np.random.Generator) -> tuple[float, float, float]:
@@ -229,13 +257,16 @@ def generate_scenarios(layout: str, placement: str, height: float, n: int, seed:
         if not region.any():
             rejected += 1
             continue
-        ell = grid.path_length(grid.distances_to(region), start[0], start[1])
-        if not math.isfinite(ell) or ell > MAX_SHORTEST_PATH:
+        # Solvable: the privileged oracle's route, through surely free cells, is short enough.
+        route = grid.path_length(grid.distances_to(region), start[0], start[1])
+        if not math.isfinite(route) or route > MAX_SHORTEST_PATH:
             rejected += 1
             continue
+        start = tuple(round(v, 4) for v in start)
+        ell = shortest_path_length(layout, target, height, start[0], start[1])
         out.append(Scenario(
             scenario_id=len(out), layout=layout, placement=placement, height=height,
-            start_x=round(start[0], 4), start_y=round(start[1], 4), start_theta=round(start[2], 4),
+            start_x=start[0], start_y=start[1], start_theta=start[2],
             target_object=obj.name, target_x=round(target.center[0], 4),
             target_y=round(target.center[1], 4), target_z=round(target.z_min, 5),
             target_yaw=round(target.yaw, 4), shortest_path=round(ell, 4)))

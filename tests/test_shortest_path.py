@@ -1,0 +1,294 @@
+"""ℓ, the shortest path behind SPL, is a lower bound on the path of every success the env can produce.
+
+The bound is stated in :data:`egosearch.navgrid.LOWER_BOUND_SLACK` and checked by
+:func:`egosearch.navgrid.lower_bound_holds`. It is checked here on hand-built scenes, on the stored
+evaluations, and by driving the env on the stored scenario sets with four searchers: the oracle,
+random actions, a beeline that walks straight at the target into whatever is in the way, and a
+follower of ℓ's own grid that walks into contact with furniture when that is shorter. The default run
+takes the two shortest scenarios of each stored set; ``-m slow`` takes every scenario.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import egosearch.scenarios as scenarios_mod
+from egosearch.agent import AgentSpec, wrap_angle
+from egosearch.env import SearchEnv
+from egosearch.navgrid import LOWER_BOUND_SLACK, MAX_PENETRATION, NavGrid, lower_bound_holds
+from egosearch.policies import OraclePolicy, RandomPolicy
+from egosearch.scenarios import (
+    SUCCESS_DISTANCE,
+    navgrid_for,
+    read_scenarios,
+    shortest_path_length,
+    shortest_path_region,
+    success_region,
+    visible_from,
+)
+from egosearch.scene import layouts
+from egosearch.scene.objects import get_object, target_part
+from egosearch.scene.parts import TAG_OBSTACLE, TAG_TARGET, TAG_WALL, Part, Scene
+from egosearch.world import PENETRATION_TOLERANCE
+
+ROOT = Path(__file__).resolve().parents[1]
+STORED_SETS = sorted(ROOT.glob("results/*/scenarios/*/*/h*.csv"))
+WALL = frozenset({TAG_OBSTACLE, TAG_WALL})
+R = AgentSpec().body_radius
+
+
+def test_the_stated_slack():
+    assert LOWER_BOUND_SLACK == {"relative": 0.03, "additive": 0.08}
+    assert lower_bound_holds(2.08 + 0.03 * 2.0, 2.0)
+    assert not lower_bound_holds(2.09 + 0.03 * 2.0, 2.0)
+    # The env's own rule on how deep a body may end a step must sit inside what ℓ allows for.
+    assert PENETRATION_TOLERANCE <= MAX_PENETRATION
+
+
+# --------------------------------------------------------------------------------------------- hand-built scenes
+def diner(gap: float = 0.42) -> Scene:
+    """A 6 x 4 m room; a 1.2 x 0.8 m table at the west end; a partition at x = 1 from wall to wall
+    but for one gap of ``gap`` m centred on y = 0."""
+    half = (4.0 - gap) / 2
+    parts = [
+        Part("north", "box", (0, 2.05, 1.3), (6.2, 0.1, 2.6), tags=WALL),
+        Part("south", "box", (0, -2.05, 1.3), (6.2, 0.1, 2.6), tags=WALL),
+        Part("east", "box", (3.05, 0, 1.3), (0.1, 4.0, 2.6), tags=WALL),
+        Part("west", "box", (-3.05, 0, 1.3), (0.1, 4.0, 2.6), tags=WALL),
+        Part("part_n", "box", (1.0, 2.0 - half / 2, 1.3), (0.1, half, 2.6), tags=WALL),
+        Part("part_s", "box", (1.0, -2.0 + half / 2, 1.3), (0.1, half, 2.6), tags=WALL),
+        Part("table", "box", (-1.5, 0.0, 0.375), (1.2, 0.8, 0.75), tags={TAG_OBSTACLE}),
+    ]
+    return Scene("diner", tuple(parts), (), (-3.0, -2.0, 3.0, 2.0))
+
+
+def test_free_cells_are_reachable_and_contact_cells_too():
+    grid = NavGrid(diner(), AgentSpec())
+    assert not (grid.free & ~grid.reachable).any()
+    # Bodies touching the table's east edge (x = -0.9) or pressed MAX_PENETRATION into it: their
+    # cells are reachable.
+    for depth in (0.0, MAX_PENETRATION):
+        for y in np.linspace(-0.4, 0.4, 9):
+            assert grid.reachable[grid.cell(-0.9 + R - depth, y)], (depth, y)
+    # No surely-free cell holds a body 5 mm from contact (its centre at -0.725 clears by 0.175 m).
+    assert not grid.free[grid.cell(-0.9 + R + 0.005, 0.0)]
+    # The cell spanning x in [-0.80, -0.75] has no point where the body is less than 4 cm inside.
+    assert not grid.reachable[grid.cell(-0.9 + R - 0.06, 0.0)]
+
+
+def test_a_gap_the_body_fits_through_is_open_to_ell_and_a_narrower_one_is_not():
+    spec = AgentSpec()
+    wide = NavGrid(diner(gap=2 * R + 0.02), spec)
+    goal = np.zeros(wide.shape, bool)
+    goal[wide.cell(2.5, 0.0)] = True
+    through = wide.lower_bound_length(wide.distances_to(goal, reachable=True), -0.5, 0.0)
+    assert through == pytest.approx(3.0, abs=0.03 * 3.0 + wide.resolution)
+    # The surely-free cells keep a margin of up to a cell diagonal: they close this gap.
+    assert not np.isfinite(wide.distances_to(goal)[wide.cell(-0.5, 0.0)])
+    narrow = NavGrid(diner(gap=2 * (R - MAX_PENETRATION) - 0.03), spec)
+    assert not np.isfinite(narrow.distances_to(goal, reachable=True)[narrow.cell(-0.5, 0.0)])
+
+
+@pytest.fixture()
+def diner_layout(monkeypatch):
+    """``layout="diner"`` names :func:`diner` for every layout-keyed helper (scenarios, env)."""
+    real = layouts.get_scene
+    monkeypatch.setattr(layouts, "get_scene", lambda name: diner() if name == "diner" else real(name))
+    scenarios_mod.navgrid_for.cache_clear()
+    scenarios_mod._ray_mesh.cache_clear()
+    yield "diner"
+    scenarios_mod.navgrid_for.cache_clear()
+    scenarios_mod._ray_mesh.cache_clear()
+
+
+def test_visible_from_on_a_hand_built_scene(diner_layout):
+    # A 10 cm cube on the table; the partition (2.6 m high) hides it from the east but for the gap.
+    cube = Part("target", "box", (-1.2, 0.0, 0.8), (0.1, 0.1, 0.1), tags={TAG_TARGET})
+    cams = np.array([
+        [-0.5, 0.0, 1.6],   # west of the partition, above the table: sees it
+        [-0.5, 0.0, 0.5],   # same place, below the table top: the table's edge hides it
+        [2.5, 1.5, 1.6],    # east of the partition: the straight line crosses part_n at y = 0.89
+        [2.5, 0.0, 0.8],    # east, in line with the gap, at the cube's height: sees it through
+    ])
+    assert visible_from(diner_layout, cams, cube).tolist() == [True, False, False, True]
+    # Through the 0.42 m gap all 10 probe points of the 0.1 m cube are in sight.
+    assert visible_from(diner_layout, cams[3:], cube, min_probes=10).tolist() == [True]
+    assert visible_from(diner_layout, cams[1:3], cube, min_probes=1).tolist() == [False, False]
+
+
+def test_success_region_on_a_hand_built_scene(diner_layout):
+    target = target_part(get_object("keys"), -1.0, 0.0, 0.75)
+    grid = navgrid_for(diner_layout)
+    region = success_region(diner_layout, target, 1.6)
+    rows, cols = np.nonzero(region)
+    assert len(rows) > 0
+    reach = SUCCESS_DISTANCE + R
+    for r, c in zip(rows, cols):
+        x, y = grid.center(r, c)
+        assert math.hypot(x - target.center[0], y - target.center[1]) <= reach + 1e-9
+        assert grid.free[r, c] and x < 1.0  # never east of the partition
+    # A surely-free cell 0.6 m east of the keys, in plain sight: in.
+    assert region[grid.cell(-0.4, 0.0)]
+    # A cell whose centre is 0.025 m or more beyond the body-surface distance: out.
+    assert not region[grid.cell(-1.0 + reach + 0.05, 0.0)]
+    # Touching the table beside the keys (not a surely-free cell): out of success_region, in the
+    # region that ℓ is measured to.
+    touch = (-0.9 + R - 0.005, 0.0)
+    assert not region[grid.cell(*touch)]
+    assert shortest_path_region(diner_layout, target, 1.6)[grid.cell(*touch)]
+
+
+def test_ell_bounds_a_success_in_contact_with_the_table(diner_layout):
+    """The issue's case, in the env: keys 0.48 m beyond the table's east edge, so that from the east
+    only a body touching the edge is within 0.5 m. From 10 cm east of contact one step succeeds;
+    ℓ measured to surely-free cells was the way round the table's corner."""
+    from dataclasses import replace
+
+    from egosearch.scenarios import Scenario
+
+    keys = (-0.9 - 0.48, 0.0)
+    sc = Scenario(scenario_id=0, layout=diner_layout, placement="everywhere", height=1.6, start_x=-0.9 + R + 0.1,
+                  start_y=0.0, start_theta=math.pi, target_object="keys", target_x=keys[0], target_y=keys[1],
+                  target_z=0.75, target_yaw=0.0, shortest_path=0.0)
+    grid = navgrid_for(diner_layout)
+    ell = shortest_path_length(diner_layout, sc.target(), sc.height, sc.start_x, sc.start_y)
+    old = grid.path_length(grid.distances_to(success_region(diner_layout, sc.target(), sc.height)),
+                           sc.start_x, sc.start_y)
+    env = SearchEnv(diner_layout, "everywhere", head=True, height=sc.height)
+    try:
+        env.reset(seed=0, options={"scenario": replace(sc, shortest_path=ell)})
+        s = env.state.copy()
+        s.pitch = math.atan2(0.76 - sc.height, 0.58)  # at the keys from where the body will stop
+        env.set_agent_state(s)
+        _, _, terminated, _, info = env.step(np.array([0.6, 0, 0, 0, 0], np.float32))  # 0.15 m asked, 0.1 m free
+    finally:
+        env.close()
+    assert terminated and info["success"] and info["collided"]
+    p = info["path_length"]
+    assert p == pytest.approx(0.1, abs=0.01)
+    assert lower_bound_holds(ell, p)
+    assert not lower_bound_holds(old, p) and old > 0.5
+
+
+# --------------------------------------------------------------------------------------------- searchers
+class Beeline:
+    """Walks straight at the target (turning first) and looks at it, whatever is in the way."""
+
+    def __init__(self, env):
+        self.env = env.unwrapped
+
+    def reset(self, seed=None):
+        pass
+
+    def act(self, obs):
+        env = self.env
+        s, spec, t = env.state, env.spec_agent, env.target
+        heading = math.atan2(t.center[1] - s.y, t.center[0] - s.x)
+        turn = wrap_angle(heading - s.theta)
+        action = [1.0 if abs(turn) < 0.5 else 0.0, 0.0, float(np.clip(turn / spec.max_turn, -1, 1))]
+        horizontal = math.hypot(t.center[0] - s.x, t.center[1] - s.y)
+        pitch = math.atan2(t.center[2] - s.camera_height, horizontal)
+        action += [float(np.clip((pitch - s.pitch) / spec.max_pitch_rate, -1, 1)),
+                   float(np.clip(-s.head_yaw / spec.max_yaw_rate, -1, 1))]
+        return np.asarray(action, np.float32)
+
+
+class Follower(OraclePolicy):
+    """The oracle on ℓ's own grid and goal region: it walks into contact when that is shorter."""
+
+    def _plan(self):
+        env = self.env
+        self.grid = navgrid_for(env.layout)
+        self.dist = self.grid.distances_to(shortest_path_region(env.layout, env.target, env.base_height),
+                                           reachable=True)
+        self._cells_xy = np.meshgrid(self.grid.xs, self.grid.ys)
+
+    def _line_free(self, x0, y0, x1, y1):
+        n = max(2, int(math.hypot(x1 - x0, y1 - y0) / (self.grid.resolution / 2)) + 1)
+        return all(self.grid.reachable[self.grid.cell(x0 + t * (x1 - x0), y0 + t * (y1 - y0))]
+                   for t in np.linspace(0, 1, n))
+
+
+SEARCHERS = {"oracle": OraclePolicy, "random": lambda env: RandomPolicy(5, seed=0), "beeline": Beeline,
+             "follower": Follower}
+
+
+def _check_sets(pick) -> dict[str, int]:
+    """Run every searcher on ``pick(scenarios)`` of each stored set; every success must respect ℓ."""
+    assert STORED_SETS, "no stored scenario sets under results/*/scenarios"
+    successes = dict.fromkeys(SEARCHERS, 0)
+    broken = []
+    for path in STORED_SETS:
+        chosen = pick(read_scenarios(path))
+        env = SearchEnv(chosen[0].layout, chosen[0].placement, head=True, height=chosen[0].height)
+        try:
+            for sc in chosen:
+                for name, make in SEARCHERS.items():
+                    policy = make(env)
+                    obs, _ = env.reset(seed=sc.scenario_id, options={"scenario": sc})
+                    policy.reset(seed=sc.scenario_id)
+                    done = False
+                    while not done:
+                        obs, _, terminated, truncated, info = env.step(policy.act(obs))
+                        done = terminated or truncated
+                    if info["success"]:
+                        successes[name] += 1
+                        if not lower_bound_holds(sc.shortest_path, info["path_length"]):
+                            broken.append((path.name, sc.scenario_id, name, sc.shortest_path, info["path_length"]))
+        finally:
+            env.close()
+    assert not broken, broken
+    return successes
+
+
+def test_ell_bounds_every_success_on_the_shortest_stored_scenarios():
+    successes = _check_sets(lambda scs: sorted(scs, key=lambda s: s.shortest_path)[:2])
+    # Each searcher must have produced successes for the check to mean anything.
+    assert all(successes.values()), successes
+
+
+@pytest.mark.slow
+def test_ell_bounds_every_success_on_every_stored_scenario():
+    successes = _check_sets(lambda scs: scs)
+    assert successes["oracle"] >= 0.9 * sum(len(read_scenarios(p)) for p in STORED_SETS), successes
+    assert all(successes.values()), successes
+
+
+# --------------------------------------------------------------------------------------------- stored files
+def _stored_ell_matches(pick) -> None:
+    for path in STORED_SETS:
+        for sc in pick(read_scenarios(path)):
+            ell = shortest_path_length(sc.layout, sc.target(), sc.height, sc.start_x, sc.start_y)
+            assert sc.shortest_path == pytest.approx(round(ell, 4), abs=1e-9), (path, sc.scenario_id)
+
+
+def test_stored_ell_is_what_the_code_computes_now():
+    _stored_ell_matches(lambda scs: scs[:3])
+
+
+@pytest.mark.slow
+def test_every_stored_ell_is_what_the_code_computes_now():
+    _stored_ell_matches(lambda scs: scs)
+
+
+def test_stored_evaluation_successes_respect_the_current_ell():
+    """Every stored evaluation's success against ℓ of its scenario set as stored now (the rows
+    themselves may carry an older ℓ)."""
+    checked = 0
+    for path in sorted(ROOT.glob("results/*/eval/*/seed*/*/*/h*.csv")):
+        profile, layout, placement, height = path.parts[-7], path.parts[-3], path.parts[-2], path.name
+        ells = {sc.scenario_id: sc.shortest_path
+                for sc in read_scenarios(ROOT / "results" / profile / "scenarios" / layout / placement / height)}
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                if int(row["success"]):
+                    checked += 1
+                    ell, p = ells[int(row["scenario_id"])], float(row["path_length"])
+                    assert lower_bound_holds(ell, p), (path, row["scenario_id"], ell, p)
+    if not checked:
+        pytest.skip("no stored evaluations")
