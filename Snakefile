@@ -21,6 +21,7 @@ include: "egosearch/workflow/rules/train.smk"
 include: "egosearch/workflow/rules/evaluate.smk"
 include: "egosearch/workflow/rules/fullbody.smk"
 include: "egosearch/workflow/rules/report.smk"
+include: "egosearch/workflow/rules/budget.smk"
 
 
 rule all:

@@ -128,13 +128,26 @@ def _cmd_report(args) -> None:
     if args.what == "table1":
         report.cmd_table1(args.files, args.out_prefix, variant=args.variant, bounds=args.bounds)
     elif args.what == "table2":
-        from egosearch.rl.config import load_config, table2_rows
+        from egosearch.rl.config import departure_rows, load_config, table2_rows
 
-        report.cmd_table2(table2_rows(load_config(args.profile)), args.out_prefix)
+        cfg = load_config(args.profile)
+        report.cmd_table2(table2_rows(cfg), args.out_prefix, departure_rows(cfg))
     elif args.what == "fig6":
         report.cmd_fig6(_group_curves(args.files), args.out_prefix, random_files=args.random)
     elif args.what == "fig7":
         report.cmd_fig7(args.files, args.out_prefix, planner=args.planner)
+    elif args.what == "budget":
+        from egosearch.report.budget import budget_figure, budget_frame
+
+        runs: dict[str, list[tuple[str, str]]] = {}
+        for spec in args.run:
+            setting, sep, files = spec.partition("=")
+            curve, sep2, evals = files.partition(":")
+            if not (sep and sep2 and setting and curve and evals):
+                raise ValueError(f"--run {spec!r}: expected SETTING=CURVE_CSV:EVAL_CSV")
+            runs.setdefault(setting, []).append((curve, evals))
+        for path in budget_figure(budget_frame(runs), args.out_prefix, chosen=args.chosen):
+            print(f"wrote {path}")
     elif args.what == "compare":
         report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
                            candidate_name="candidate")
@@ -178,7 +191,7 @@ def _regenerate(profile: str, reference: str | None) -> None:
     from egosearch.report.provenance import check_stored
     from egosearch.report.readme import variants_of_all, workflow_config
     from egosearch.report.tables import BOUNDS
-    from egosearch.rl.config import load_config, table2_rows
+    from egosearch.rl.config import departure_rows, load_config, table2_rows
     from egosearch.variants import load_variant
 
     config = workflow_config()
@@ -211,7 +224,8 @@ def _regenerate(profile: str, reference: str | None) -> None:
     if fullbody_oracle:
         report.cmd_fig7(fullbody_oracle, figs / "fig7_oracle", planner="oracle")
     learner = config["profiles"][profile]["learner"]
-    report.cmd_table2(table2_rows(load_config(learner)), figs / "table2")
+    learner_cfg = load_config(learner)
+    report.cmd_table2(table2_rows(learner_cfg), figs / "table2", departure_rows(learner_cfg))
 
 
 def _cmd_video(args) -> None:
@@ -295,6 +309,13 @@ def _report_parsers(sub) -> None:
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
     r.add_argument("--planner", default="actor", choices=("actor", "oracle"),
                    help="which planner drove the full-body runs (oracle figures say so in a title)")
+
+    r = reports.add_parser("budget", help="the budget study: success at one cell vs env steps and core-hours")
+    r.add_argument("--run", action="append", required=True, metavar="SETTING=CURVE_CSV:EVAL_CSV",
+                   help="one training run of a setting: its curve.csv and its per-episode CSV at the cell "
+                        "(repeat per seed and setting)")
+    r.add_argument("--chosen", help="the setting the profile uses (drawn filled)")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
 
     r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell")
     r.add_argument("--reference", nargs="+", required=True, help="the reference variant's evaluation CSVs")

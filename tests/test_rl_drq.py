@@ -158,3 +158,11 @@ def test_curriculum_radius_grows_linearly_then_stops():
     cfg = load_config("smoke", {"curriculum_steps": 1000})
     assert cfg.start_radius(0) == 1.0 and cfg.start_radius(500) == 6.5 and cfg.start_radius(1000) is None
     assert load_config("smoke", {}).start_radius(0) is None  # off by default (the paper has none)
+
+
+def test_training_throughput_counts_env_steps_per_core_second():
+    from egosearch.rl.bench import training_throughput
+
+    r = training_throughput("smoke", env_steps=120, overrides={"num_threads": 1})
+    assert r["env_steps"] == 120 and r["core_s"] > 0
+    assert r["env_steps_per_core_s"] == pytest.approx(120 / r["core_s"], rel=0.01)

@@ -306,9 +306,26 @@ PAPER_TABLE2 = [
 def test_table2_rows_match_the_paper():
     assert table2_rows(load_config("paper", {})) == PAPER_TABLE2
     assert list(TABLE2_PAPER) == PAPER_TABLE2
-    rows = dict(table2_rows(load_config("cpu", {})))
-    assert rows["Batch-size"] == "32" and rows["Replay buffer"] == "100000"
-    assert rows["Encoder (CNN) : Number of filters"] == str(load_config("cpu", {}).encoder_num_filters)
+    cpu = load_config("cpu", {})
+    rows = dict(table2_rows(cpu))
+    assert rows["Batch-size"] == str(cpu.batch_size) and rows["Replay buffer"] == "100000"
+    assert rows["Encoder (CNN) : Number of filters"] == str(cpu.encoder_num_filters)
+    assert rows["Augmentation"] == "Random Shift (±1 px at 25x25)"
+    assert rows["Encoder (CNN) : τ (polyak averaging)"].startswith("none")
+
+
+def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
+    from egosearch.rl.config import HOUSEKEEPING_FIELDS, SacCurlConfig, departure_rows, field_docs
+
+    assert departure_rows(load_config("paper", {})) == []
+    cfg = load_config("paper", {"batch_size": 64, "seed": 7, "algorithm": "sac_drq", "encoder_num_layers": 2})
+    rows = {f: (mine, paper, doc) for f, mine, paper, doc in departure_rows(cfg)}
+    assert set(rows) == {"batch_size", "algorithm", "encoder_num_layers"}  # seed is housekeeping
+    assert rows["batch_size"][:2] == ("64", "32") and rows["batch_size"][2].startswith('Table 2 "Batch-size"')
+    assert rows["algorithm"][2].startswith("Paper 4.2")
+    docs = field_docs()  # every field documents its source, so every departure can name one
+    assert set(docs) == {f for f in SacCurlConfig.__dataclass_fields__} and all(docs.values())
+    assert "seed" in HOUSEKEEPING_FIELDS
 
 
 def test_bench_timer_runs():

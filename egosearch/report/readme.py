@@ -140,7 +140,35 @@ def block_compare(root: Path, profile: str) -> str:
     return "\n".join(parts) + "\n" + note + "\n"
 
 
+def block_departures(root: Path, profile: str) -> str:
+    """The generated Table 2's list of the profile's learner settings that are not the paper's."""
+    path = root / "paper_figs" / profile / "table2.md"
+    if not path.exists():
+        return _missing(root, path)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    start = next((i for i, line in enumerate(lines) if line.startswith("Where this profile departs")), None)
+    if start is None:
+        return f"*`{path.relative_to(root)}` lists no departure: this profile is the paper's Table 2.*\n"
+    return "\n".join(lines[start:]).rstrip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
+def block_budget(root: Path, profile: str) -> str:
+    """The budget study's table: success at its cell, env steps and core-hours per learner setting."""
+    path = root / "paper_figs" / profile / "budget.csv"
+    if not path.exists():
+        return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 budget")
+    df = pd.read_csv(path)
+    lines = ["| setting | seeds | env steps per run | core-hours per run | env steps per core-second | "
+             "success, 1.05 m excl. low cabinets (95% CI) |", "|---|---|---|---|---|---|"]
+    for r in df.itertuples(index=False):
+        lines.append(f"| `{r.setting}` | {int(r.n_seeds)} | {int(r.env_steps):,} | {_fmt(r.core_hours_per_seed)} | "
+                     f"{r.env_steps_per_core_s:.0f} | {_fmt(r.success_rate)} [{_fmt(r.low)}, {_fmt(r.high)}] |")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
+    "departures": block_departures,
+    "budget": block_budget,
     "table1": block_table1,
     "fig6": block_fig6,
     "fig7": block_fig7,
