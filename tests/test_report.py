@@ -230,6 +230,30 @@ def test_compare_rejects_bad_input():
         compare_cells(cell_frame(np.ones(10)), cell_frame(np.ones(10)), "steps")
 
 
+def _paired(values, metric, seeds=(0,)):
+    return pd.concat([pd.DataFrame({"scenario_id": range(len(values)), "seed": s, metric: values}) for s in seeds],
+                     ignore_index=True)
+
+
+def test_compare_exact_two_sided_permutation_p_value_by_hand():
+    # 4 scenarios: exact enumeration of the 2^4 sign flips of d = (0.6, 0.3, -0.2, 0.05), sum 0.75.
+    # |sum| >= 0.75 for + + + +, + + + -, + + - + (1.15, 1.05, 0.75: the observed one counts) and
+    # their three mirrors: p = 6/16.
+    ref = _paired([0.2, 0.3, 0.5, 0.1], "spl")
+    cand = _paired([0.8, 0.6, 0.3, 0.15], "spl")
+    assert compare_cells(ref, cand, "spl")["p_value"] == pytest.approx(6 / 16, abs=1e-12)
+    # 5 scenarios, the candidate succeeds in every one the reference fails: only all + and
+    # all - reach |sum| = 5: p = 2/32 (a one-sided test would say 1/32).
+    res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success"), "success")
+    assert res["p_value"] == pytest.approx(2 / 32, abs=1e-12) and not res["significant"]
+    # d = (1, 1, 1, 1, -1), sum 3: sums >= 3 need at most one minus sign (1 + 5 patterns): p = 12/32.
+    res = compare_cells(_paired([0, 0, 0, 0, 1], "success"), _paired([1, 1, 1, 1, 0], "success"), "success")
+    assert res["p_value"] == pytest.approx(12 / 32, abs=1e-12)
+    # Seeds are averaged per scenario first: two candidate seeds agreeing give the same p.
+    res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success", seeds=(0, 1)), "success")
+    assert res["p_value"] == pytest.approx(2 / 32, abs=1e-12)
+
+
 def test_holm():
     assert holm([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
     assert holm([]).size == 0
@@ -249,33 +273,60 @@ def test_paths_parse_and_group(tmp_path):
         parse_eval_path(tmp_path / "x.csv")
 
 
+def _cell_rows(k: int, n: int, spl_of_success: float) -> pd.DataFrame:
+    """n episodes of one evaluation file: the first k succeed, each with SPL ``spl_of_success``."""
+    success = np.arange(n) < k
+    return pd.DataFrame({"scenario_id": np.arange(n), "success": success.astype(int), "steps": 50,
+                         "path_length": 2.0, "shortest_path": 1.0, "spl": np.where(success, spl_of_success, 0.0),
+                         "collisions": 0, "episode_return": 0.0}, columns=EPISODE_COLUMNS)
+
+
 def test_table1(tmp_path):
-    paths = make_eval_tree(tmp_path / "r", seeds=(0, 1, 2), n=40)
-    files = group_eval_paths(paths)
-    df = table1(files, tmp_path / "out" / "table1", n_resamples=N_RES)
+    # Known inputs: per cell i (in Table 1 order), seed s and layout l, k = (3 * i + s + 4 * l) % 11 successes
+    # of 10, each success with SPL (0.25, 0.5, 1.0)[s]; cell 2 has k = 6 everywhere (equal seeds).
+    cells = sorted(PAPER_TABLE1, key=lambda hp: (hp[0], hp[1] != "no_low_cabinets"))
+    layouts, n = ("kitchen", "bedroom"), 10
+    paths, expected = [], {}
+    for i, (h, pl) in enumerate(cells):
+        ks = {(s, li): 6 if i == 2 else (3 * i + s + 4 * li) % 11 for s in range(3) for li in range(2)}
+        for (s, li), k in ks.items():
+            p = eval_path(tmp_path / "r", "head_on", s, layouts[li], pl, h)
+            p.parent.mkdir(parents=True, exist_ok=True)
+            _cell_rows(k, n, (0.25, 0.5, 1.0)[s]).to_csv(p, index=False)
+            paths.append(p)
+        total = sum(ks.values())
+        expected[(h, pl)] = {"k": total, "spl": sum(k * (0.25, 0.5, 1.0)[s] for (s, _), k in ks.items()) / 60,
+                             "per_seed": [(ks[(s, 0)] + ks[(s, 1)]) / 20 for s in range(3)]}
+    df = table1(group_eval_paths(paths), tmp_path / "out" / "table1", n_resamples=N_RES)
     assert list(df.columns) == ["height", "placement", "n_episodes", "n_seeds", "success_rate", "wilson_low",
                                 "wilson_high", "seed_boot_low", "seed_boot_high", "spl", "paper_success_rate"]
-    assert len(df) == 6 and (df["n_episodes"] == 3 * 2 * 40).all() and (df["n_seeds"] == 3).all()
-    assert list(df["height"]) == [0.45, 0.45, 1.05, 1.05, 1.65, 1.65]
-    assert list(df["placement"][:2]) == ["no_low_cabinets", "everywhere"]
+    assert [(r.height, r.placement) for r in df.itertuples()] == cells
     for r in df.itertuples():
-        assert r.wilson_low <= r.success_rate <= r.wilson_high
-        assert r.seed_boot_low <= r.seed_boot_high
+        e = expected[(r.height, r.placement)]
+        assert (r.n_episodes, r.n_seeds) == (60, 3)
+        assert r.success_rate == e["k"] / 60
+        assert (r.wilson_low, r.wilson_high) == pytest.approx(_wilson_by_hand(e["k"], 60), abs=1e-9)
+        assert r.spl == pytest.approx(e["spl"], abs=1e-12)
+        # A percentile bootstrap of the mean of the three per-seed rates stays within them.
+        assert min(e["per_seed"]) - 1e-12 <= r.seed_boot_low <= r.seed_boot_high <= max(e["per_seed"]) + 1e-12
         assert r.paper_success_rate == PAPER_TABLE1[(r.height, r.placement)]
-        assert abs(r.success_rate - r.paper_success_rate) < 0.12
-    # pooled success rate is the mean over every episode of the cell
-    cell = [p for p in paths if parse_eval_path(p)["height"] == 1.05 and "everywhere" in str(p)]
-    pooled = pd.concat([pd.read_csv(p) for p in cell])["success"].mean()
-    row = df[(df.height == 1.05) & (df.placement == "everywhere")].iloc[0]
-    assert row.success_rate == pytest.approx(pooled)
+    equal = df.iloc[2]
+    assert (equal.success_rate, equal.seed_boot_low, equal.seed_boot_high) == (0.6, 0.6, 0.6)
     out = tmp_path / "out"
     assert pd.read_csv(out / "table1.csv").shape == (6, 11)
     md = (out / "table1.md").read_text()
     assert "| Head height | Excluding cabinets | Everywhere |" in md
-    assert "| 1.05m | ours " in md and "· paper 0.92 |" in md and "Wilson" in md
+    # The 1.05 m row from the numbers above: cells 2 and 3.
+    r3 = df.iloc[3]
+    lo, hi = _wilson_by_hand(expected[cells[3]]["k"], 60)
+    row = (f"| 1.05m | ours 0.60 [{_wilson_by_hand(36, 60)[0]:.2f}, {_wilson_by_hand(36, 60)[1]:.2f}] · paper "
+           f"{PAPER_TABLE1[cells[2]]:.2f} | ours {r3.success_rate:.2f} [{lo:.2f}, {hi:.2f}] · paper "
+           f"{PAPER_TABLE1[cells[3]]:.2f} |")
+    assert row in md.splitlines(), md
+    assert "pooled over 3 seed(s) (60 episodes per cell)" in md and "Wilson" in md
     tex = (out / "table1.tex").read_text()
     assert r"\toprule" in tex and r"\bottomrule" in tex and "Wilson" in tex and r"\caption{" in tex
-    assert "paper 0.76" in tex and "0.45m" in tex
+    assert f"1.05m & ours 0.60 [{_wilson_by_hand(36, 60)[0]:.2f}, " in tex
 
 
 def test_table1_one_seed_and_directory_prefix(tmp_path):
@@ -370,18 +421,60 @@ def test_figure6_one_seed_and_empty(tmp_path):
         figure6({"head_on": [empty]}, tmp_path / "x")
 
 
+def _fullbody_rows(method, M, spl, attempts, success=None) -> pd.DataFrame:
+    """One full-body CSV: one row per scenario, with the given per-scenario SPL and attempts."""
+    n = len(spl)
+    success = (np.asarray(spl) > 0).astype(int) if success is None else success
+    return pd.DataFrame({"scenario_id": np.arange(n), "method": method, "mg": "humanoid_phase", "M": M, "T": 20,
+                         "success": success, "steps": 60, "path_length": 3.0, "shortest_path": 1.5, "spl": spl,
+                         "attempts": attempts, "penetrations": 1, "penetration_rate": 0.01 * M, "collisions": 2},
+                        columns=FULLBODY_COLUMNS)
+
+
 def test_figure7(tmp_path):
-    files = make_fullbody(tmp_path / "r", mgs=("humanoid_phase",), seeds=(0, 1))
+    # Known inputs, 4 scenarios x 2 seeds per setting. The attempts of ours do not fall with M here (M=10
+    # plans more than M=5): the figure reports what the files say, in the order of M.
+    settings = {("one_step_short", 5): ([0.0, 0.0, 0.5, 0.0], [1, 1, 1, 1]),
+                ("one_step_long", 20): ([0.0, 0.0, 0.0, 0.0], [1, 1, 1, 1]),
+                ("noisy_search", 5): ([0.2, 0.0, 0.0, 0.4], [20, 20, 18, 20]),
+                ("ours", 1): ([0.9, 0.8, 0.0, 0.7], [100, 100, 100, 100]),
+                ("ours", 5): ([0.6, 0.6, 0.6, 0.6], [20, 20, 20, 20]),
+                ("ours", 10): ([0.5, 0.0, 0.5, 0.3], [30, 10, 20, 40]),
+                ("ours", 20): ([0.4, 0.2, 0.0, 0.0], [5, 5, 5, 5])}
+    files = []
+    for (method, M), (spl, att) in settings.items():
+        for seed in (0, 1):
+            p = tmp_path / "r" / f"{method}-M{M}" / f"seed{seed}.csv"
+            p.parent.mkdir(parents=True, exist_ok=True)
+            # Seed 1 halves the SPL of seed 0 and plans the same: per-scenario means are 0.75 x seed 0.
+            _fullbody_rows(method, M, np.asarray(spl) * (1.0 if seed == 0 else 0.5), att).to_csv(p, index=False)
+            files.append(p)
     png, pdf, csv = figure7(files, tmp_path / "fig7", n_resamples=N_RES)
     _png_ok(png)
     assert pdf.read_bytes()[:5] == b"%PDF-"
     df = pd.read_csv(csv)
-    assert list(df["method"]) == ["one_step_short", "one_step_long", "noisy_search", "ours", "ours", "ours", "ours"]
-    assert list(df[df.method == "ours"]["M"]) == [1, 5, 10, 20]
-    assert (df["n_seeds"] == 2).all() and (df["n_episodes"] == 80).all() and (df["ci_unit"] == "scenario").all()
-    assert (df["spl_low"] <= df["spl"]).all() and (df["spl"] <= df["spl_high"]).all()
+    assert list(zip(df["method"], df["M"])) == [("one_step_short", 5), ("one_step_long", 20), ("noisy_search", 5),
+                                                ("ours", 1), ("ours", 5), ("ours", 10), ("ours", 20)]
+    assert list(df["label"]) == ["1-step short", "1-step long", "Noisy search", "Ours M=1", "Ours M=5", "Ours M=10",
+                                 "Ours M=20"]
+    assert (df["n_seeds"] == 2).all() and (df["n_episodes"] == 8).all() and (df["n_scenarios"] == 4).all()
+    assert (df["ci_unit"] == "scenario").all()
+    for r in df.itertuples():
+        spl, att = settings[(r.method, r.M)]
+        assert r.spl == pytest.approx(0.75 * np.mean(spl), abs=1e-12)
+        assert r.attempts == pytest.approx(np.mean(att), abs=1e-12)
+        assert r.success_rate == pytest.approx(np.mean(np.asarray(spl) > 0), abs=1e-12)
+        assert r.penetration_rate == pytest.approx(0.01 * r.M) and r.collisions == 2.0
+        # Bootstrap over the 4 scenario means: within their range; a constant column is a point.
+        means = 0.75 * np.asarray(spl)
+        assert means.min() - 1e-12 <= r.spl_low <= r.spl <= r.spl_high <= means.max() + 1e-12
+        if np.ptp(att) == 0:
+            assert r.attempts_low == r.attempts_high == att[0]
+        else:
+            assert min(att) <= r.attempts_low < r.attempts_high <= max(att)
     ours = df[df.method == "ours"]
-    assert ours["attempts"].is_monotonic_decreasing
+    assert list(ours["attempts"]) == [100.0, 20.0, 25.0, 5.0]
+    assert (df.loc[df.method == "one_step_long", ["spl", "spl_low", "spl_high"]] == 0.0).all(axis=None)
 
 
 def test_figure7_several_mgs_one_seed_and_empty(tmp_path):
