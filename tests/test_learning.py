@@ -1,8 +1,10 @@
-"""Learning actually happens in the real env, at small scale, on an easy setting.
+"""Learning actually happens in the real env, at small scale, in one of the paper's homes.
 
-The easy setting: the 4.5 x 4 m ``studio``, no targets in low cabinets, and the progress form of
-r_d (Savva et al.), with which a few thousand steps suffice; with the paper's form of r_d the
-same budget learns nothing measurable (see the README's results). About four minutes on 2 cores.
+The default ``cpu`` learner (SAC-DrQ, 8 lockstep envs) trains for 12k env steps in
+``kitchen_living`` with the start-distance curriculum held near its first radius (starts within
+about 2 m of the target), then its deterministic policy must beat the random searcher on held-out
+scenarios of the same home whose target is within 2 m of the start (ℓ <= 2 m). About two
+minutes on an idle core (3.5 measured beside two trainings).
 """
 
 import numpy as np
@@ -14,19 +16,21 @@ from egosearch.rl.config import load_config
 from egosearch.rl.train import ActorPolicy, train
 from egosearch.scenarios import generate_scenarios
 
-STEPS = 6000
+STEPS = 12_000
 
 
 @pytest.mark.slow
-def test_sac_curl_beats_the_random_searcher_in_the_studio(tmp_path):
-    cfg = load_config("smoke", {"total_env_steps": STEPS, "replay_capacity": STEPS, "init_steps": 500,
-                                "eval_every": STEPS, "eval_episodes": 2, "checkpoint_every": STEPS,
-                                "log_every": 1000, "num_threads": 1, "seed": 0})
-    train("EgoSearch-v0", cfg, tmp_path, env_kwargs={"layout": "studio", "placement": "no_low_cabinets",
-                                                     "distance_reward": "progress"},
-          variant="easy", progress=False)
-    scenarios = generate_scenarios("studio", "no_low_cabinets", 1.05, n=40, seed=5)
+def test_cpu_learner_beats_the_random_searcher_in_kitchen_living(tmp_path):
+    # curriculum_steps 10x the run: the start radius grows only from 1.0 to 2.1 m
+    cfg = load_config("cpu", {"total_env_steps": STEPS, "curriculum_steps": 10 * STEPS, "init_steps": 2000,
+                              "eval_every": STEPS, "eval_episodes": 2, "checkpoint_every": STEPS,
+                              "log_every": 2000, "num_threads": 1, "seed": 0})
+    train("EgoSearch-v0", cfg, tmp_path, env_kwargs={"layout": "kitchen_living", "placement": "no_low_cabinets"},
+          variant="near", progress=False)
+    scenarios = [s for s in generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=120, seed=5)
+                 if s.shortest_path <= 2.0][:40]
+    assert len(scenarios) >= 20
     actor = ActorPolicy(tmp_path / "actor.pt")
     learned = np.mean([r["success"] for r in evaluate("EgoSearch-v0", lambda env: actor, scenarios)])
     floor = np.mean([r["success"] for r in evaluate("EgoSearch-v0", lambda env: RandomPolicy(5, seed=0), scenarios)])
-    assert learned >= floor + 0.1, (learned, floor)
+    assert learned >= floor + 0.2, (learned, floor)
