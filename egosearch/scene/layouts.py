@@ -259,6 +259,10 @@ def _grow(r: Rect, m: float) -> Rect:
 Factory = Callable[[str, float, float, float], F.Built]
 
 
+class _RequiredPieceMissing(RuntimeError):
+    """A draw of the generator left a room without its required piece: draw again."""
+
+
 class _Room:
     """A room to furnish: ``sides`` are the ones that are real walls (others open onto floor)."""
 
@@ -324,7 +328,7 @@ class _Furnisher:
             if self._try(name, factory, x, y, yaw, hard, soft if access > 0 else None, room):
                 return True
         if required:
-            raise RuntimeError(f"random home: could not place required {name!r} in {room.label}")
+            raise _RequiredPieceMissing(f"random home: could not place required {name!r} in {room.label}")
         return False
 
     def free_standing(self, room: _Room, name: str, width: float, depth: float, factory: Factory,
@@ -507,6 +511,16 @@ def _mirror(scene_parts, surfaces, rooms, bounds, flip_x: bool, flip_y: bool):
     return parts, surfs, [(label, xy(*c)) for label, c in rooms]
 
 
+#: Draws of :func:`random_home` before it gives up; about one seed in 1,000 needs a second.
+MAX_HOME_ATTEMPTS = 20
+
+
+def home_rng(seed: int, attempt: int) -> np.random.Generator:
+    """The generator of draw ``attempt`` of home ``seed``: the plain seed first (so the homes
+    of the first draw never change), then seeds derived from (seed, attempt)."""
+    return np.random.default_rng(seed if attempt == 0 else [seed, attempt])
+
+
 @functools.lru_cache(maxsize=64)
 def random_home(seed: int) -> Scene:
     """A seeded home of 2-3 rooms (8-12 x 6-9 m) furnished from the layouts' vocabulary.
@@ -517,11 +531,24 @@ def random_home(seed: int) -> Scene:
     0.85-1.1 m doorways at random offsets. Pieces go against walls by rejection sampling: no
     overlaps, a free access zone in front of each, doorways kept clear, and free space kept
     one connected region. The whole home is finally mirrored at random. Same seed, same Scene.
+
+    Every seed builds: a draw whose required piece (kitchen run, bed, desk, sink) finds no
+    room is drawn again from :func:`home_rng` ``(seed, attempt)``, and ``meta["attempt"]``
+    records which draw the home is.
     """
-    if not isinstance(seed, (int, np.integer)) or seed < 0:
+    if not isinstance(seed, (int, np.integer)) or isinstance(seed, bool) or seed < 0:
         raise ValueError(f"random_home seed={seed!r}; allowed: an integer >= 0")
     seed = int(seed)
-    rng = np.random.default_rng(seed)
+    for attempt in range(MAX_HOME_ATTEMPTS):
+        try:
+            return _draw_home(seed, attempt)
+        except _RequiredPieceMissing:
+            continue
+    raise RuntimeError(f"random home {seed}: no draw of {MAX_HOME_ATTEMPTS} placed every required piece")
+
+
+def _draw_home(seed: int, attempt: int) -> Scene:
+    rng = home_rng(seed, attempt)
     W = round(float(rng.uniform(8.0, 12.0)), 1)
     H = round(float(rng.uniform(6.0, 9.0)), 1)
     bounds = (0.0, 0.0, W, H)
@@ -598,7 +625,7 @@ def random_home(seed: int) -> Scene:
     flip_x, flip_y = bool(rng.random() < 0.5), bool(rng.random() < 0.5)
     parts, surfs, labels = _mirror(structure + home.parts, home.surfaces, home.rooms, bounds, flip_x, flip_y)
     home.parts, home.surfaces, home.rooms = parts, surfs, labels
-    return home.scene({"seed": seed, "flip": (flip_x, flip_y)})
+    return home.scene({"seed": seed, "attempt": attempt, "flip": (flip_x, flip_y)})
 
 
 # ----------------------------------------------------------------------------------- lookup
