@@ -11,10 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet
-from pybullet_utils import bullet_client
 
 from egosearch.agent import AgentSpec
+from egosearch.bullet import connect, pybullet
 from egosearch.scene.parts import Part, Scene
 
 #: Physics sub-steps per env step. Enough that the body (moving <= 0.25 m per env step)
@@ -44,7 +43,7 @@ class World:
     def __init__(self, scene: Scene, spec: AgentSpec):
         self.scene = scene
         self.spec = spec
-        self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        self._p = connect()
         p = self._p
         p.setPhysicsEngineParameter(fixedTimeStep=0.15 / SUBSTEPS, numSubSteps=0,
                                     numSolverIterations=10, deterministicOverlappingPairs=1)

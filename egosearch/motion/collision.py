@@ -13,10 +13,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet
-from pybullet_utils import bullet_client
 
 from egosearch.agent import AgentSpec
+from egosearch.bullet import connect, pybullet
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose
 from egosearch.scene.parts import Scene
@@ -30,7 +29,7 @@ class PenetrationCounter:
     def __init__(self, scene: Scene, character: str):
         self.scene = scene
         self.character = character
-        self._p = bullet_client.BulletClient(connection_mode=pybullet.DIRECT)
+        self._p = connect()
         self.static_ids = [add_static_part(self._p, part) for part in scene.obstacles]
         self._static_set = frozenset(self.static_ids)
         self._part_of = dict(zip(self.static_ids, scene.obstacles))

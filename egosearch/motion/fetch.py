@@ -16,9 +16,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pybullet
 
 from egosearch.agent import AgentState, wrap_angle
+from egosearch.bullet import pybullet
 from egosearch.motion import quat
 from egosearch.motion.base import (
     SUBSTEP_SECONDS,

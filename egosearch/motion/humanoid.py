@@ -12,15 +12,12 @@ limbs and boxes for the feet, posed with ``resetBasePositionAndOrientation`` and
 
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
 from functools import lru_cache
 
 import numpy as np
-import pybullet
 
 from egosearch.agent import AgentSpec
+from egosearch.bullet import pybullet, quiet_native_output
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose, Limits
 from egosearch.motion.collision import union_aabb
@@ -78,26 +75,8 @@ def limb_shapes(pose: FullBodyPose, scale: float = HUMANOID_SCALE):
     return shape_segments(pose_frames(pose, scale), scale)
 
 
-@contextlib.contextmanager
-def _quiet_native_output():
-    """Silence what C code writes to stdout/stderr (pybullet's URDF importer warnings)."""
-    try:
-        saved = [os.dup(1), os.dup(2)]
-    except OSError:
-        yield
-        return
-    sys.stdout.flush()
-    sys.stderr.flush()
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        os.dup2(devnull, 2)
-        yield
-    finally:
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in (*saved, devnull):
-            os.close(fd)
+#: The URDF importer's warnings about the spherical joints, which have no <axis>: harmless.
+_URDF_NOISE = ("b3Warning[examples/Importers/ImportURDFDemo/BulletUrdfImporter.cpp", "urdfdom: no axis element")
 
 
 class HumanoidBody:
@@ -106,7 +85,7 @@ class HumanoidBody:
     def __init__(self, client, scale: float = HUMANOID_SCALE):
         self._p = client
         self.scale = scale
-        with _quiet_native_output():  # the URDF's spherical joints have no <axis>: harmless warnings
+        with quiet_native_output(_URDF_NOISE):
             self.body_id = client.loadURDF(str(pybullet_data_path() / URDF), [0, 0, -50], globalScaling=scale,
                                            useFixedBase=True, flags=pybullet.URDF_MAINTAIN_LINK_ORDER)
         self.joint_index = {}
