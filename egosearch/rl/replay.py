@@ -332,6 +332,14 @@ class MultiReplay:
         for b in self.buffers:
             b.new_episode()
 
+    def end_episodes(self) -> None:
+        """Cut every ring's running episode: its last transition becomes truncated (n-step returns
+        stop there and bootstrap) and the next ``add`` starts a new episode."""
+        for b in self.buffers:
+            if b.in_episode and b.n_added:
+                b.truncated[(b.n_added - 1) % b.capacity] = True
+            b.new_episode()
+
     def sample(self, batch_size: int) -> dict[str, torch.Tensor]:
         """A batch (see :meth:`ReplayBuffer.sample`, plus ``discount`` when n-step or several rings)."""
         if len(self.buffers) == 1 and self.n_step == 1:

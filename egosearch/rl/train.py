@@ -537,7 +537,8 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
         recent.extend((float(r), float(s)) for r, s in ckpt["recent"])
         curve.truncate(int(ckpt["csv_rows"]["curve"]))
         train_log.truncate(int(ckpt["csv_rows"]["train"]))
-        replay.new_episode()  # the envs are reset below, mid-episode
+        # The run that was not stopped cut its episodes here too (see restart_episodes below).
+        replay.end_episodes()
         reset_seeds = [cfg.seed + 7919 * step + 104_729 * i for i in range(len(envs))]
     else:
         curve.truncate(0)
@@ -550,6 +551,16 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
     observations = [reset(e, sd) for e, sd in zip(envs, reset_seeds)]
     stored = [to_replay(o) for o in observations]  # as the replay stores them, each computed once
     ep_returns = [0.0] * len(envs)
+
+    def restart_episodes() -> None:
+        """Cut every env's episode at a checkpoint and reset it with a seed of the step, exactly as
+        a run resumed from that checkpoint does: so killing and resuming gives the same run as not
+        stopping (the cut transitions count as truncated, so they still bootstrap)."""
+        replay.end_episodes()
+        for i, e in enumerate(envs):
+            observations[i] = reset(e, cfg.seed + 7919 * step + 104_729 * i)
+            stored[i] = to_replay(observations[i])
+            ep_returns[i] = 0.0
     del ckpt
     atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
                                           "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict()})
@@ -665,6 +676,8 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
                 last_row = do_eval()
             if crossed(cfg.checkpoint_every, before):
                 save_checkpoint()
+                if step < cfg.total_env_steps:
+                    restart_episodes()
             if bar is not None:
                 bar.update(step - before)
             if on_step is not None:

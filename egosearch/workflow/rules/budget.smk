@@ -1,24 +1,6 @@
 # The budget study (`snakemake --cores 2 budget`, not part of `all`): success at 1.05 m excluding
-# low cabinets against env steps and core-hours, for the learner settings of config `budget:`.
-# A setting is a variant file (ablations/budget_*.yaml: learner overrides on top of the profile),
-# so the train and evaluate rules serve it unchanged; the profile's own setting is the reference
-# variant's runs, which `all` makes anyway.
-BUDGET = PROF.get("budget", {"variants": [], "seeds": [0]})
-BUDGET_CELL = ("no_low_cabinets", "1.05")
-
-
-def budget_runs(variant, seeds):
-    placement, height = BUDGET_CELL
-    return [(f"{RESULTS}/train/{variant}/seed{seed}/curve.csv",
-             f"{RESULTS}/eval/{variant}/seed{seed}/{LAYOUT}/{placement}/h{height}.csv") for seed in seeds]
-
-
-def budget_inputs():
-    runs = {v: budget_runs(v, BUDGET["seeds"]) for v in BUDGET["variants"]}
-    runs[REF] = budget_runs(REF, SEEDS)
-    return runs
-
-
+# low cabinets against env steps and core-hours, for the learner settings of config `budget:`
+# (their paths: budget_inputs in common.smk).
 rule budget:
     """What each learner setting buys per env step and per core-hour (the evidence for the profile)."""
     input:

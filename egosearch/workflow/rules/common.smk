@@ -106,3 +106,24 @@ def fig6_random_files():
     is evaluated in during training (Figure 6's curves): its level in that figure."""
     placement = VARIANTS[REF].train_env["placement"]
     return bound_files(["random"], [placement]) if placement in PLACEMENTS else []
+
+
+# The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top
+# of the profile), so the train and evaluate rules serve it unchanged; the profile's own setting
+# is the reference variant's runs, which `all` makes anyway.
+BUDGET = PROF.get("budget", {"variants": [], "seeds": [0]})
+BUDGET_CELL = ("no_low_cabinets", "1.05")
+
+
+def budget_runs(variant, seeds):
+    placement, height = BUDGET_CELL
+    return [(f"{RESULTS}/train/{variant}/seed{seed}/curve.csv",
+             f"{RESULTS}/eval/{variant}/seed{seed}/{LAYOUT}/{placement}/h{height}.csv") for seed in seeds]
+
+
+def budget_inputs():
+    runs = {v: budget_runs(v, BUDGET["seeds"]) for v in BUDGET["variants"]}
+    runs[REF] = budget_runs(REF, SEEDS)
+    return runs
+
+
