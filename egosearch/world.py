@@ -159,7 +159,12 @@ class World:
                 collided = any(c[8] < CONTACT_DISTANCE
                                for c in p.getContactPoints(bodyA=self.agent_id))
         pose = self.pose()
-        if collided and self.penetration() > PENETRATION_TOLERANCE:
+        # Checked on every step, not only after a reported contact: contact points come from
+        # the collision pass *before* each sub-step's integration, so a body that travels
+        # into furniture during the last sub-step (the motor may cover several cm in one) has
+        # no contact to show for it, and would start the next step inside.
+        if self.penetration() > PENETRATION_TOLERANCE:
+            collided = True
             pose = self._back_off((x, y, theta), pose)
         # Freeze the body where it ended: a blocked target must not keep pushing next step.
         for joint in (_JOINT_X, _JOINT_Y, _JOINT_YAW):
@@ -169,7 +174,8 @@ class World:
 
     def _back_off(self, start, end, iterations: int = 8):
         """The last pose on the segment start -> end whose body clears the home: the solver
-        leaves the body a few cm inside what it hit, and a body must end outside."""
+        leaves the body a few cm inside what it hit, and a body must end outside. Every step
+        starts legal, so the answer is at worst ``start`` itself."""
         free, blocked = 0.0, 1.0
         for _ in range(iterations):
             mid = (free + blocked) / 2
