@@ -16,8 +16,11 @@ from egosearch.workflow_check import ConfigError, check_config, checked_variants
 REPO = Path(__file__).resolve().parent.parent
 HEAD = "name: NAME\nenv_id: EgoSearch-v0\ntrain_env: {layout: kitchen_living, placement: everywhere}\n"
 ALLOWED = ", ".join(variant_names(REPO / "ablations"))
-# Snakemake's own notice, printed before the Snakefile runs whenever --config is given.
-NOTICE = "Config file egosearch/workflow/config.yaml is extended by additional config specified via the command line."
+# Snakemake's own notices, printed before the Snakefile body runs: the workflow profile, and
+# --config on top of the config file.
+NOTICES = ("Using workflow specific profile profiles/default for setting default command line arguments.",
+           "Config file egosearch/workflow/config.yaml is extended by additional config specified via the command "
+           "line.")
 
 # (file stem, file text, the one line). Each is a typo the DAG used to pass, or a message that was
 # a traceback.
@@ -75,11 +78,13 @@ def config(**changes):
 
 @pytest.fixture(scope="module")
 def suite(tmp_path_factory):
-    """The workflow files and ablations/ with every bad variant file added (no results)."""
+    """The workflow files, its profiles and ablations/ with every bad variant file added (no results)."""
     dest = tmp_path_factory.mktemp("suite")
     shutil.copy2(REPO / "Snakefile", dest / "Snakefile")
     shutil.copytree(REPO / "egosearch" / "workflow", dest / "egosearch" / "workflow")
     shutil.copytree(REPO / "ablations", dest / "ablations")
+    if (REPO / "profiles").is_dir():
+        shutil.copytree(REPO / "profiles", dest / "profiles")
     for stem, text, _ in BAD_VARIANT_FILES:
         (dest / "ablations" / f"{stem}.yaml").write_text(text.replace("NAME", stem))
     return dest
@@ -88,7 +93,7 @@ def suite(tmp_path_factory):
 def snakemake_lines(cwd, *args):
     out = subprocess.run([sys.executable, "-m", "snakemake", "-n", *args], cwd=cwd, capture_output=True, text=True,
                          timeout=600)
-    lines = [line for line in (out.stdout + out.stderr).splitlines() if line.strip() and line != NOTICE]
+    lines = [line for line in (out.stdout + out.stderr).splitlines() if line.strip() and line not in NOTICES]
     return out.returncode, lines
 
 
