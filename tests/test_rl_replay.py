@@ -104,6 +104,7 @@ def test_very_short_episodes_drop_overwritten_transitions_never_corrupt():
 def test_matches_the_fake_env_stacks_including_resets():
     register_fake_envs()
     env = gymnasium.make(FAKE_ENV_ID, max_steps=7)
+    env.action_space.seed(0)  # unseeded, the episode lengths (and so the count below) varied run to run
     buf = ReplayBuffer(30, S, K, seed=1)
     obs, _ = env.reset(seed=3)
     log = []
@@ -113,7 +114,11 @@ def test_matches_the_fake_env_stacks_including_resets():
         buf.add(obs, a, r, nxt, term, trunc)
         log.append((obs, a, r, nxt, term, trunc))
         obs = env.reset()[0] if term or trunc else nxt
-    assert check_all_valid(buf, log) == 30
+    # Episodes of at most 7 steps need more than the ring's 1 + 1/8 frames per transition, so the
+    # oldest transitions may lose their frames: they must drop out of sampling, never come back
+    # corrupted (check_all_valid compares every sampleable one with the log).
+    valid = check_all_valid(buf, log)
+    assert valid == len(buf) and 25 <= valid <= 30
 
 
 def test_discontinuous_obs_is_an_error_and_new_episode_fixes_it():
