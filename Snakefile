@@ -35,6 +35,7 @@ rule all:
         rules.fig7.output,
         rules.fig7_oracle.output,
         rules.pictures.output,
+        rules.video.output,
         provenance_file(),
 
 

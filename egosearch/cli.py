@@ -234,9 +234,19 @@ def _cmd_video(args) -> None:
     from egosearch.scenarios import read_scenarios
 
     scenarios = {sc.scenario_id: sc for sc in read_scenarios(args.scenarios)}
-    if args.scenario_id not in scenarios:
-        raise ValueError(f"--scenario-id={args.scenario_id} is not in {args.scenarios}")
-    scenario = scenarios[args.scenario_id]
+    scenario_id = args.scenario_id
+    if args.first_success:
+        import pandas as pd
+
+        runs = pd.read_csv(args.first_success)
+        found = sorted(runs.loc[runs["success"].astype(bool), "scenario_id"].astype(int))
+        if found:
+            scenario_id = found[0]
+        else:
+            print(f"note: no episode of {args.first_success} succeeded; filming scenario {scenario_id} instead")
+    if scenario_id not in scenarios:
+        raise ValueError(f"--scenario-id={scenario_id} is not in {args.scenarios}")
+    scenario = scenarios[scenario_id]
     make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
     row = write_search_video(scenario.layout, args.character, make_policy, scenario, args.out,
                              still_path=args.still, M=args.M, T=args.T, seed=args.seed, env_id=env_id)
@@ -427,6 +437,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--scenario-id", type=int, default=0, help="the scenario_id of the row to search (default 0)")
+    p.add_argument("--first-success", metavar="FULLBODY_CSV",
+                   help="film the first scenario that succeeded in this full-body CSV of the same settings "
+                        "(instead of --scenario-id)")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
     p.add_argument("--weights", help="actor.pt of the search policy")
     p.add_argument("--M", type=int, default=5, help="steps executed per plan")

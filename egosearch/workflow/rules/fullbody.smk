@@ -46,3 +46,31 @@ rule fullbody_oracle:
     shell:
         "egosearch fullbody --policy oracle --setting {wildcards.setting} --scenarios {input.scenarios} "
         "--limit {params.limit} --T {params.T} --seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+rule video:
+    """One learned search, filmed: the first scenario the reference policy found in Figure 7's
+    `ours` M=5 humanoid runs, replayed as a GIF (first-person depth + mask beside a third-person
+    view) and a still of the moment the target is found."""
+    input:
+        actor=ancient(f"{RESULTS}/train/{REF}/seed{FULLBODY['seeds'][0]}/actor.pt"),
+        scenarios=ancient(scenario_file("everywhere", "1.65")),
+        fullbody=ancient(f"{RESULTS}/fullbody/ours-M5-humanoid_phase/seed{FULLBODY['seeds'][0]}.csv"),
+    output:
+        gif=f"{FIGS}/search.gif",
+        still=f"{FIGS}/search_still.png",
+    log:
+        f"{RESULTS}/logs/report/video.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/video.tsv"
+    params:
+        seed=FULLBODY["seeds"][0],
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch video --character humanoid_phase --scenarios {input.scenarios} --first-success {input.fullbody} "
+        "--weights {input.actor} --M 5 --seed {params.seed} --out {output.gif} --still {output.still} > {log} 2>&1"

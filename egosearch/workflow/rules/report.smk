@@ -156,6 +156,7 @@ rule provenance:
         rules.fig6.output,
         rules.fig7.output,
         rules.fig7_oracle.output,
+        rules.video.output,
     output:
         provenance_file(),
     log:
