@@ -16,7 +16,9 @@
 
 Killing the process at any moment and running the same call again resumes from the last
 checkpoint: CSV rows written after that checkpoint are dropped and recomputed, so the CSVs end up
-with neither duplicate nor missing rows. Every file is written atomically (temp file in the same
+with neither duplicate nor missing rows. Every env's episode is cut (counted as truncated) at each
+checkpoint, in the uninterrupted run as in the resumed one, so a resumed run equals the run that
+was not stopped. Every file is written atomically (temp file in the same
 folder, fsync, ``os.replace``).
 """
 
