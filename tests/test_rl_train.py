@@ -211,12 +211,23 @@ def test_bad_actor_file_is_a_clear_error(tmp_path):
         ActorPolicy(bad)
 
 
-def test_learning_beats_random_on_the_fake_env(tmp_path):
+LEARNERS = {
+    # ~25 s on one core: 500 updates of the smoke-sized learner (100 -> 84 crops, K = 5, CURL)
+    "sac_curl": {"total_env_steps": 700},
+    # the cpu profile's learner at smoke sizes: 4 lockstep envs, 3-step returns, 500 updates of 64
+    "sac_drq": {"algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2, "encoder_stride2_layers": 2,
+                "aug_pad": 2, "num_envs": 4, "n_step": 3, "batch_size": 64, "update_every": 2,
+                "actor_update_freq": 1, "critic_target_update_freq": 1, "total_env_steps": 1200},
+}
+
+
+@pytest.mark.parametrize("learner", list(LEARNERS))
+def test_learning_beats_random_on_the_fake_env(tmp_path, learner):
     from egosearch.policies import RandomPolicy
 
-    # ~25 s on one core: 500 updates of the smoke-sized learner (100 -> 84 crops, K = 5, CURL)
-    cfg = load_config("smoke", {**SMOKE, "total_env_steps": 700, "init_steps": 200, "eval_every": 700,
-                                "checkpoint_every": 700, "log_every": 100, "eval_episodes": 5, "seed": 0})
+    steps = LEARNERS[learner]["total_env_steps"]
+    cfg = load_config("smoke", {**SMOKE, **LEARNERS[learner], "init_steps": 200, "eval_every": steps,
+                                "checkpoint_every": steps, "log_every": 100, "eval_episodes": 5, "seed": 0})
     train(FAKE_ENV_ID, cfg, tmp_path, progress=False)
     evaluate = default_evaluator(FAKE_ENV_ID, {}, episodes=20)
     trained = evaluate(ActorPolicy(tmp_path / "actor.pt"))

@@ -38,10 +38,12 @@ from egosearch.rl.config import SacCurlConfig
 from egosearch.rl.sac_curl import (
     _LOG_2PI,
     METRIC_KEYS,
+    ActorHead,
     AgentStateError,
     Projection,
     crop_at,
     mlp,
+    obs_to_tensors,
     resolve_device,
     squashed_sample,
     weight_init,
@@ -124,23 +126,6 @@ def random_shift(x: torch.Tensor, pad: int) -> torch.Tensor:
     return crop_at(padded, oy, ox, h)
 
 
-class DrqActorHead(nn.Module):
-    """Own projection of the (detached) conv features, concat [mask, proprio], MLP -> (mu, log_std)."""
-
-    def __init__(self, conv_dim: int, latent_dim: int, extra_dim: int, action_dim: int, hidden_dim: int,
-                 num_layers: int, activation: str, log_std_min: float, log_std_max: float, tanh: bool):
-        super().__init__()
-        self.proj = Projection(conv_dim, latent_dim, tanh)
-        self.trunk = mlp(latent_dim + extra_dim, hidden_dim, 2 * action_dim, num_layers, activation)
-        self.log_std_min, self.log_std_max = float(log_std_min), float(log_std_max)
-
-    def forward(self, h: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        mu, log_std = self.trunk(torch.cat([self.proj(h), extra], dim=-1)).chunk(2, dim=-1)
-        log_std = torch.tanh(log_std)
-        log_std = self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
-        return mu, log_std
-
-
 class DrqCritic(nn.Module):
     """Projection of the conv features and twin Q-heads (the part that has a Polyak target)."""
 
@@ -175,23 +160,13 @@ class DrqActorNet(nn.Module):
         super().__init__()
         self.arch = dict(arch)
         self.encoder = _encoder(arch)
-        self.head = DrqActorHead(self.encoder.out_dim, arch["encoder_latent_dim"], arch["extra_dim"],
+        self.head = ActorHead(self.encoder.out_dim, arch["encoder_latent_dim"], arch["extra_dim"],
                                  arch["action_dim"], arch["actor_hidden_dim"], arch["actor_num_layers"],
                                  arch["actor_activation"], arch["actor_log_std_min"], arch["actor_log_std_max"],
                                  arch["encoder_tanh"])
 
     def forward(self, depth: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         return self.head(self.encoder(self.encoder.pool(depth)), extra)
-
-
-def batch_obs_tensors(obs: dict, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
-    """One observation or a batch (stacked dict) -> (uint8 depth (B, K, H, W), [mask, proprio])."""
-    depth = torch.as_tensor(np.asarray(obs["depth"]))
-    mask = torch.as_tensor(np.asarray(obs["mask"], np.float32))
-    proprio = torch.as_tensor(np.asarray(obs["proprio"], np.float32))
-    if depth.ndim == 3:
-        depth, mask, proprio = depth[None], mask[None], proprio[None]
-    return depth.to(device), torch.cat([mask, proprio], dim=-1).to(device)
 
 
 class SacDrqAgent:
@@ -206,7 +181,7 @@ class SacDrqAgent:
         arch = self.arch()
         self.encoder = _encoder(arch)
         self.critic = DrqCritic(self.encoder.out_dim, cfg, arch["extra_dim"], self.action_dim)
-        self.actor = DrqActorHead(self.encoder.out_dim, cfg.encoder_latent_dim, arch["extra_dim"], self.action_dim,
+        self.actor = ActorHead(self.encoder.out_dim, cfg.encoder_latent_dim, arch["extra_dim"], self.action_dim,
                                   cfg.actor_hidden_dim, cfg.actor_num_layers, cfg.actor_activation,
                                   cfg.actor_log_std_min, cfg.actor_log_std_max, cfg.encoder_tanh)
         for net in (self.encoder, self.critic, self.actor):
@@ -218,12 +193,11 @@ class SacDrqAgent:
         self.log_alpha = torch.tensor(math.log(cfg.init_temperature), device=self.device, requires_grad=True)
         self.target_entropy = -float(self.action_dim)
         self.num_updates = 0
-        betas = lambda b1, b2: (b1, b2)  # noqa: E731
         self.critic_opt = self._adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
                                       {"params": self.encoder.parameters(), "lr": cfg.encoder_lr}],
-                                     cfg.critic_lr, betas(cfg.critic_beta1, cfg.critic_beta2))
-        self.actor_opt = self._adam(self.actor.parameters(), cfg.actor_lr, betas(cfg.actor_beta1, cfg.actor_beta2))
-        self.alpha_opt = self._adam([self.log_alpha], cfg.alpha_lr, betas(cfg.alpha_beta1, cfg.alpha_beta2))
+                                     cfg.critic_lr, (cfg.critic_beta1, cfg.critic_beta2))
+        self.actor_opt = self._adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
+        self.alpha_opt = self._adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
         self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
 
     @staticmethod
@@ -249,7 +223,7 @@ class SacDrqAgent:
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         """Actions (B, A) in [-1, 1] for a stacked batch of observations (one forward pass)."""
         with torch.inference_mode():
-            depth, extra = batch_obs_tensors(obs, self.device)
+            depth, extra = obs_to_tensors(obs, self.device, self.cfg.image_size)  # no crop: the whole image
             mu, log_std = self.actor(self.encoder(self.encoder.pool(depth)), extra)
             a = torch.tanh(mu) if deterministic else squashed_sample(mu, log_std, torch.randn_like(mu))[0]
         return a.float().cpu().numpy()
