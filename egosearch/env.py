@@ -89,7 +89,8 @@ class SearchEnv(gymnasium.Env):
     def __init__(self, layout: str = "kitchen_living", placement: str = "everywhere",
                  head: bool = True, height: float | None = None, height_noise: bool | None = None,
                  max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
-                 distance_reward: str = "distance", render_mode: str | None = None):
+                 distance_reward: str = "distance", train_heights: tuple[float, float] | None = None,
+                 render_mode: str | None = None):
         """
         Args:
             layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
@@ -101,6 +102,8 @@ class SearchEnv(gymnasium.Env):
             objects: target object names to draw from in training (default: all).
             distance_reward: ``distance`` (paper) or ``progress`` (an ablation): see
                 :data:`DISTANCE_REWARDS`.
+            train_heights: (low, high) range (m) of the per-episode camera height in training;
+                default the paper's ``AgentSpec.train_height_range`` [1.0, 1.8].
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
         """
         self.scene = layouts_mod.get_scene(layout)
@@ -119,6 +122,11 @@ class SearchEnv(gymnasium.Env):
         for name in self.objects:
             get_object(name)
         self.spec_agent = replace(AgentSpec(), head=bool(head))
+        if train_heights is not None:
+            low, high = (check_height(h) for h in train_heights)
+            if low > high:
+                raise ValueError(f"train_heights={train_heights!r}: low must not exceed high")
+            self.spec_agent = replace(self.spec_agent, train_height_range=(low, high))
         self._scale = self.spec_agent.action_scale()
         self.world = World(self.scene, self.spec_agent)
         self.sensor = DepthMaskSensor(self.scene, width=IMAGE_SIZE, height=IMAGE_SIZE)

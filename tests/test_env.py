@@ -114,3 +114,22 @@ def test_start_radius_curriculum_starts_near_the_target():
         far.append(math.hypot(env.target.center[0] - env.state.x, env.target.center[1] - env.state.y))
     assert max(far) > 3.0  # without the option, starts come from the whole home
     env.close()
+
+
+def test_training_heights_of_the_cpu_profile_reach_the_lowest_evaluation_camera():
+    from egosearch.rl.config import load_config
+    from egosearch.rl.train import train_env_kwargs
+
+    assert "train_heights" not in train_env_kwargs(load_config("paper"), {"layout": "kitchen_living"})
+    kwargs = train_env_kwargs(load_config("cpu"), {"layout": "kitchen_living"})
+    assert kwargs["train_heights"] == (0.45, 1.8)
+    assert train_env_kwargs(load_config("cpu"), {"train_heights": (1.0, 1.2)})["train_heights"] == (1.0, 1.2)
+    env = gymnasium.make("EgoSearch-v0", **kwargs).unwrapped
+    bases = []
+    for seed in range(30):
+        env.reset(seed=seed)
+        bases.append(env.base_height)
+    assert 0.45 <= min(bases) < 0.8 and max(bases) <= 1.8
+    env.close()
+    with pytest.raises(ValueError, match="train_heights"):
+        gymnasium.make("EgoSearch-v0", train_heights=(1.5, 1.0))

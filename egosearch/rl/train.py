@@ -482,12 +482,19 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
 
 
 def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
-    """The training envs' keyword arguments: the variant's, with r_d's form from the learner config
-    (``train_distance_reward``) unless the variant sets ``distance_reward`` itself. The paper's
-    form is the env's default, so it is not passed (envs without the option still train)."""
-    if cfg.train_distance_reward == "distance":
-        return dict(env_kwargs)
-    return {"distance_reward": cfg.train_distance_reward, **env_kwargs}
+    """The training envs' keyword arguments: the variant's, with r_d's form
+    (``train_distance_reward``) and the training heights (``train_height_min``) from the learner
+    config unless the variant sets ``distance_reward`` / ``train_heights`` itself. The paper's
+    values are the env's defaults, so they are not passed (envs without the options still train)."""
+    from egosearch.agent import AgentSpec
+
+    aids: dict = {}
+    if cfg.train_distance_reward != "distance":
+        aids["distance_reward"] = cfg.train_distance_reward
+    paper_low, paper_high = AgentSpec().train_height_range
+    if cfg.train_height_min != paper_low:
+        aids["train_heights"] = (cfg.train_height_min, paper_high)
+    return {**aids, **env_kwargs}
 
 
 def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: int, device):
