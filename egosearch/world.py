@@ -23,6 +23,12 @@ SUBSTEPS = 4
 CONTACT_DISTANCE = 0.001
 #: A body may end a step at most this deep (m) in the home; the solver's slop is backed off.
 PENETRATION_TOLERANCE = 0.005
+#: Deepest (m) the body may be in the home after any sub-step. Deeper means the motors are
+#: squeezing it through a gap narrower than itself (two chair and sofa arms 33 cm apart let a
+#: 40 cm body through, 4.5 cm deep at the pinch, and the step ended outside both); the step then
+#: stops before the pinch. Equal to ``egosearch.navgrid.MAX_PENETRATION``, the bound that ℓ's
+#: grid assumes (a test keeps them equal; this module must not import that one's scipy).
+SWEEP_TOLERANCE = 0.01
 _JOINT_X, _JOINT_Y, _JOINT_YAW = 0, 1, 2
 _BODY_LINK = 2
 
@@ -132,6 +138,7 @@ class World:
     # -- motion ---------------------------------------------------------------------------
     def reset_agent(self, x: float, y: float, theta: float) -> None:
         p = self._p
+        self.swept_poses = [(x, y, theta)]
         for joint, value in ((_JOINT_X, x), (_JOINT_Y, y), (_JOINT_YAW, theta)):
             p.resetJointState(self.agent_id, joint, value, 0.0)
         # Motors hold the reset pose until the first command.
@@ -153,19 +160,32 @@ class World:
         target = (x + c * dx - s * dy, y + s * dx + c * dy, theta + dtheta)
         self._command(*target)
         collided = False
+        passed = [(x, y, theta)]
+        squeezed = False
         for _ in range(SUBSTEPS):
             p.stepSimulation()
             if not collided:
                 collided = any(c[8] < CONTACT_DISTANCE
                                for c in p.getContactPoints(bodyA=self.agent_id))
-        pose = self.pose()
-        # Checked on every step, not only after a reported contact: contact points come from
-        # the collision pass *before* each sub-step's integration, so a body that travels
-        # into furniture during the last sub-step (the motor may cover several cm in one) has
-        # no contact to show for it, and would start the next step inside.
-        if self.penetration() > PENETRATION_TOLERANCE:
-            collided = True
-            pose = self._back_off((x, y, theta), pose)
+            now = self.pose()
+            # Contact points come from the collision pass *before* each sub-step's motion, so
+            # only the pose itself shows a body pushed deep into (or through) furniture.
+            depth = self.penetration()
+            if depth > SWEEP_TOLERANCE:
+                squeezed = collided = True
+                pose = self._back_off(passed[-1], now)
+                break
+            passed.append(now)
+        if not squeezed:
+            pose = passed.pop()
+            # Checked on every step, not only after a reported contact: a body that travels
+            # into furniture during the last sub-step has no contact to show for it, and would
+            # start the next step inside.
+            if depth > PENETRATION_TOLERANCE:
+                collided = True
+                pose = self._back_off((x, y, theta), pose)
+        #: The poses this step passed through (after each sub-step) and ended at.
+        self.swept_poses = passed[1:] + [pose]
         # Freeze the body where it ended: a blocked target must not keep pushing next step.
         for joint in (_JOINT_X, _JOINT_Y, _JOINT_YAW):
             p.resetJointState(self.agent_id, joint, pose[joint], 0.0)

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from egosearch.agent import AgentSpec
-from egosearch.navgrid import NavGrid
+from egosearch.navgrid import MAX_PENETRATION, NavGrid
 from egosearch.scene.geometry import deepest_penetration
 from egosearch.scene.parts import TAG_OBSTACLE, TAG_WALL, Part, Scene
-from egosearch.world import PENETRATION_TOLERANCE, World, random_free_pose
+from egosearch.world import PENETRATION_TOLERANCE, SWEEP_TOLERANCE, World, random_free_pose
 
 WALL = frozenset({TAG_OBSTACLE, TAG_WALL})
 
@@ -80,6 +80,37 @@ def test_a_move_into_a_panel_during_the_last_substep_is_backed_off():
     # Backed off along its own path: between the start and the pose the physics reached.
     assert start[1] - 0.2 <= pose[1] <= start[1] + 1e-9
     w.close()
+
+
+def test_the_body_is_not_squeezed_through_a_gap_narrower_than_itself():
+    """Replayed from kitchen_living, where a head-off policy passed between an armchair arm and a
+    sofa arm whose corners are 33 cm apart: the 40 cm body went 4.5 cm deep at the pinch, ended
+    the step outside both, and so reached the target by a way shorter than ℓ."""
+    parts = (
+        Part("armchair_arm", "box", (3.8, 1.735, 0.31), (0.65, 0.18, 0.62), tags={TAG_OBSTACLE}),
+        Part("sofa_arm", "box", (4.39, 2.45, 0.31), (0.18, 0.7, 0.62), tags={TAG_OBSTACLE}),
+    )
+    spec = AgentSpec()
+    w = World(Scene("pinch", parts, (), (3.0, 1.0, 5.5, 3.5)), spec)
+    start, end = (4.091, 2.071), (4.323, 1.849)
+    heading = math.atan2(end[1] - start[1], end[0] - start[0])
+    w.reset_agent(*start, heading)
+    pose, collided = w.move(math.dist(start, end), 0.0, 0.0)
+    assert collided
+    assert math.dist(pose[:2], start) < 0.1  # stopped before the pinch, not through it
+    for x, y, _ in w.swept_poses:
+        depth, _ = deepest_penetration(parts, x, y, spec.body_radius, spec.body_clearance,
+                                       spec.body_clearance + spec.body_height)
+        assert depth <= SWEEP_TOLERANCE
+    # A gap wider than the body still lets it through.
+    w.reset_agent(4.7, 1.2, 0.0)
+    pose, collided = w.move(0.25, 0.0, 0.0)
+    assert not collided and pose[0] == pytest.approx(4.95, abs=2e-3)
+    w.close()
+
+
+def test_the_world_and_the_grid_share_the_deepest_allowed_penetration():
+    assert SWEEP_TOLERANCE == MAX_PENETRATION
 
 
 def test_random_actions_never_end_inside_anything(world):
