@@ -1,4 +1,5 @@
-"""Fuzz: no env step and no reset leaves the body more than 1 cm inside an obstacle.
+"""Fuzz: no env step and no reset leaves the body more than 1 cm inside an obstacle, nor passes
+more than 1 cm deep through one on the way (every sub-step's pose is checked).
 
 Random, mostly forward actions in generated homes. Each pose is checked against the scene's
 own parts (:mod:`egosearch.scene.geometry`), not against pybullet, so a pybullet shape that
@@ -67,7 +68,9 @@ def fuzz(seeds, episodes: int, episode_steps: int = EPISODE_STEPS) -> dict:
                 _, _, terminated, truncated, info = env.step(_mostly_forward(rng, env.action_space.shape[0]))
                 steps += 1
                 done = terminated or truncated
-                check(env.scene, *info["pose"][:2], f"{layout} episode {episode} step {info['steps']}")
+                assert env.world.swept_poses[-1][:2] == pytest.approx(info["pose"][:2])
+                for k, (x, y, _) in enumerate(env.world.swept_poses):
+                    check(env.scene, x, y, f"{layout} episode {episode} step {info['steps']} sub-step {k}")
         env.close()
     return {"worst": worst["depth"], "where": worst["where"], "steps": steps, "resets": resets}
 

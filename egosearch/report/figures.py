@@ -165,7 +165,8 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
         ax.set_xlim(left=0)
         ax.yaxis.set_major_locator(MultipleLocator(0.2))
         ax.xaxis.set_major_formatter(FuncFormatter(_steps_formatter))
-        ax.legend(loc="lower right")
+        # Above the axes: inside, any corner would hide a curve at some profile's success rates.
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.01), borderaxespad=0.0)
         outs = _save(fig, base)
     return [*outs, _with(base, ".csv")]
 
