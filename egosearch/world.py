@@ -26,9 +26,10 @@ PENETRATION_TOLERANCE = 0.005
 #: Deepest (m) the body may be in the home after any sub-step. Deeper means the motors are
 #: squeezing it through a gap narrower than itself (two chair and sofa arms 33 cm apart let a
 #: 40 cm body through, 4.5 cm deep at the pinch, and the step ended outside both); the step then
-#: stops before the pinch. Equal to ``egosearch.navgrid.MAX_PENETRATION``, the bound that ℓ's
-#: grid assumes (a test keeps them equal; this module must not import that one's scipy).
-SWEEP_TOLERANCE = 0.01
+#: stops before the pinch. Below ``egosearch.navgrid.MAX_PENETRATION`` (1 cm), the bound that
+#: ℓ's grid assumes, by 2 mm for pybullet's cylinder against the exact geometry (a test keeps it
+#: below; this module must not import that one's scipy).
+SWEEP_TOLERANCE = 0.008
 _JOINT_X, _JOINT_Y, _JOINT_YAW = 0, 1, 2
 _BODY_LINK = 2
 
@@ -113,8 +114,10 @@ class World:
 
     def penetration(self) -> float:
         """Deepest penetration of the body, where it is now, into the home (m, >= 0)."""
-        x, y, _ = self.pose()
-        return max(0.0, -self.clearance_at(x, y, 0.01))
+        return self._penetration_at(self.pose())
+
+    def _penetration_at(self, pose) -> float:
+        return max(0.0, -self.clearance_at(pose[0], pose[1], 0.01))
 
     def clearance_at(self, x: float, y: float, max_distance: float = 0.5) -> float:
         """Signed distance (m) from a body placed at (x, y) to the nearest obstacle, capped."""
@@ -161,7 +164,6 @@ class World:
         self._command(*target)
         collided = False
         passed = [(x, y, theta)]
-        squeezed = False
         for _ in range(SUBSTEPS):
             p.stepSimulation()
             if not collided:
@@ -170,20 +172,21 @@ class World:
             now = self.pose()
             # Contact points come from the collision pass *before* each sub-step's motion, so
             # only the pose itself shows a body pushed deep into (or through) furniture.
-            depth = self.penetration()
+            depth = self._penetration_at(now)
             if depth > SWEEP_TOLERANCE:
-                squeezed = collided = True
+                collided = True
                 pose = self._back_off(passed[-1], now)
+                depth = self._penetration_at(pose)
                 break
             passed.append(now)
-        if not squeezed:
+        else:
             pose = passed.pop()
-            # Checked on every step, not only after a reported contact: a body that travels
-            # into furniture during the last sub-step has no contact to show for it, and would
-            # start the next step inside.
-            if depth > PENETRATION_TOLERANCE:
-                collided = True
-                pose = self._back_off((x, y, theta), pose)
+        # Checked on every step, not only after a reported contact: a body that travels into
+        # furniture during the last sub-step has no contact to show for it, and would start
+        # the next step inside.
+        if depth > PENETRATION_TOLERANCE:
+            collided = True
+            pose = self._back_off((x, y, theta), pose)
         #: The poses this step passed through (after each sub-step) and ended at.
         self.swept_poses = passed[1:] + [pose]
         # Freeze the body where it ended: a blocked target must not keep pushing next step.

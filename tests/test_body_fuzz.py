@@ -22,6 +22,8 @@ from egosearch.scene.parts import TAG_OBSTACLE, Part
 
 #: The rule of the body: never more than this deep (m) in the home after a step or a reset.
 MAX_DEPTH = 0.01
+#: The rule on the way: never more than this deep after any sub-step either (ℓ's grid assumes it).
+MAX_SWEEP_DEPTH = 0.01
 #: Scenario starts drawn per home (evaluation resets put the body there directly).
 SCENARIO_STARTS = 50
 #: Long episodes: a mostly-forward body spends more of them pushing against furniture, where
@@ -42,13 +44,14 @@ def fuzz(seeds, episodes: int, episode_steps: int = EPISODE_STEPS) -> dict:
     """Run ``episodes`` episodes in each home ``home<seed>``; the deepest pose found and counts."""
     spec = AgentSpec()
     z0, z1 = spec.body_clearance, spec.body_clearance + spec.body_height
-    worst = {"depth": 0.0, "where": None}
+    worst = {"depth": 0.0, "where": None, "sweep": 0.0, "sweep_where": None}
     steps = resets = 0
 
-    def check(scene, x, y, where):
+    def check(scene, x, y, where, on_the_way=False):
         depth, part = deepest_penetration(scene.parts, x, y, spec.body_radius, z0, z1)
-        if depth > worst["depth"]:
-            worst.update(depth=depth, where=f"{where}: {depth * 100:.2f} cm in {part}")
+        key, at = ("sweep", "sweep_where") if on_the_way else ("depth", "where")
+        if depth > worst[key]:
+            worst.update({key: depth, at: f"{where}: {depth * 100:.2f} cm in {part}"})
 
     for seed in seeds:
         layout = f"home{seed}"
@@ -68,11 +71,14 @@ def fuzz(seeds, episodes: int, episode_steps: int = EPISODE_STEPS) -> dict:
                 _, _, terminated, truncated, info = env.step(_mostly_forward(rng, env.action_space.shape[0]))
                 steps += 1
                 done = terminated or truncated
+                where = f"{layout} episode {episode} step {info['steps']}"
                 assert env.world.swept_poses[-1][:2] == pytest.approx(info["pose"][:2])
-                for k, (x, y, _) in enumerate(env.world.swept_poses):
-                    check(env.scene, x, y, f"{layout} episode {episode} step {info['steps']} sub-step {k}")
+                check(env.scene, *info["pose"][:2], where)
+                for k, (x, y, _) in enumerate(env.world.swept_poses[:-1]):
+                    check(env.scene, x, y, f"{where} sub-step {k}", on_the_way=True)
         env.close()
-    return {"worst": worst["depth"], "where": worst["where"], "steps": steps, "resets": resets}
+    return {"worst": worst["depth"], "where": worst["where"], "worst_sweep": worst["sweep"],
+            "sweep_where": worst["sweep_where"], "steps": steps, "resets": resets}
 
 
 def test_fuzz_small_slice():
@@ -80,14 +86,17 @@ def test_fuzz_small_slice():
     assert found["resets"] == 2 * (SCENARIO_STARTS + 1)
     assert found["steps"] >= 2 * 20  # mostly-forward episodes rarely find the target fast
     assert found["worst"] <= MAX_DEPTH, found["where"]
+    assert found["worst_sweep"] <= MAX_SWEEP_DEPTH, found["sweep_where"]
 
 
 @pytest.mark.slow
 def test_fuzz_hundred_homes():
     found = fuzz(range(100), episodes=2)
     print(f"\nbody fuzz: 100 homes, {found['steps']} steps, {found['resets']} resets, "
-          f"deepest {found['worst'] * 100:.2f} cm ({found['where']})")
+          f"deepest {found['worst'] * 100:.2f} cm ({found['where']}), on the way "
+          f"{found['worst_sweep'] * 100:.2f} cm ({found['sweep_where']})")
     assert found["worst"] <= MAX_DEPTH, found["where"]
+    assert found["worst_sweep"] <= MAX_SWEEP_DEPTH, found["sweep_where"]
 
 
 # -- the geometry the fuzz relies on, on hand-worked cases ---------------------------------------
