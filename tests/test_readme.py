@@ -92,6 +92,43 @@ def test_compare_block_lists_every_stored_comparison(tmp_path):
     assert "| 1.05 | everywhere | spl | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.03 | 0.06 |" in out
 
 
+def _write_reading_inputs(root: Path) -> None:
+    figs = root / "paper_figs" / "cpu"
+    figs.mkdir(parents=True)
+    rows = []
+    for (h, pl, rate, lo, hi) in [(0.45, "no_low_cabinets", 0.20, 0.15, 0.25), (1.05, "no_low_cabinets", 0.85, 0.80, 0.90),
+                                   (0.45, "everywhere", 0.50, 0.45, 0.55), (1.05, "everywhere", 0.55, 0.50, 0.60)]:
+        rows.append({"height": h, "placement": pl, "success_rate": rate, "wilson_low": lo, "wilson_high": hi,
+                     "random_success_rate": 0.0, "oracle_success_rate": 1.0})
+    pd.DataFrame(rows).to_csv(figs / "table1.csv", index=False)
+    pd.DataFrame([{"variant": v, "env_steps": s, "success_rate": r, "low": lo, "high": hi}
+                  for v, s, r, lo, hi in [("head_on", 0, 0.0, 0.0, 0.0), ("head_on", 100, 0.6, 0.5, 0.7),
+                                          ("head_off", 100, 0.3, 0.2, 0.4)]]).to_csv(figs / "fig6.csv", index=False)
+    pd.DataFrame([{"method": m, "label": lab, "M": M, "spl": spl, "spl_low": lo, "spl_high": hi, "attempts": att}
+                  for m, lab, M, spl, lo, hi, att in [("one_step_short", "1-step short", 5, 0.10, 0.05, 0.15, 9.0),
+                                                      ("ours", "ours", 1, 0.50, 0.45, 0.55, 60.0),
+                                                      ("ours", "ours", 20, 0.12, 0.08, 0.16, 3.0)]]
+                 ).to_csv(figs / "fig7.csv", index=False)
+
+
+def test_reading_block_states_what_the_stored_numbers_show(tmp_path):
+    """Hand-made numbers: which cells are within 0.10 of the paper (0.50, 0.92, 0.58, 0.75), which
+    intervals are apart, and the direction of M."""
+    from egosearch.report.readme import block_reading
+
+    _write_reading_inputs(tmp_path)
+    text = block_reading(tmp_path, "cpu")
+    assert "within 0.10 of the paper's success rate in 2 of 4 cells" in text  # 1.05 excl and 0.45 everywhere
+    assert "0.45 m no low cabinets 0.20 vs 0.50" in text and "1.05 m everywhere 0.55 vs 0.75" in text
+    assert "every cell sits 0.20–0.85 of the way" in text
+    # excluding cabinets: 0.85 - 0.20 = +0.65, paper 0.92 - 0.50 = +0.42; everywhere 0.55 - 0.50, paper 0.75 - 0.58
+    assert "minus 0.45 m is +0.65 (paper: +0.42); 1.05 m against 0.45 m: intervals apart" in text
+    assert "minus 0.45 m is +0.05 (paper: +0.17); 1.05 m against 0.45 m: intervals overlap" in text
+    assert "head-on minus head-off is +0.30 (seed-bootstrap intervals apart)" in text
+    assert "1-step short 0.10 (ours' interval above theirs at 1 of 2 M)" in text
+    assert "SPL falls from 0.50 at M=1 to 0.12 at M=20 (intervals apart); attempts fall from 60.0 to 3.0" in text
+
+
 def test_unknown_block_is_an_error(tmp_path):
     with pytest.raises(ValueError, match="'tabel1' is unknown"):
         render_readme("<!-- egosearch:begin tabel1 -->\n<!-- egosearch:end tabel1 -->", tmp_path, "p")

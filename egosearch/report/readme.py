@@ -19,6 +19,7 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import yaml
 
@@ -166,6 +167,113 @@ def block_budget(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+def _versus(a: float, a_low: float, a_high: float, b: float, b_low: float, b_high: float) -> str:
+    """"above", "below" or "overlapping": where interval a lies against interval b."""
+    if a_low > b_high:
+        return "above"
+    if a_high < b_low:
+        return "below"
+    return "overlapping"
+
+
+def _apart(*intervals) -> str:
+    return "intervals overlap" if _versus(*intervals) == "overlapping" else "intervals apart"
+
+
+def _reading_table1(df: pd.DataFrame) -> list[str]:
+    from egosearch.report.tables import PAPER_TABLE1 as PAPER
+
+    df = df.assign(height=df["height"].round(2))
+    cell = {(r.height, r.placement): r for r in df.itertuples(index=False)}
+    out = []
+    close = [(h, pl) for (h, pl), r in cell.items() if abs(r.success_rate - PAPER.get((h, pl), math.nan)) <= 0.10]
+    far = ", ".join(f"{h:g} m {pl.replace('_', ' ')} {_fmt(r.success_rate)} vs {_fmt(PAPER[(h, pl)])}"
+                    for (h, pl), r in cell.items() if (h, pl) not in close)
+    out.append(f"- **Table 1 against the paper:** within 0.10 of the paper's success rate in {len(close)} of "
+               f"{len(cell)} cells" + (f"; further off in the others (ours vs paper): {far}." if far else "."))
+    if {"random_success_rate", "oracle_success_rate"} <= set(df.columns):
+        floor = df["random_success_rate"]
+        share = (df["success_rate"] - floor) / (df["oracle_success_rate"] - floor)
+        out.append(f"- **Between the bounds:** every cell sits {_fmt(share.min())}–{_fmt(share.max())} of the way "
+                   "from the random searcher to the privileged oracle.")
+    for pl in ("no_low_cabinets", "everywhere"):
+        low, tall = cell.get((0.45, pl)), [cell[(h, pl)] for h in (1.05, 1.65) if (h, pl) in cell]
+        if low is None or not tall:
+            continue
+        ours = np.mean([t.success_rate for t in tall]) - low.success_rate
+        paper = np.mean([PAPER[(t.height, pl)] for t in tall]) - PAPER[(0.45, pl)]
+        taller = " and ".join(f"{t.height:g}" for t in tall)
+        sides = [f"{t.height:g} m against 0.45 m: " + _apart(t.success_rate, t.wilson_low, t.wilson_high,
+                                                            low.success_rate, low.wilson_low, low.wilson_high)
+                 for t in tall]
+        out.append(f"- **Height, {pl.replace('_', ' ')}** (paper: tall cameras see more, a drop for the shortest): "
+                   f"the mean of {taller} m minus 0.45 m is {ours:+.2f} (paper: {paper:+.2f}); "
+                   + "; ".join(sides) + ".")
+    moves = []
+    for h in (0.45, 1.05, 1.65):
+        a, b = cell.get((h, "everywhere")), cell.get((h, "no_low_cabinets"))
+        if a is None or b is None:
+            continue
+        paper = PAPER[(h, "everywhere")] - PAPER[(h, "no_low_cabinets")]
+        apart = _apart(a.success_rate, a.wilson_low, a.wilson_high, b.success_rate, b.wilson_low, b.wilson_high)
+        moves.append(f"{h:g} m {a.success_rate - b.success_rate:+.2f} (paper {paper:+.2f}; {apart})")
+    if moves:
+        out.append("- **Cabinets** (paper: tall cameras lose when targets may be inside low cabinets, the shortest "
+                   "gains): everywhere minus excluding cabinets, " + "; ".join(moves) + ".")
+    return out
+
+
+def _reading_fig6(df: pd.DataFrame) -> list[str]:
+    last = {v: g.sort_values("env_steps").iloc[-1] for v, g in df.groupby("variant", sort=False)}
+    if "head_on" not in last or "head_off" not in last:
+        return []
+    on, off = last["head_on"], last["head_off"]
+    if any(math.isnan(x) for x in (on.low, on.high, off.low, off.high)):
+        side = "one seed: no interval"
+    else:
+        side = "seed-bootstrap " + _apart(on.success_rate, on.low, on.high, off.success_rate, off.low, off.high)
+    return [f"- **Head on vs head off** (paper: head movement gives a 20% higher success rate): at "
+            f"{int(on.env_steps):,} env steps, head-on minus head-off is {on.success_rate - off.success_rate:+.2f} "
+            f"({side})."]
+
+
+def _reading_fig7(df: pd.DataFrame) -> list[str]:
+    ours = df[df["method"] == "ours"].sort_values("M")
+    base = df[df["method"] != "ours"]
+    if ours.empty or base.empty:
+        return []
+    out = []
+    verdicts = []
+    for b in base.itertuples(index=False):
+        apart = sum(_versus(o.spl, o.spl_low, o.spl_high, b.spl, b.spl_low, b.spl_high) == "above"
+                    for o in ours.itertuples(index=False))
+        verdicts.append(f"{b.label} {_fmt(b.spl)} (ours' interval above theirs at {apart} of {len(ours)} M)")
+    out.append(f"- **Ours vs the baselines** (paper: ours about 40% higher SPL than 1-step and than noisy search): "
+               f"ours has SPL {_fmt(ours['spl'].min())}–{_fmt(ours['spl'].max())} over M; " + "; ".join(verdicts) + ".")
+    first, last = ours.iloc[0], ours.iloc[-1]
+    if len(ours) > 1:
+        trend = "falls" if last.spl < first.spl else "rises"
+        side = _apart(first.spl, first.spl_low, first.spl_high, last.spl, last.spl_low, last.spl_high)
+        attempts = "fall" if last.attempts < first.attempts else "rise"
+        out.append(f"- **M** (paper: smaller M gives higher SPL, at the cost of more attempts): SPL {trend} from "
+                   f"{_fmt(first.spl)} at M={int(first.M)} to {_fmt(last.spl)} at M={int(last.M)} ({side}); "
+                   f"attempts {attempts} from {first.attempts:.1f} to {last.attempts:.1f}.")
+    return out
+
+
+def block_reading(root: Path, profile: str) -> str:
+    """The stored run read against the paper's sentences, written from Table 1, Figure 6 and Figure 7's
+    data: which claims it reproduces, by how much, and whether the 95% intervals are apart."""
+    figs = root / "paper_figs" / profile
+    paths = [figs / "table1.csv", figs / "fig6.csv", figs / "fig7.csv"]
+    missing = [p for p in paths if not p.exists()]
+    if missing:
+        return _missing(root, missing[0])
+    lines = (_reading_table1(pd.read_csv(paths[0])) + _reading_fig6(pd.read_csv(paths[1]))
+             + _reading_fig7(pd.read_csv(paths[2])))
+    return "\n".join(lines) + "\n\nFrom `" + "`, `".join(str(p.relative_to(root)) for p in paths) + "`.\n"
+
+
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
@@ -175,6 +283,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
     "provenance": block_provenance,
     "compare": block_compare,
+    "reading": block_reading,
 }
 
 
