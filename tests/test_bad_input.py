@@ -32,6 +32,9 @@ BAD_VARIANT_FILES = [
     ("lr_negative", HEAD + "config: {critic_lr: -1.0}\n",
      "ablations/lr_negative.yaml: config (on the cpu learner profile): SacCurlConfig.critic_lr=-1.0 is out of "
      "range; allowed: > 0"),
+    ("too_short", HEAD + "config: {train_height_min: 0.1}\n",
+     "ablations/too_short.yaml: config (on the cpu learner profile): SacCurlConfig.train_height_min=0.1 is out "
+     "of range; allowed: [0.3, 1.8] m (training heights are drawn from [this, 1.8] m)"),
     ("steps_float", HEAD + "config: {total_env_steps: 2.5e4}\n",
      "ablations/steps_float.yaml: config: total_env_steps='2.5e4' is not an int"),
     ("flag_word", HEAD + "config: {encoder_tanh: maybe}\n",
