@@ -276,11 +276,6 @@ def test_every_stored_ell_is_what_the_code_computes_now():
     _stored_ell_matches(lambda scs: scs)
 
 
-# Open defect (found by the stored run of the current cpu profile, not yet explained): the head-off
-# policy succeeded in 3.38 m where ℓ says 4.24 m. Listed so that any NEW violation still fails.
-KNOWN_VIOLATIONS = {("cpu/eval/head_off/seed2/kitchen_living/everywhere/h0.45.csv", 81)}
-
-
 def test_stored_evaluation_successes_respect_the_current_ell():
     """Every stored evaluation's success against ℓ of its scenario set as stored now (the rows
     themselves may carry an older ℓ)."""
@@ -297,6 +292,6 @@ def test_stored_evaluation_successes_respect_the_current_ell():
                     ell, p = ells[int(row["scenario_id"])], float(row["path_length"])
                     if not lower_bound_holds(ell, p):
                         violations.add((str(path.relative_to(ROOT / "results")), int(row["scenario_id"])))
-    assert violations <= KNOWN_VIOLATIONS, sorted(violations - KNOWN_VIOLATIONS)
+    assert not violations, sorted(violations)
     if not checked:
         pytest.skip("no stored evaluations")
