@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from egosearch.report.budget import BUDGET_COLUMNS, budget_figure, budget_frame
+from egosearch.report.budget import BUDGET_COLUMNS, budget_figure, budget_frame, log_ticks
 from egosearch.report.stats import wilson_ci
 
 CURVE = ["env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss", "curl_loss",
@@ -45,3 +45,27 @@ def test_budget_refuses_runs_of_one_setting_that_end_at_different_steps(tmp_path
     runs = {"mixed": [_run(tmp_path, "mixed", 0, 1000, 5.0, [1]), _run(tmp_path, "mixed", 1, 2000, 5.0, [0])]}
     with pytest.raises(ValueError, match="different env steps"):
         budget_frame(runs)
+
+
+def test_log_ticks_label_a_span_narrower_than_a_decade():
+    # The stored study's core-hours (0.36-0.80 per run, padded by 1.4x): no power of ten inside
+    # but 1, so a plain log axis labels one tick at most.
+    assert log_ticks(0.255, 1.116) == [0.3, 0.5, 1.0]
+    assert log_ticks(17_000, 420_000) == [20_000, 30_000, 50_000, 100_000, 200_000, 300_000]
+    # Too many at 1-2-3-5: 1-2-5, then 1-3, then one per decade.
+    assert log_ticks(1, 50) == [1, 2, 5, 10, 20, 50]
+    assert log_ticks(1, 100) == [1, 3, 10, 30, 100]
+    assert log_ticks(1, 1000) == [1, 10, 100, 1000]
+
+
+def test_budget_names_the_machine_each_setting_trained_on(tmp_path):
+    import json
+
+    old = _run(tmp_path, "old", 0, 1000, 100.0, [1, 0])
+    new = [_run(tmp_path, "new", s, 1000, 100.0, [1, 1]) for s in range(2)]
+    for (curve, _), cpu in zip(new, ("CPU B", "CPU A")):
+        (curve.parent / "done.json").write_text(json.dumps({"machine": {"cpu": cpu, "cores": 2}}))
+    df = budget_frame({"old": [old], "new": new}).set_index("setting")
+    # A run finished before training recorded its machine says so; seeds split over machines name both.
+    assert df.loc["old", "machine"] == "not recorded"
+    assert df.loc["new", "machine"] == "CPU A + CPU B"

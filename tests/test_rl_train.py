@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.machine import cpu_model
 from egosearch.rl.config import load_config
 from egosearch.rl.sac_curl import AgentStateError
 from egosearch.rl.train import (
@@ -65,6 +66,8 @@ def check_complete_run(out: Path, cfg, checkpoint_kept: bool = False) -> dict:
     done = json.loads((out / "done.json").read_text())
     assert done["env_steps"] == cfg.total_env_steps
     assert done["updates"] == cfg.total_env_steps - cfg.init_steps + 1  # an update after every step >= init_steps
+    # core time is read against the machine that spent it (the budget study's `trained on`)
+    assert done["machine"] == {"cpu": cpu_model(), "cores": os.cpu_count()}
     # deleted at the end unless asked for (it holds the replay buffer)
     assert (out / CHECKPOINT_NAME).exists() == checkpoint_kept
     assert not list(out.glob("**/.tmp*"))  # no temp file left behind, even after a kill -9

@@ -3,12 +3,15 @@
 One point per learner setting: success at one Table 1 cell (1.05 m, excluding low cabinets by
 default), pooled over the setting's seeds with a Wilson 95% interval, against the env steps it
 trained for and the core-hours its training took (``wall_s`` of the last row of its curve.csv
-times its torch threads: the runs are one-thread jobs, so wall time on a core is core time).
+times its torch threads: the runs are one-thread jobs, so wall time on a core is core time). Core
+time is the machine's: each row names the CPU its runs trained on (``machine``).
 CSV in, files out: no torch, no simulator.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -17,7 +20,7 @@ import matplotlib
 import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, NullFormatter
+from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
 from egosearch.report.data import _with, output_base, read_curves, read_episodes
 from egosearch.report.figures import OKABE_ITO, STYLE, _save
@@ -26,7 +29,18 @@ from egosearch.report.stats import wilson_ci
 PathLike = str | os.PathLike
 
 BUDGET_COLUMNS = ("setting", "label", "n_seeds", "env_steps", "core_hours", "core_hours_per_seed", "episodes",
-                  "success_rate", "low", "high", "env_steps_per_core_s")
+                  "success_rate", "low", "high", "env_steps_per_core_s", "machine")
+NOT_RECORDED = "not recorded"
+
+
+def run_machine(curve: PathLike) -> str:
+    """The CPU that trained the run of ``curve`` (from the ``done.json`` beside it; runs made before
+    training recorded it say so), so that core-hours are read against the machine they were spent on."""
+    done = Path(curve).parent / "done.json"
+    try:
+        return json.loads(done.read_text()).get("machine", {}).get("cpu") or NOT_RECORDED
+    except (OSError, ValueError, AttributeError):
+        return NOT_RECORDED
 
 
 def budget_frame(runs: Mapping[str, Iterable[tuple[PathLike, PathLike]]], threads: int = 1,
@@ -52,8 +66,21 @@ def budget_frame(runs: Mapping[str, Iterable[tuple[PathLike, PathLike]]], thread
                      "env_steps": steps[0], "core_hours": core_s / 3600,
                      "core_hours_per_seed": core_s / 3600 / len(pairs), "episodes": n,
                      "success_rate": k / n, "low": low, "high": high,
-                     "env_steps_per_core_s": steps[0] * len(pairs) / core_s})
+                     "env_steps_per_core_s": steps[0] * len(pairs) / core_s,
+                     "machine": " + ".join(sorted({run_machine(c) for c, _ in pairs}))})
     return pd.DataFrame(rows, columns=list(BUDGET_COLUMNS))
+
+
+def log_ticks(low: float, high: float, max_ticks: int = 6) -> list[float]:
+    """Round tick values (1, 2, 3, 5, else fewer, times a power of ten) inside [low, high], at most
+    ``max_ticks`` of them (one per decade when even that is more), on any span, including one
+    narrower than a decade, where a plain log axis has no labelled tick."""
+    for mantissas in ((1, 2, 3, 5), (1, 2, 5), (1, 3), (1,)):
+        ticks = [float(f"{m}e{e}") for e in range(math.floor(math.log10(low)), math.ceil(math.log10(high)) + 1)
+                 for m in mantissas if low <= float(f"{m}e{e}") <= high]
+        if len(ticks) <= max_ticks:
+            return ticks
+    return ticks
 
 
 def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, excluding low cabinets",
@@ -75,9 +102,14 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
                 ax.errorbar([x], [row.success_rate], yerr=[[row.success_rate - row.low], [row.high - row.success_rate]],
                             fmt="o" if row.setting == chosen else "s", color=colour,
                             mfc=colour if row.setting == chosen else "white", ms=6, label=label)
-        for ax in axes:
+        for ax, values in zip(axes, (df["env_steps"], df["core_hours_per_seed"])):
+            low, high = float(values.min()) / 1.4, float(values.max()) * 1.4
             ax.set_xscale("log")
-            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.set_xlim(low, high)
+            # The settings may span less than a decade, where a log axis has no labelled tick.
+            ax.xaxis.set_major_locator(FixedLocator(log_ticks(low, high)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v / 1000:g}k" if v >= 1000 else f"{v:g}"))
+            ax.xaxis.set_minor_locator(NullLocator())
             ax.xaxis.set_minor_formatter(NullFormatter())
         axes[0].set_xlabel("environment steps per run")
         axes[1].set_xlabel("core-hours per run (training, all in)")
@@ -89,4 +121,4 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
     return [_with(base, ".csv"), *outs]
 
 
-__all__ = ["BUDGET_COLUMNS", "budget_figure", "budget_frame"]
+__all__ = ["BUDGET_COLUMNS", "NOT_RECORDED", "budget_figure", "budget_frame", "log_ticks", "run_machine"]

@@ -38,6 +38,7 @@ import gymnasium
 import numpy as np
 import torch
 
+from egosearch.machine import cpu_model
 from egosearch.rl.config import SacCurlConfig
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_curl import (
@@ -711,6 +712,8 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
                "env_steps": step, "updates": agent.num_updates,
                "episodes": episodes, "wall_s": round(wall(), 3), "actor": "actor.pt",
                "final_eval": {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in last_row.items()},
+               # wall_s is core time only on the machine that ran it: the budget study shows which
+               "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
                "config": cfg.to_dict()}
     atomic_json(done_path, summary)
     if not cfg.keep_checkpoint and ckpt_path.exists():
