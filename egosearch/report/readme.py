@@ -159,14 +159,12 @@ def block_budget(root: Path, profile: str) -> str:
     if not path.exists():
         return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 budget")
     df = pd.read_csv(path)
-    machine = "machine" in df.columns
     lines = ["| setting | seeds | env steps per run | core-hours per run | env steps per core-second | "
-             "success, 1.05 m excl. low cabinets (95% CI) |" + (" trained on |" if machine else ""),
-             "|---|---|---|---|---|---|" + ("---|" if machine else "")]
+             "success, 1.05 m excl. low cabinets (95% CI) | trained on |", "|---|---|---|---|---|---|---|"]
     for r in df.itertuples(index=False):
         lines.append(f"| `{r.setting}` | {int(r.n_seeds)} | {int(r.env_steps):,} | {_fmt(r.core_hours_per_seed)} | "
-                     f"{r.env_steps_per_core_s:.0f} | {_fmt(r.success_rate)} [{_fmt(r.low)}, {_fmt(r.high)}] |"
-                     + (f" {r.machine} |" if machine else ""))
+                     f"{r.env_steps_per_core_s:.0f} | {_fmt(r.success_rate)} [{_fmt(r.low)}, {_fmt(r.high)}] | "
+                     f"{r.machine} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
