@@ -3,6 +3,8 @@
 #   snakemake --cores 2 table1                  # Table 1 only (trains what it needs)
 #   snakemake --cores 2 compare --config variant=my_variant
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
+import sys
+
 from snakemake.utils import min_version, validate
 
 from egosearch.workflow_check import checked_variants
@@ -46,3 +48,9 @@ if workflow.is_main_process:
 
     if clear_stale_locks():
         print("Removed the lock of a snakemake run that was killed (no snakemake process runs here).")
+
+    from egosearch.workflow_check import reports_missing_inputs
+
+    for line in reports_missing_inputs((r.name, [str(f) for f in r.output], [str(f) for f in r.input])
+                                       for r in workflow.rules if not r.has_wildcards()):
+        print(line, file=sys.stderr)

@@ -4,7 +4,9 @@ Observation (a ``Dict``):
 - ``depth``: the last K = 5 depth frames, oldest first, uint8 100x100, depth / 5 m * 255; at
   reset the first frame is repeated K times;
 - ``mask``: the 29-d mask feature [xc, yc, r, alpha, 5x5 mask] plus a visibility flag;
-- ``proprio``: (q_p, q_y, last change of q_p, last change of q_y); zeros for the head-off body.
+- ``proprio``: (q_p, q_y, last change of q_p, last change of q_y); zeros for the head-off body;
+- ``state`` (only with ``privileged_state=True``, for a privileged critic in training): the
+  hidden state of :func:`privileged_state`. No policy ever reads it.
 
 Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.agent.AgentSpec`
 (head-off: [dx, dy, dtheta]).
@@ -51,6 +53,8 @@ SUCCESS_REWARD = 10.0
 LIVE_PENALTY = -0.1
 COLLISION_PENALTY_PER_HIT = -0.1
 COLLISION_PENALTY_FLOOR = -3.0
+PRIVILEGED_STATE_DIM = 12
+"""Size of :func:`privileged_state`."""
 
 
 DISTANCE_REWARDS = ("distance", "progress")
@@ -83,6 +87,18 @@ def target_distance(state: AgentState, target: Part, body_radius: float) -> floa
     return max(0.0, d)
 
 
+def privileged_state(state: AgentState, target: Part, distance: float, visible: bool) -> np.ndarray:
+    """What the env knows and the policy does not (asymmetric actor-critic, Pinto et al. 2018):
+    the body's position (m / 10) and heading (cos, sin) in the home, the target's position
+    (m / 10), the target in the body's frame (forward, left, m / 5), the distance of eq. 2 (m / 5),
+    the camera height (m) and whether the target is seen."""
+    dx, dy = target.center[0] - state.x, target.center[1] - state.y
+    c, s = math.cos(state.theta), math.sin(state.theta)
+    return np.array([state.x / 10, state.y / 10, c, s, target.center[0] / 10, target.center[1] / 10,
+                     target.center[2] / 10, (c * dx + s * dy) / 5, (-s * dx + c * dy) / 5, distance / 5,
+                     state.camera_height, float(visible)], np.float32)
+
+
 class SearchEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 1.0 / 0.15}
 
@@ -90,7 +106,7 @@ class SearchEnv(gymnasium.Env):
                  head: bool = True, height: float | None = None, height_noise: bool | None = None,
                  max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
                  distance_reward: str = "distance", train_heights: tuple[float, float] | None = None,
-                 render_mode: str | None = None):
+                 privileged_state: bool = False, render_mode: str | None = None):
         """
         Args:
             layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
@@ -104,6 +120,8 @@ class SearchEnv(gymnasium.Env):
                 :data:`DISTANCE_REWARDS`.
             train_heights: (low, high) range (m) of the per-episode camera height in training;
                 default the paper's ``AgentSpec.train_height_range`` [1.0, 1.8].
+            privileged_state: add the ``state`` entry (:func:`privileged_state`) to every
+                observation, for a learner's privileged critic; policies never read it.
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
         """
         self.scene = layouts_mod.get_scene(layout)
@@ -130,11 +148,15 @@ class SearchEnv(gymnasium.Env):
         self._scale = self.spec_agent.action_scale()
         self.world = World(self.scene, self.spec_agent)
         self.sensor = DepthMaskSensor(self.scene, width=IMAGE_SIZE, height=IMAGE_SIZE)
-        self.observation_space = spaces.Dict({
+        self.with_state = bool(privileged_state)
+        observation_spaces = {
             "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
             "mask": spaces.Box(-4.0, 4.0, (MASK_FEATURE_DIM,), np.float32),
             "proprio": spaces.Box(-4.0, 4.0, (4,), np.float32),
-        })
+        }
+        if self.with_state:
+            observation_spaces["state"] = spaces.Box(-np.inf, np.inf, (PRIVILEGED_STATE_DIM,), np.float32)
+        self.observation_space = spaces.Dict(observation_spaces)
         self.action_space = spaces.Box(-1.0, 1.0, (self.spec_agent.action_dim,), np.float32)
         self._frames = np.zeros((FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8)
         self._last_depth = self._last_mask = None
@@ -265,8 +287,12 @@ class SearchEnv(gymnasium.Env):
         proprio = np.zeros(4, np.float32)
         if self.spec_agent.head:
             proprio[:] = (s.pitch, s.head_yaw, self._dq[0], self._dq[1])
-        return {"depth": self._frames.copy(), "mask": mask_feature(mask).astype(np.float32),
-                "proprio": proprio}
+        obs = {"depth": self._frames.copy(), "mask": mask_feature(mask).astype(np.float32),
+               "proprio": proprio}
+        if self.with_state:
+            distance = target_distance(s, self.target, self.spec_agent.body_radius)
+            obs["state"] = privileged_state(s, self.target, distance, bool(mask.any()))
+        return obs
 
     def _info(self, visible: bool, success: bool, distance: float | None = None) -> dict:
         s = self.state

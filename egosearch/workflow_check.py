@@ -100,3 +100,20 @@ def checked_variants(config: dict, argv: list[str] | None = None,
     except (ConfigError, VariantError) as err:
         print(f"egosearch: error: {err}", file=sys.stderr)
         sys.exit(1)
+
+
+def reports_missing_inputs(rules, exists=lambda p: Path(p).exists()) -> list[str]:
+    """One line for each rule whose outputs are all stored but some of whose inputs are not.
+
+    ``rules``: (name, outputs, inputs) of the rules without wildcards. Snakemake (>= 7.7) does not
+    rerun a job whose outputs exist for a missing input, even one a rule can make (it takes it for
+    a deleted intermediate), so a variant or budget setting added to the config would otherwise
+    be skipped without a word; ``-R NAME`` makes the missing inputs and redoes the report."""
+    lines = []
+    for name, outputs, inputs in rules:
+        missing = [p for p in inputs if not exists(p)]
+        if outputs and missing and all(exists(p) for p in outputs):
+            lines.append(f"{name}: its outputs are stored but {len(missing)} of its inputs are not "
+                         f"(e.g. {missing[0]}); Snakemake will not make them for it: "
+                         f"add `-R {name}` to make them and redo {name}")
+    return lines

@@ -112,3 +112,26 @@ def test_config_file_is_valid_yaml_with_all_profiles():
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
     assert set(config["profiles"]) == {"smoke", "cpu", "paper"}
     assert config["profile"] == "cpu"
+
+
+def test_a_report_with_stored_outputs_and_missing_inputs_is_named():
+    from egosearch.workflow_check import reports_missing_inputs
+
+    stored = {"fig6.png", "fig6.csv", "a/curve.csv"}
+    rules = [("fig6", ["fig6.png", "fig6.csv"], ["a/curve.csv", "new/curve.csv"]),
+             ("table1", ["table1.csv"], ["new/curve.csv"]),  # not made yet: Snakemake makes it
+             ("budget", ["fig6.csv"], ["a/curve.csv"])]  # nothing missing
+    lines = reports_missing_inputs(rules, exists=stored.__contains__)
+    assert lines == ["fig6: its outputs are stored but 1 of its inputs are not (e.g. new/curve.csv); Snakemake "
+                     "will not make them for it: add `-R fig6` to make them and redo fig6"]
+
+
+def test_a_variant_added_to_the_config_is_named_with_the_command_that_makes_it():
+    untrained = [p.stem for p in sorted((REPO / "ablations").glob("head_on_*.yaml"))
+                 if not (REPO / "results" / "cpu" / "train" / p.stem).exists()]
+    if not untrained or not (REPO / "paper_figs" / "cpu" / "fig6.csv").exists():
+        pytest.skip("needs the stored cpu Figure 6 and an ablation without cpu results")
+    result = run(["-n", "fig6", "--config", f"variants=[head_on,head_off,{untrained[0]}]"])
+    assert result.returncode == 0, result.stderr
+    assert "fig6: its outputs are stored but 3 of its inputs are not" in result.stderr + result.stdout
+    assert "add `-R fig6`" in result.stderr + result.stdout

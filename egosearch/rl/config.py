@@ -203,6 +203,14 @@ class SacCurlConfig:
     that, starts are drawn from the whole home as in the paper. TRAINING ONLY: evaluation always
     uses the stored scenarios."""
 
+    critic_privileged_state: bool = False
+    """Paper: False (the critic sees what the actor sees). True ("sac_drq" only): an asymmetric
+    actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
+    and the target's positions, the target in the body's frame, its distance: see
+    ``egosearch.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
+    (history + state, not state alone). The actor, and so every policy and actor file, sees only
+    the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it."""
+
     train_height_min: float = 1.0
     """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
     (plus the per-step noise). Otherwise training heights are drawn from [this, 1.8] m. The
@@ -300,6 +308,8 @@ class SacCurlConfig:
             bad("aug_pad", "an integer >= 0")
         if not 0 <= self.encoder_stride2_layers <= self.encoder_num_layers:
             bad("encoder_stride2_layers", f"0..encoder_num_layers={self.encoder_num_layers}")
+        if self.critic_privileged_state and self.algorithm != "sac_drq":
+            bad("critic_privileged_state", "False for algorithm sac_curl (only sac_drq has a privileged critic)")
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
         if self.algorithm == "sac_drq":

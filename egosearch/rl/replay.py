@@ -12,7 +12,8 @@ Layout
   frame f_{t+1} of every next observation.
 - A transition ring of ``capacity`` slots holding, per transition, the absolute number of the
   frame f_t (newest frame of obs_t), the step t within its episode, the action, the reward, the
-  terminated/truncated flags and the (small) mask / proprio vectors of obs and next_obs.
+  terminated/truncated flags and the (small) mask / proprio vectors of obs and next_obs (and,
+  with ``state_dim`` > 0, the env's privileged ``state`` vectors, for a privileged critic).
 - The stack of obs_t is frames [f_{max(t-K+1+j, 0)} for j = 0..K-1] (oldest first), and that of
   next_obs_t is the same shifted by one, so one gather of K + 1 frames yields both
   (obs = [:, :K], next_obs = [:, 1:]).
@@ -50,13 +51,13 @@ def frame_slots(capacity: int, frame_history: int) -> int:
 
 
 def replay_gb(capacity: int = 100_000, image_size: int = 100, frame_history: int = 5,
-              mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5) -> float:
+              mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5, state_dim: int = 0) -> float:
     """Exact memory (GB = 1e9 bytes) of the arrays of a :class:`ReplayBuffer`."""
     frames = frame_slots(capacity, frame_history) * image_size * image_size  # uint8
     per_transition = (8 + 4  # frame number (int64), step in episode (int32)
                       + 4 * action_dim + 4  # action, reward (float32)
                       + 2  # terminated, truncated (bool)
-                      + 4 * 2 * (mask_dim + proprio_dim))  # mask/proprio of obs and next_obs
+                      + 4 * 2 * (mask_dim + proprio_dim + state_dim))  # of obs and next_obs
     return (frames + capacity * per_transition) / 1e9
 
 
@@ -68,12 +69,13 @@ class ReplayBuffer:
     on ``device``: ``obs_depth`` / ``next_obs_depth`` (B, K, H, W) uint8 (two views of one
     (B, K+1, H, W) gather), ``mask``, ``proprio``, ``next_mask``, ``next_proprio``, ``action``,
     ``reward`` (B, 1), ``not_done`` (B, 1) = 1 - terminated (time-limit truncation still
-    bootstraps, as in CURL) and ``index`` (absolute transition numbers).
+    bootstraps, as in CURL) and ``index`` (absolute transition numbers); with ``state_dim`` > 0
+    also ``state`` / ``next_state`` (the observations' privileged ``state`` entries).
     """
 
     def __init__(self, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5,
-                 device: str | torch.device = "cpu", seed: int | None = None):
+                 device: str | torch.device = "cpu", seed: int | None = None, state_dim: int = 0):
         if capacity < 1:
             raise ValueError(f"ReplayBuffer capacity={capacity} is out of range; allowed: >= 1")
         self.capacity = int(capacity)
@@ -94,6 +96,9 @@ class ReplayBuffer:
         self.proprio = np.zeros((c, self.proprio_dim), np.float32)
         self.next_mask = np.zeros((c, self.mask_dim), np.float32)
         self.next_proprio = np.zeros((c, self.proprio_dim), np.float32)
+        self.state_dim = int(state_dim)
+        self.state = np.zeros((c, self.state_dim), np.float32)
+        self.next_state = np.zeros((c, self.state_dim), np.float32)
         self.n_added = 0  # transitions ever added
         self.frames_written = 0  # frames ever written
         self.episode_start = 0  # absolute frame number of the current episode's f_0
@@ -145,6 +150,9 @@ class ReplayBuffer:
         self.proprio[i] = obs["proprio"]
         self.next_mask[i] = next_obs["mask"]
         self.next_proprio[i] = next_obs["proprio"]
+        if self.state_dim:
+            self.state[i] = obs["state"]
+            self.next_state[i] = next_obs["state"]
         self._write_frame(next_depth[-1])
         self.n_added += 1
         self.t += 1
@@ -205,7 +213,7 @@ class ReplayBuffer:
             return x.pin_memory().to(dev, non_blocking=True) if pin else x.to(dev)
 
         window = window.pin_memory().to(dev, non_blocking=True) if pin else window.to(dev)
-        return {
+        batch = {
             "obs_depth": window[:, :-1],
             "next_obs_depth": window[:, 1:],
             "mask": put(self.mask[i]),
@@ -217,6 +225,9 @@ class ReplayBuffer:
             "not_done": put((~self.terminated[i]).astype(np.float32)[:, None]),
             "index": torch.from_numpy(n),
         }
+        if self.state_dim:
+            batch["state"], batch["next_state"] = put(self.state[i]), put(self.next_state[i])
+        return batch
 
     # ---- checkpoints ----------------------------------------------------------------------
     _SCALARS = ("capacity", "image_size", "k", "mask_dim", "proprio_dim", "action_dim",
@@ -225,7 +236,7 @@ class ReplayBuffer:
     def _arrays(self) -> dict[str, np.ndarray]:
         return {name: getattr(self, name) for name in (
             "frames", "frame_no", "t_in_ep", "action", "reward", "terminated", "truncated",
-            "mask", "proprio", "next_mask", "next_proprio")}
+            "mask", "proprio", "next_mask", "next_proprio", "state", "next_state")}
 
     def state_dict(self) -> dict:
         """Plain arrays + scalars (only the filled part of the rings)."""
@@ -246,6 +257,8 @@ class ReplayBuffer:
                 raise ValueError(f"replay buffer state has {name}={int(state[name])}, "
                                  f"this buffer has {getattr(self, name)}")
         for name, arr in self._arrays().items():
+            if name not in state and arr.shape[1:] == (0,):  # written before states existed
+                continue
             src = np.asarray(state[name])
             if src.shape[1:] != arr.shape[1:] or src.shape[0] > arr.shape[0]:
                 raise ValueError(f"replay buffer state array {name} has shape {src.shape}")
@@ -311,13 +324,15 @@ class MultiReplay:
 
     def __init__(self, num_envs: int, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5, n_step: int = 1,
-                 gamma: float = 0.99, device: str | torch.device = "cpu", seed: int | None = None):
+                 gamma: float = 0.99, device: str | torch.device = "cpu", seed: int | None = None,
+                 state_dim: int = 0):
         if num_envs < 1 or n_step < 1:
             raise ValueError(f"MultiReplay num_envs={num_envs}, n_step={n_step}; allowed: >= 1 each")
         self.n_step, self.gamma = int(n_step), float(gamma)
         per_env = max(1, int(capacity) // int(num_envs))
         self.buffers = [ReplayBuffer(per_env, image_size, frame_history, mask_dim, proprio_dim, action_dim,
-                                     device=device, seed=None if seed is None else seed + 104_729 * i)
+                                     device=device, seed=None if seed is None else seed + 104_729 * i,
+                                     state_dim=state_dim)
                         for i in range(num_envs)]
         self.device = torch.device(device)
 
@@ -380,7 +395,7 @@ class MultiReplay:
         def put(a: np.ndarray) -> torch.Tensor:
             return torch.from_numpy(np.ascontiguousarray(a)).to(self.device)
 
-        return {
+        batch = {
             "obs_depth": put(obs_stack), "next_obs_depth": put(next_stack),
             "mask": put(buf.mask[i0]), "proprio": put(buf.proprio[i0]),
             "next_mask": put(buf.next_mask[i1]), "next_proprio": put(buf.next_proprio[i1]),
@@ -389,6 +404,9 @@ class MultiReplay:
             "discount": put(discount.astype(np.float32)[:, None]),
             "index": torch.from_numpy(first),
         }
+        if buf.state_dim:  # the state of the step whose next_obs the target bootstraps from
+            batch["state"], batch["next_state"] = put(buf.state[i0]), put(buf.next_state[i1])
+        return batch
 
     def state_dict(self) -> dict:
         if len(self.buffers) == 1:

@@ -17,7 +17,9 @@ one update several times cheaper:
 - ``encoder_stride2_layers`` leading stride-2 convs (CURL: one) shrink the maps further;
 - the target critic is a Polyak copy of the critic's projection and Q-heads; the online encoder
   embeds next_obs for the target (DrQ-v2), so there is no target encoder;
-- n-step returns (``n_step``; DrQ-v2 uses 3) come from the replay (:class:`MultiReplay`).
+- n-step returns (``n_step``; DrQ-v2 uses 3) come from the replay (:class:`MultiReplay`);
+- ``critic_privileged_state`` (off unless a config sets it): the Q-heads also read the env's
+  hidden ``state`` vector (asymmetric actor-critic); the actor never does.
 
 ``act`` / ``act_batch`` / ``update`` / ``state_dict`` / ``actor_state`` match
 :class:`egosearch.rl.sac_curl.SacCurlAgent`, so :mod:`egosearch.rl.train` drives either.
@@ -130,6 +132,8 @@ class DrqCritic(nn.Module):
     """Projection of the conv features and twin Q-heads (the part that has a Polyak target)."""
 
     def __init__(self, conv_dim: int, cfg: SacCurlConfig, extra_dim: int, action_dim: int):
+        """``extra_dim``: the mask and proprio values, plus the privileged state's when the
+        critic reads it (the caller concatenates them)."""
         super().__init__()
         self.proj = Projection(conv_dim, cfg.encoder_latent_dim, cfg.encoder_tanh)
         in_dim = cfg.encoder_latent_dim + extra_dim + action_dim
@@ -174,13 +178,16 @@ class SacDrqAgent:
     optional ``discount`` (B, 1) column (gamma^n of n-step returns; default gamma)."""
 
     def __init__(self, cfg: SacCurlConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
-                 device: str | torch.device | None = None):
+                 device: str | torch.device | None = None, state_dim: int = 0):
         self.cfg = cfg.validate()
         self.device = resolve_device(cfg.device) if device is None else torch.device(device)
         self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
+        if cfg.critic_privileged_state and state_dim < 1:
+            raise ValueError("critic_privileged_state needs the env's privileged state (state_dim >= 1)")
+        self.state_dim = int(state_dim) if cfg.critic_privileged_state else 0
         arch = self.arch()
         self.encoder = _encoder(arch)
-        self.critic = DrqCritic(self.encoder.out_dim, cfg, arch["extra_dim"], self.action_dim)
+        self.critic = DrqCritic(self.encoder.out_dim, cfg, arch["extra_dim"] + self.state_dim, self.action_dim)
         self.actor = ActorHead(self.encoder.out_dim, cfg.encoder_latent_dim, arch["extra_dim"], self.action_dim,
                                   cfg.actor_hidden_dim, cfg.actor_num_layers, cfg.actor_activation,
                                   cfg.actor_log_std_min, cfg.actor_log_std_max, cfg.encoder_tanh)
@@ -237,6 +244,11 @@ class SacDrqAgent:
         self.num_updates += 1
         extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
         next_extra = torch.cat([batch["next_mask"], batch["next_proprio"]], dim=-1)
+        # what the critic reads besides the conv features: the actor's inputs, plus the state
+        critic_extra, next_critic_extra = extra, next_extra
+        if self.state_dim:
+            critic_extra = torch.cat([extra, batch["state"]], dim=-1)
+            next_critic_extra = torch.cat([next_extra, batch["next_state"]], dim=-1)
         discount = batch.get("discount")
         if discount is None:
             discount = torch.full_like(batch["reward"], cfg.gamma)
@@ -250,11 +262,11 @@ class SacDrqAgent:
             h_next = self.encoder(nxt)
             mu, log_std = self.actor(h_next, next_extra)
             next_pi, next_log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            tq1, tq2 = self.critic_target(h_next, next_extra, next_pi)
+            tq1, tq2 = self.critic_target(h_next, next_critic_extra, next_pi)
             target_q = batch["reward"] + batch["not_done"] * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
 
         h = self.encoder(obs)
-        q1, q2 = self.critic(h, extra, batch["action"])
+        q1, q2 = self.critic(h, critic_extra, batch["action"])
         critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
         self.critic_opt.zero_grad(set_to_none=True)
         critic_loss.backward()
@@ -265,7 +277,7 @@ class SacDrqAgent:
             h_actor = h.detach()
             mu, log_std = self.actor(h_actor, extra)
             pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            aq1, aq2 = self.critic(h_actor, extra, pi)
+            aq1, aq2 = self.critic(h_actor, critic_extra, pi)
             actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
             self.actor_opt.zero_grad(set_to_none=True)
             actor_params = list(self.actor.parameters())
@@ -292,6 +304,8 @@ class SacDrqAgent:
         arch = {name: getattr(self.cfg, name) for name in _ARCH_FIELDS}
         arch.update(action_dim=self.action_dim, mask_dim=self.mask_dim, proprio_dim=self.proprio_dim,
                     extra_dim=self.mask_dim + self.proprio_dim, crop_size=self.cfg.image_size)
+        if self.state_dim:  # only then: actor files of critics without it keep their arch
+            arch["critic_state_dim"] = self.state_dim
         return arch
 
     def state_dict(self) -> dict[str, Any]:

@@ -485,8 +485,9 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
 def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
     """The training envs' keyword arguments: the variant's, with r_d's form
     (``train_distance_reward``) and the training heights (``train_height_min``) from the learner
-    config unless the variant sets ``distance_reward`` / ``train_heights`` itself. The paper's
-    values are the env's defaults, so they are not passed (envs without the options still train)."""
+    config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
+    privileged state when the critic reads it (``critic_privileged_state``). The paper's values are
+    the env's defaults, so they are not passed (envs without the options still train)."""
     from egosearch.agent import AgentSpec
 
     aids: dict = {}
@@ -495,15 +496,19 @@ def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
     paper_low, paper_high = AgentSpec().train_height_range
     if cfg.train_height_min != paper_low:
         aids["train_heights"] = (cfg.train_height_min, paper_high)
+    if cfg.critic_privileged_state:
+        aids["privileged_state"] = True
     return {**aids, **env_kwargs}
 
 
-def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: int, device):
-    """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state)."""
+def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
+               state_dim: int = 0):
+    """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state);
+    ``state_dim``: size of the env's privileged state (``critic_privileged_state``)."""
     if cfg.algorithm == "sac_drq":
         from egosearch.rl.sac_drq import SacDrqAgent
 
-        return SacDrqAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
+        return SacDrqAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
     return SacCurlAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
 
 
@@ -524,13 +529,19 @@ def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwarg
     torch.manual_seed(cfg.seed)
     env = envs[0]
     action_dim, mask_dim, proprio_dim = _env_spaces(env, cfg)
+    state_dim = 0
+    if cfg.critic_privileged_state:
+        if "state" not in env.observation_space.spaces:
+            raise ValueError(f"critic_privileged_state needs an env whose observations hold a 'state' "
+                             f"entry (privileged_state=True); {env_id} gives none")
+        state_dim = int(env.observation_space["state"].shape[0])
     for i, e in enumerate(envs):
         e.action_space.seed(cfg.seed + 7 * i)
-    agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, device)
+    agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
     to_replay = getattr(agent, "replay_obs", lambda o: o)
     replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, getattr(agent, "replay_image_size", cfg.image_size),
                          cfg.frame_history, mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
-                         device=device, seed=cfg.seed)
+                         device=device, seed=cfg.seed, state_dim=state_dim)
     curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
     train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
 

@@ -1,5 +1,7 @@
 # Inputs are ancient(): stored results are trusted whatever their file times (a fresh clone gives
-# every file the checkout time). A job still reruns when a job upstream of it runs.
+# every file the checkout time). A job still reruns when a job upstream of it runs, but Snakemake
+# does not rerun a job with stored outputs for a MISSING input (a variant added to the config):
+# the Snakefile names such rules and the `-R` that redoes them.
 # Names and paths shared by every rule. Every output path is a function of
 # (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
 from pathlib import Path
