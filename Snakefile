@@ -51,6 +51,8 @@ if workflow.is_main_process:
 
     from egosearch.workflow_check import reports_missing_inputs
 
-    for line in reports_missing_inputs((r.name, [str(f) for f in r.output], [str(f) for f in r.input])
-                                       for r in workflow.rules if not r.has_wildcards()):
+    # input functions (compare's) are resolved only when the DAG is built: their paths are unknown here
+    for line in reports_missing_inputs(
+            (r.name, [str(f) for f in r.output], [str(f) for f in r.input if isinstance(f, str)])
+            for r in workflow.rules if not r.has_wildcards()):
         print(line, file=sys.stderr)

@@ -11,7 +11,8 @@ def test_every_ablation_file_loads_and_its_config_validates(name):
 
     variant = load_variant(name)
     assert variant.name == name
-    load_config("cpu", variant.config)  # the profile the ablations vary (`snakemake compare`)
+    for profile in ("smoke", "cpu", "paper"):  # `egosearch variant check` checks all three
+        load_config(profile, variant.config)
 
 
 def test_bad_variant_files(tmp_path):

@@ -135,3 +135,11 @@ def test_a_variant_added_to_the_config_is_named_with_the_command_that_makes_it()
     assert result.returncode == 0, result.stderr
     assert "fig6: its outputs are stored but 3 of its inputs are not" in result.stderr + result.stdout
     assert "add `-R fig6`" in result.stderr + result.stdout
+
+
+def test_a_stored_comparison_gives_no_missing_input_line():
+    if not (REPO / "results" / "cpu" / "compare" / "head_off_vs_head_on.csv").exists():
+        pytest.skip("needs the stored cpu comparison head_off vs head_on")
+    result = run(["-n", "compare", "--config", "variant=head_off"])
+    assert result.returncode == 0, result.stderr
+    assert "its outputs are stored" not in result.stderr + result.stdout
