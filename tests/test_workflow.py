@@ -142,4 +142,5 @@ def test_a_stored_comparison_gives_no_missing_input_line():
         pytest.skip("needs the stored cpu comparison head_off vs head_on")
     result = run(["-n", "compare", "--config", "variant=head_off"])
     assert result.returncode == 0, result.stderr
-    assert "its outputs are stored" not in result.stderr + result.stdout
+    # other rules' lines (a budget setting not trained yet) are not this test's business
+    assert "compare: its outputs are stored" not in result.stderr + result.stdout
