@@ -30,6 +30,7 @@ import time
 import numpy as np
 import torch
 
+from egosearch.env import PRIVILEGED_STATE_DIM
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent, resolve_device
@@ -45,15 +46,17 @@ def _cpu_seconds_all() -> float | None:
         return None
 
 
-def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0, size: int = 100) -> ReplayBuffer:
+def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0, size: int = 100,
+                  state_dim: int = 0) -> ReplayBuffer:
     rng = np.random.default_rng(seed)
-    buf = ReplayBuffer(n, size, 5, 30, 4, action_dim, device=device, seed=seed)
+    buf = ReplayBuffer(n, size, 5, 30, 4, action_dim, device=device, seed=seed, state_dim=state_dim)
     frames = np.repeat(rng.integers(0, 256, (1, size, size), dtype=np.uint8), 5, axis=0)
-    obs = {"depth": frames, "mask": np.zeros(30, np.float32), "proprio": np.zeros(4, np.float32)}
+    obs = {"depth": frames, "mask": np.zeros(30, np.float32), "proprio": np.zeros(4, np.float32),
+           "state": np.zeros(state_dim, np.float32)}
     for t in range(n):
         frames = np.concatenate([frames[1:], rng.integers(0, 256, (1, size, size), dtype=np.uint8)])
         nxt = {"depth": frames, "mask": rng.normal(size=30).astype(np.float32),
-               "proprio": rng.normal(size=4).astype(np.float32)}
+               "proprio": rng.normal(size=4).astype(np.float32), "state": rng.normal(size=state_dim).astype(np.float32)}
         end = (t + 1) % 100 == 0
         buf.add(obs, rng.uniform(-1, 1, action_dim), float(rng.normal()), nxt, False, end)
         obs = nxt if not end else {**nxt, "depth": np.repeat(frames[-1:], 5, axis=0)}
@@ -71,11 +74,13 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
         torch.manual_seed(0)
         device = resolve_device(cfg.device)
+        state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
         if cfg.algorithm == "sac_curl":
             agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
         else:
-            agent = make_agent(cfg, action_dim, 30, 4, device)
-        replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size))
+            agent = make_agent(cfg, action_dim, 30, 4, device, state_dim)
+        replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size),
+                                state_dim=state_dim)
         sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
         for _ in range(warmup):
             agent.update(replay.sample(cfg.batch_size))
