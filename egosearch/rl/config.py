@@ -310,7 +310,9 @@ class SacCurlConfig:
         if not 0 <= self.encoder_stride2_layers <= self.encoder_num_layers:
             bad("encoder_stride2_layers", f"0..encoder_num_layers={self.encoder_num_layers}")
         if self.critic_privileged_state and self.algorithm != "sac_drq":
-            bad("critic_privileged_state", "False for algorithm sac_curl (only sac_drq has a privileged critic)")
+            # the cpu profile sets it, so a sac_curl variant there must say so
+            bad("critic_privileged_state", "False for algorithm sac_curl (only sac_drq has a privileged critic; "
+                "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
         if self.algorithm == "sac_drq":
