@@ -24,6 +24,7 @@ include: "egosearch/workflow/rules/evaluate.smk"
 include: "egosearch/workflow/rules/fullbody.smk"
 include: "egosearch/workflow/rules/report.smk"
 include: "egosearch/workflow/rules/budget.smk"
+include: "egosearch/workflow/rules/generalise.smk"
 
 
 rule all:

@@ -1,4 +1,5 @@
-"""``egosearch bench env``: sensor frames/s and env steps/s on one core."""
+"""``egosearch bench env``: sensor frames/s and env steps/s on one core; ``egosearch bench homes``: what
+building a generated home costs against a training episode, per episode and with the pool."""
 
 from __future__ import annotations
 
@@ -60,3 +61,50 @@ def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3
         "pinned_core": core,
         "cpu": platform.processor() or platform.machine(),
     }
+
+
+def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: int = 0,
+                learner_env_steps_per_core_s: float = 150.0, pool_size: int = 4,
+                episodes_per_swap: int = 25) -> dict:
+    """Seconds to build a generated home's env (scene, world, sensor, navigation grid: the first reset
+    included) against the seconds of a training episode, on one core.
+
+    A training episode costs its env steps plus the learner's share; the learner's share is taken
+    from the cpu profile's measured rate (``learner_env_steps_per_core_s`` env steps per core-second
+    of a whole training, env included, ``egosearch bench learner``). ``build_share_per_episode`` is
+    the share of training time a new home per episode would take; ``build_share_pooled`` the share
+    with :class:`egosearch.home_pool.HomePoolEnv`'s pool (one build every ``episodes_per_swap``
+    episodes, ``pool_size`` at the start, amortised over a 300k-step run of 100-step episodes)."""
+    import gymnasium
+
+    import egosearch.envs  # noqa: F401
+    from egosearch.scenarios import MAX_STEPS
+
+    builds, steps_s = [], []
+    rng = np.random.default_rng(seed)
+    with one_core() as core:
+        for home in range(first_seed, first_seed + n_homes):
+            t0 = time.perf_counter()
+            env = gymnasium.make("EgoSearch-v0", layout=f"home{home}")
+            env.reset(seed=seed)
+            builds.append(time.perf_counter() - t0)
+            for _ in range(episodes):
+                env.reset()
+                t0 = time.perf_counter()
+                for _ in range(MAX_STEPS):
+                    _, _, terminated, truncated, _ = env.step(rng.uniform(-1, 1, env.action_space.shape[0]))
+                    if terminated or truncated:
+                        break
+                steps_s.append((time.perf_counter() - t0) / max(1, env.unwrapped.steps))
+            env.close()
+    build = float(np.mean(builds))
+    episode = MAX_STEPS / learner_env_steps_per_core_s
+    per_episode = build / (build + episode)
+    episodes_per_run = 300_000 / MAX_STEPS
+    pooled_builds = pool_size + episodes_per_run / episodes_per_swap
+    pooled = pooled_builds * build / (pooled_builds * build + episodes_per_run * episode)
+    return {"homes": n_homes, "build_s_mean": round(build, 3), "build_s_max": round(float(np.max(builds)), 3),
+            "env_ms_per_step": round(1000 * float(np.mean(steps_s)), 3),
+            "training_episode_s": round(episode, 3), "build_share_per_episode": round(per_episode, 3),
+            "build_share_pooled": round(pooled, 4), "pool_size": pool_size, "episodes_per_swap": episodes_per_swap,
+            "pinned_core": core, "cpu": platform.processor() or platform.machine()}

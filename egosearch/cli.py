@@ -16,8 +16,20 @@ def _cmd_scenarios(args) -> None:
 
     if args.n < 1:
         raise ValueError(f"--n={args.n}: a scenario set needs at least 1 scenario")
-    scenarios = generate_scenarios(args.layout, args.placement, args.height, args.n, args.seed,
-                                   progress=True)
+    if args.homes:
+        from dataclasses import replace
+
+        first, sep, stop = args.homes.partition(":")
+        if not (sep and first.isdigit() and stop.isdigit() and int(first) < int(stop)):
+            raise ValueError(f"--homes={args.homes!r}: expected FIRST:STOP, generated home seeds with FIRST < STOP")
+        scenarios = []
+        for home in range(int(first), int(stop)):  # --n per home, one id sequence over the group
+            # the home's seed joins the set's, so that homes do not repeat each other's draws
+            for sc in generate_scenarios(f"home{home}", args.placement, args.height, args.n, args.seed + home):
+                scenarios.append(replace(sc, scenario_id=len(scenarios)))
+    else:
+        scenarios = generate_scenarios(args.layout, args.placement, args.height, args.n, args.seed,
+                                       progress=True)
     write_scenarios(args.out, scenarios)
     print(f"wrote {len(scenarios)} scenarios to {args.out}")
 
@@ -41,6 +53,10 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int):
         return OraclePolicy, "EgoSearch-v0"
     if kind == "random":
         return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), "EgoSearch-v0"
+    if kind in ("frontier", "frontier_head_off"):
+        from egosearch.frontier import FrontierPolicy
+
+        return FrontierPolicy, "EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0"
     if kind == "actor":
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
@@ -48,7 +64,7 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int):
 
         actor = ActorPolicy(weights)
         return (lambda env: actor), actor.env_id or "EgoSearch-v0"
-    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, actor")
+    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, actor")
 
 
 def _cmd_evaluate(args) -> None:
@@ -84,7 +100,17 @@ def _cmd_train(args) -> None:
         overrides["num_threads"] = args.threads
     cfg = load_config(args.profile, overrides)
     env = variant.train_env
-    evaluator = scenario_evaluator(variant.env_id, env["layout"], env["placement"], n=cfg.eval_episodes)
+    # The training curve (Figure 6) is read in both paper homes for a policy trained in either or both of
+    # them; a policy trained in generated homes is read in its split's first home.
+    from egosearch.scene.layouts import LAYOUT_NAMES
+
+    if env["layout"] == "generated":
+        curve_homes = [f"home{env['home_seeds'][0]}"]
+    elif env["layout"] in (*LAYOUT_NAMES, "paper_homes"):
+        curve_homes = list(LAYOUT_NAMES)
+    else:
+        curve_homes = [env["layout"]]
+    evaluator = scenario_evaluator(variant.env_id, curve_homes, env["placement"], n=cfg.eval_episodes)
     try:
         summary = train(variant.env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
                         variant=variant.name)
@@ -147,6 +173,12 @@ def _cmd_report(args) -> None:
                 raise ValueError(f"--run {spec!r}: expected SETTING=CURVE_CSV:EVAL_CSV")
             runs.setdefault(setting, []).append((curve, evals))
         for path in budget_figure(budget_frame(runs), args.out_prefix, chosen=args.chosen):
+            print(f"wrote {path}")
+    elif args.what == "generalise":
+        from egosearch.report.generalise import generalise_report
+
+        trained_on = dict(item.partition("=")[::2] for item in args.trained_on)
+        for path in generalise_report(args.files, args.bounds, args.out_prefix, trained_on, args.generated):
             print(f"wrote {path}")
     elif args.what == "compare":
         report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
@@ -258,6 +290,8 @@ def _cmd_bench(args) -> None:
 
     if args.what == "env":
         result = bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
+    elif args.what == "homes":
+        result = bench.bench_homes()
     else:
         from egosearch.rl.bench import bench_learner
 
@@ -332,6 +366,16 @@ def _report_parsers(sub) -> None:
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
     r.add_argument("--out", help="write the comparison to this CSV as well as printing it")
 
+    r = reports.add_parser("generalise", help="trained-on x evaluated-on: normalised scores per group of homes")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of the policies: .../{variant}/seed{seed}/{group}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--bounds", nargs="+", required=True, help="the random searcher's and the oracle's evaluation "
+                                                              "CSVs on the same groups")
+    r.add_argument("--generated", help="the variant trained in generated homes (its gap to its training split)")
+    r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
+                   help="what each variant trained in, for the labels")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))
+
     r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
     r.add_argument("--profile", **profile)
     r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
@@ -371,7 +415,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--height", type=float, default=1.65,
                    help=f"camera height (m): any value in [{HEIGHT_RANGE[0]}, {HEIGHT_RANGE[1]}] is a valid "
                         f"experiment; Table 1 uses {', '.join(f'{h:g}' for h in EVAL_HEIGHTS)} (default 1.65)")
-    p.add_argument("--n", type=int, default=100, help="number of scenarios (default 100)")
+    p.add_argument("--n", type=int, default=100, help="number of scenarios (per home with --homes; default 100)")
+    p.add_argument("--homes", default=None, metavar="FIRST:STOP",
+                   help="instead of --layout: generated homes home<FIRST> ... home<STOP-1>, --n scenarios each, "
+                        "in one set (the generalisation benchmark's groups)")
     p.add_argument("--seed", type=int, default=0, help="seed of the set: the same seed gives the same rows")
     p.add_argument("--out", required=True, help="the scenario CSV to write")
     p.set_defaults(func=_cmd_scenarios)
@@ -379,9 +426,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
-                                                     "target) or random")
+                                                     "target), random, or frontier / frontier_head_off (the "
+                                                     "classical searcher, head moving or fixed)")
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor)")
-    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random")
+    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier, "
+                                    "EgoSearchNoHead-v0 for frontier_head_off")
     p.add_argument("--seed", type=int, default=0, help=policy_seed)
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--threads", type=int, default=1, help=threads)
@@ -424,9 +473,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_fullbody)
 
-    p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics) or learner")
-    p.add_argument("what", choices=("env", "learner"), help="env: sensor frames/s and env steps/s on one core; "
-                                                            "learner: SAC+CURL updates/s")
+    p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics), homes (building one) or learner")
+    p.add_argument("what", choices=("env", "homes", "learner"),
+                   help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
+                        "against a training episode; learner: SAC+CURL updates/s")
     p.add_argument("--layout", default="kitchen_living", help=f"env: the home ({layouts})")
     p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
     p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")

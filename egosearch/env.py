@@ -8,12 +8,27 @@ Observation (a ``Dict``):
 - ``state`` (only with ``privileged_state=True``, for a privileged critic in training): the
   hidden state of :func:`privileged_state`. No policy ever reads it.
 
+With ``target_memory=True`` (the ``*Memory-v0`` ids: a CHANGE OF OBSERVATION, never the paper's)
+the ``mask`` vector gains :data:`TARGET_MEMORY_DIM` values after the paper's 30: where the target
+was last seen, as a point estimated from that frame's depth under the mask and carried by the
+body's own odometry into its current frame (forward, left, up from the camera; m / 5, m / 5,
+m / 2), the steps since then (/ 100, capped at 1) and whether it was ever seen this episode. It is
+the one-entry "semantic map" of a classical object-goal searcher (habitat's GPS+compass gives the
+same odometry), the cheapest memory the policy lacks: it forgets a target as soon as it leaves view.
+With ``floor_map=True`` (the ``*Map-v0`` ids, also a CHANGE OF OBSERVATION) it gains
+:data:`FLOOR_MAP_DIM` more: a 7 x 7 grid of 0.6 m squares around the body, turning with it, saying
+how much of each square's floor it has seen, how much of it is occupied, and whether it has stood
+there (:class:`egosearch.floormap.FloorMap`, built from its own depth frames and pose): the map a
+classical searcher plans on, as a memory of where it has been and what it has not seen.
+
 Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.agent.AgentSpec`
 (head-off: [dx, dy, dtheta]).
 
 Reward: r = 1.0 r_s + 1.0 r_d + 1.0 r_l + 0.1 r_c with r_s = 10 on success, r_d = minus the
 distance to the target while it is seen (else 0), r_l = -0.1 and r_c = clip(-0.1 n_col, -3, 0)
-over the episode's collision count.
+over the episode's collision count. TRAINING ONLY, with ``coverage_bonus=b > 0`` (an exploration
+aid, never in evaluation): + b for each step that enters a 0.5 m floor cell the body has not been
+in this episode (a count-based novelty bonus; ``info["r_cov"]``).
 
 Two ways to start an episode:
 - training (no scenario given): a random target on the placement scheme's surfaces, a random
@@ -34,12 +49,13 @@ import numpy as np
 from gymnasium import spaces
 
 from egosearch.agent import AgentSpec, AgentState, check_height
+from egosearch.floormap import FloorMap
 from egosearch.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario, check_placement, navgrid_for
 from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
 from egosearch.scene.placement import sample_target
-from egosearch.sensor import DepthMaskSensor, mask_feature
+from egosearch.sensor import DepthMaskSensor, camera_axes, mask_feature, pixel_rays_camera
 from egosearch.world import World
 
 FRAME_HISTORY = 5
@@ -55,6 +71,16 @@ COLLISION_PENALTY_PER_HIT = -0.1
 COLLISION_PENALTY_FLOOR = -3.0
 PRIVILEGED_STATE_DIM = 12
 """Size of :func:`privileged_state`."""
+TARGET_MEMORY_DIM = 5
+"""Values the ``target_memory`` option appends to ``mask`` (see the module docstring)."""
+COVERAGE_CELL = 0.5
+"""Side (m) of the floor cells the training-only ``coverage_bonus`` counts."""
+FLOOR_MAP_CELLS = 7
+"""Side of the ``floor_map`` option's egocentric grid (squares)."""
+FLOOR_MAP_DIM = 3 * FLOOR_MAP_CELLS * FLOOR_MAP_CELLS
+"""Values the ``floor_map`` option appends to ``mask``."""
+MEMORY_HORIZON = 100
+"""Steps since the target was last seen are divided by this (and capped at 1)."""
 
 
 DISTANCE_REWARDS = ("distance", "progress")
@@ -106,7 +132,8 @@ class SearchEnv(gymnasium.Env):
                  head: bool = True, height: float | None = None, height_noise: bool | None = None,
                  max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
                  distance_reward: str = "distance", train_heights: tuple[float, float] | None = None,
-                 privileged_state: bool = False, render_mode: str | None = None):
+                 privileged_state: bool = False, target_memory: bool = False, floor_map: bool = False,
+                 coverage_bonus: float = 0.0, render_mode: str | None = None):
         """
         Args:
             layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
@@ -122,6 +149,11 @@ class SearchEnv(gymnasium.Env):
                 default the paper's ``AgentSpec.train_height_range`` [1.0, 1.8].
             privileged_state: add the ``state`` entry (:func:`privileged_state`) to every
                 observation, for a learner's privileged critic; policies never read it.
+            target_memory: append the last-seen target memory to ``mask`` (a change of
+                observation: see the module docstring).
+            floor_map: append the egocentric floor map to ``mask`` (a change of observation).
+            coverage_bonus: training-only reward per step into a floor cell not visited this
+                episode (0: the paper's reward).
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
         """
         self.scene = layouts_mod.get_scene(layout)
@@ -149,9 +181,18 @@ class SearchEnv(gymnasium.Env):
         self.world = World(self.scene, self.spec_agent)
         self.sensor = DepthMaskSensor(self.scene, width=IMAGE_SIZE, height=IMAGE_SIZE)
         self.with_state = bool(privileged_state)
+        self.target_memory = bool(target_memory)
+        self.coverage_bonus = float(coverage_bonus)
+        if not (math.isfinite(self.coverage_bonus) and self.coverage_bonus >= 0):
+            raise ValueError(f"coverage_bonus={coverage_bonus!r}; allowed: a finite number >= 0")
+        self._rays = pixel_rays_camera(IMAGE_SIZE, IMAGE_SIZE, self.sensor.fov_deg) if self.target_memory else None
+        # a coarse map is enough for a 0.6 m summary, and keeps the env step cheap (~1 ms)
+        self._floor = FloorMap.for_sensor(self.sensor, pixel_stride=6, free_step=0.15) if floor_map else None
+        mask_dim = (MASK_FEATURE_DIM + (TARGET_MEMORY_DIM if self.target_memory else 0)
+                    + (FLOOR_MAP_DIM if floor_map else 0))
         observation_spaces = {
             "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
-            "mask": spaces.Box(-4.0, 4.0, (MASK_FEATURE_DIM,), np.float32),
+            "mask": spaces.Box(-4.0, 4.0, (mask_dim,), np.float32),
             "proprio": spaces.Box(-4.0, 4.0, (4,), np.float32),
         }
         if self.with_state:
@@ -189,7 +230,12 @@ class SearchEnv(gymnasium.Env):
         self.collisions = 0
         self.path_length = 0.0
         self._dq = np.zeros(2)
+        self._memory_point, self._since_seen = None, 0
+        self._visited = {self._cell()}
+        if self._floor is not None:
+            self._floor.reset()
         depth, mask = self._sense()
+        self._remember(depth, mask)
         self._frames[:] = depth
         self._seen_distance = target_distance(self.state, self.target, spec.body_radius) if mask.any() else None
         return self._observation(mask), self._info(mask.any(), False)
@@ -231,6 +277,7 @@ class SearchEnv(gymnasium.Env):
         self.collisions += int(collided)
         self.steps += 1
         depth, mask = self._sense()
+        self._remember(depth, mask)
         self._frames[:-1] = self._frames[1:]
         self._frames[-1] = depth
         visible = bool(mask.any())
@@ -241,7 +288,46 @@ class SearchEnv(gymnasium.Env):
         truncated = not success and self.steps >= self.max_steps
         info = self._info(visible, success, distance)
         info.update(terms, collided=collided)
-        return self._observation(mask), terms["reward"], success, truncated, info
+        reward = terms["reward"]
+        if self.coverage_bonus:
+            cell = self._cell()
+            info["r_cov"] = self.coverage_bonus if cell not in self._visited else 0.0
+            self._visited.add(cell)
+            reward += info["r_cov"]
+        return self._observation(mask), reward, success, truncated, info
+
+    # -- the target memory and coverage (options) ------------------------------------------------
+    def _cell(self) -> tuple[int, int]:
+        return (math.floor(self.state.x / COVERAGE_CELL), math.floor(self.state.y / COVERAGE_CELL))
+
+    def _remember(self, depth: np.ndarray, mask: np.ndarray) -> None:
+        """Where the target is, from this frame's depth under the mask, in the home's frame (the
+        body's own pose serves as ideal odometry): kept until the next sight. And the floor map."""
+        if self._floor is not None:
+            self._floor.update(depth, self.state)
+        if not self.target_memory:
+            return
+        if not mask.any():
+            self._since_seen += 1
+            return
+        s = self.state
+        z = float(np.median(depth[mask])) / 255.0 * self.sensor.max_depth
+        ray = self._rays[mask].mean(axis=0)
+        self._memory_point = np.asarray(s.camera_position) + camera_axes(s.camera_yaw, s.pitch).T @ (ray * z)
+        self._since_seen = 0
+
+    def _memory_feature(self) -> np.ndarray:
+        out = np.zeros(TARGET_MEMORY_DIM, np.float32)
+        if self._memory_point is None:
+            out[3] = 1.0
+            return out
+        s = self.state
+        dx, dy = self._memory_point[0] - s.x, self._memory_point[1] - s.y
+        c, sn = math.cos(s.theta), math.sin(s.theta)
+        out[:] = (np.clip((c * dx + sn * dy) / 5, -4, 4), np.clip((-sn * dx + c * dy) / 5, -4, 4),
+                  np.clip((self._memory_point[2] - s.camera_height) / 2, -4, 4),
+                  min(self._since_seen, MEMORY_HORIZON) / MEMORY_HORIZON, 1.0)
+        return out
 
     # -- state access for the replanner (paper Algorithm 1) ----------------------------------
     def snapshot(self) -> dict:
@@ -249,6 +335,9 @@ class SearchEnv(gymnasium.Env):
         return {"state": self.state.copy(), "frames": self._frames.copy(), "steps": self.steps,
                 "collisions": self.collisions, "path_length": self.path_length, "dq": self._dq.copy(),
                 "seen_distance": self._seen_distance,
+                "memory": (None if self._memory_point is None else self._memory_point.copy(), self._since_seen),
+                "visited": set(self._visited),
+                "floor": None if self._floor is None else self._floor.copy_state(),
                 "rng": self.np_random.bit_generator.state,
                 "last": (self._last_depth, self._last_mask)}
 
@@ -258,6 +347,11 @@ class SearchEnv(gymnasium.Env):
         self.steps, self.collisions, self.path_length = snap["steps"], snap["collisions"], snap["path_length"]
         self._dq = snap["dq"].copy()
         self._seen_distance = snap["seen_distance"]
+        point, self._since_seen = snap["memory"]
+        self._memory_point = None if point is None else point.copy()
+        self._visited = set(snap["visited"])
+        if self._floor is not None:
+            self._floor.set_state(snap["floor"])
         self.np_random.bit_generator.state = snap["rng"]
         self._last_depth, self._last_mask = snap["last"]
 
@@ -271,6 +365,7 @@ class SearchEnv(gymnasium.Env):
         Returns the observation and whether the target is seen."""
         depth, mask = self._sense()
         if push:
+            self._remember(depth, mask)
             self._frames[:-1] = self._frames[1:]
             self._frames[-1] = depth
         return self._observation(mask), bool(mask.any())
@@ -287,8 +382,12 @@ class SearchEnv(gymnasium.Env):
         proprio = np.zeros(4, np.float32)
         if self.spec_agent.head:
             proprio[:] = (s.pitch, s.head_yaw, self._dq[0], self._dq[1])
-        obs = {"depth": self._frames.copy(), "mask": mask_feature(mask).astype(np.float32),
-               "proprio": proprio}
+        feature = mask_feature(mask).astype(np.float32)
+        if self.target_memory:
+            feature = np.concatenate([feature, self._memory_feature()])
+        if self._floor is not None:
+            feature = np.concatenate([feature, self._floor.egocentric(self.state, FLOOR_MAP_CELLS)])
+        obs = {"depth": self._frames.copy(), "mask": feature, "proprio": proprio}
         if self.with_state:
             distance = target_distance(s, self.target, self.spec_agent.body_radius)
             obs["state"] = privileged_state(s, self.target, distance, bool(mask.any()))

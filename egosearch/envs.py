@@ -6,6 +6,12 @@ from gymnasium.envs.registration import register, registry
 ENV_IDS = {
     "EgoSearch-v0": {"head": True},
     "EgoSearchNoHead-v0": {"head": False},
+    # A change of observation (never the paper's): the last-seen target memory (SearchEnv docs).
+    "EgoSearchMemory-v0": {"head": True, "target_memory": True},
+    "EgoSearchNoHeadMemory-v0": {"head": False, "target_memory": True},
+    # ... and the egocentric floor map built from its depth frames and pose (also a change of observation).
+    "EgoSearchMap-v0": {"head": True, "target_memory": True, "floor_map": True},
+    "EgoSearchNoHeadMap-v0": {"head": False, "target_memory": True, "floor_map": True},
 }
 
 for _env_id, _kwargs in ENV_IDS.items():

@@ -73,28 +73,30 @@ def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
     write_csv_atomic(path, EPISODE_COLUMNS, rows)
 
 
-def scenario_evaluator(env_id: str, layout: str, placement: str, n: int, seed: int = 7):
+def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = 7):
     """``evaluate(policy) -> {success_rate, spl, episode_return}`` on ``n`` fixed held-out
-    scenarios of the training home (the three evaluation heights in turn). The learner calls it
-    every ``eval_every`` steps: these rows are Figure 6's data. ``episode_return`` is always the
-    paper's reward (the env's default r_d), whatever reward a variant trains with, so that the
-    curves of variants are on one scale."""
+    scenarios of ``layout`` (a home, or a list of homes taken in turn), the three evaluation heights
+    in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
+    ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
+    variant trains with, so that the curves of variants are on one scale."""
     from egosearch.agent import EVAL_HEIGHTS
     from egosearch.metrics import spl
     from egosearch.scenarios import generate_scenarios
 
-    per_height = [generate_scenarios(layout, placement, h, n=-(-n // len(EVAL_HEIGHTS)), seed=seed)
-                  for h in EVAL_HEIGHTS]
-    scenarios = [sc for i in range(max(map(len, per_height))) for group in per_height
+    layouts = [layout] if isinstance(layout, str) else list(layout)
+    groups = [(home, h) for home in layouts for h in EVAL_HEIGHTS]
+    per_group = [generate_scenarios(home, placement, h, n=-(-n // len(groups)), seed=seed) for home, h in groups]
+    scenarios = [sc for i in range(max(map(len, per_group))) for group in per_group
                  for sc in group[i:i + 1]][:n]
     envs: dict = {}
 
     def evaluate_policy(policy) -> dict:
         rows = []
         for sc in scenarios:
-            if sc.height not in envs:
-                envs[sc.height] = make_env(env_id, sc)
-            rows.append(run_episode(envs[sc.height], policy, sc, seed=seed + sc.scenario_id))
+            key = (sc.layout, sc.height)
+            if key not in envs:
+                envs[key] = make_env(env_id, sc)
+            rows.append(run_episode(envs[key], policy, sc, seed=seed + sc.scenario_id))
         return {"success_rate": sum(r["success"] for r in rows) / len(rows),
                 "spl": spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
                            [r["path_length"] for r in rows]),

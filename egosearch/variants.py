@@ -30,9 +30,10 @@ class Variant:
     name: str
     """File stem in ``ablations/``; the ``{variant}`` of every output path."""
     env_id: str
-    """``EgoSearch-v0`` (head on) or ``EgoSearchNoHead-v0`` (head off)."""
+    """``EgoSearch-v0`` (head on) or ``EgoSearchNoHead-v0`` (head off); the ``*Memory-v0`` ids add
+    the last-seen target memory to the observation (a change of observation)."""
     train_env: dict
-    """Keyword arguments of the training env (layout, placement, objects)."""
+    """Keyword arguments of the training env (layout, placement, objects, training-only aids)."""
     config: dict = field(default_factory=dict)
     """Learner config overrides on top of the profile."""
     description: str = ""
@@ -87,6 +88,7 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
     if data["name"] != path.stem:
         raise VariantError(f"{path}: name={data['name']!r} must equal the file name {path.stem!r}")
     _check_objects(data["train_env"].get("objects") or [], path)
+    _check_homes(data["train_env"], path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),
                    config=_learner_overrides(data.get("config") or {}, path),
                    description=data.get("description", ""), path=str(path))
@@ -129,6 +131,21 @@ def _learner_overrides(config: dict, path: Path) -> dict:
             raise VariantError(f"{path}: config: {key}={value!r} is not a finite number")
         out[key] = value
     return out
+
+
+def _check_homes(train_env: dict, path: Path) -> None:
+    """``layout: generated`` comes with ``home_seeds`` (and only then), a split that spares the held-out homes."""
+    generated, seeds = train_env["layout"] == "generated", train_env.get("home_seeds")
+    if generated != (seeds is not None):
+        raise VariantError(f"{path}: train_env: " + ("layout: generated needs home_seeds: [first, stop)" if generated
+                                                    else "home_seeds is only read with layout: generated"))
+    if generated:
+        from egosearch.home_pool import check_home_split
+
+        try:
+            check_home_split(seeds)
+        except ValueError as err:
+            raise VariantError(f"{path}: train_env: {err}") from None
 
 
 def _check_objects(names: list[str], path: Path) -> None:

@@ -76,7 +76,9 @@ def workflow_variants(config: dict, compare: bool = False, directory: Path = ABL
     ``variants``, ``reference_variant``, the profile's ``budget`` variants and, when set (or when
     ``compare`` is a target), ``variant``."""
     budget = config["profiles"][config["profile"]].get("budget", {}).get("variants", [])
-    names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget))
+    generalise = config.get("generalise") or {"variants": []}
+    names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
+                               + generalise["variants"]))
     if compare and not config.get("variant"):
         raise VariantError("compare needs a variant: snakemake --cores 2 compare --config variant=NAME")
     if config.get("variant"):
@@ -86,6 +88,11 @@ def workflow_variants(config: dict, compare: bool = False, directory: Path = ABL
     for name in names:
         variants[name] = load_variant(name, directory)
         check_learner_config(variants[name], learner)
+    generated = generalise.get("generated_variant")
+    if generated is not None and (generated not in generalise["variants"]
+                                  or variants[generated].train_env["layout"] != "generated"):
+        raise ConfigError(f"config generalise/generated_variant: {generated!r} must be one of generalise/variants "
+                          "and train in generated homes (train_env: layout: generated)")
     return variants
 
 

@@ -53,7 +53,15 @@ BAD_VARIANT_FILES = [
     ("key_typo", HEAD + "confgi: {}\n",
      "ablations/key_typo.yaml: (top level): Additional properties are not allowed ('confgi' was unexpected)"),
     ("env_typo", HEAD.replace("EgoSearch-v0", "EgoSearch-v1"),
-     "ablations/env_typo.yaml: env_id: 'EgoSearch-v1' is not one of ['EgoSearch-v0', 'EgoSearchNoHead-v0']"),
+     "ablations/env_typo.yaml: env_id: 'EgoSearch-v1' is not one of ['EgoSearch-v0', 'EgoSearchNoHead-v0', "
+     "'EgoSearchMemory-v0', 'EgoSearchNoHeadMemory-v0']"),
+    ("generated_no_split", HEAD.replace("layout: kitchen_living", "layout: generated"),
+     "ablations/generated_no_split.yaml: train_env: layout: generated needs home_seeds: [first, stop)"),
+    ("split_without_generated", HEAD.replace("everywhere}", "everywhere, home_seeds: [0, 10]}"),
+     "ablations/split_without_generated.yaml: train_env: home_seeds is only read with layout: generated"),
+    ("split_draws_heldout", HEAD.replace("layout: kitchen_living", "layout: generated, home_seeds: [899990, 900005]"),
+     "ablations/split_draws_heldout.yaml: train_env: home_seeds=[899990, 900005) overlaps the held-out homes "
+     "[900000, 900020) that no training may draw (egosearch.home_pool.HELDOUT_HOME_SEEDS)"),
 ]
 
 # (--config entries, the one line) of `snakemake -n all`.
@@ -69,6 +77,8 @@ BAD_CONFIGS = [
     (["scenario_seed=-1"], "config scenario_seed: -1 is less than the minimum of 0"),
     (["layout=mansion"], "config layout: 'mansion' does not match '^(kitchen_living|bedroom_bath|studio|home[0-9]+)$'"),
     (["heights=[1.05,1.05]"], "config heights: [1.05, 1.05] has non-unique elements"),
+    (["homes=[kitchen_living,mansion]"], "config homes/1: 'mansion' does not match "
+                                         "'^(kitchen_living|bedroom_bath|studio|home[0-9]+)$'"),
 ]
 
 
@@ -211,9 +221,10 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["evaluate", "--scenarios", "s.csv", "--weights", "missing.pt", "--out", "o.csv"],
          "egosearch evaluate: error: missing.pt: no such actor file"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "banana", "--out", "o.csv"],
-         "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, actor"),
+         "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, frontier, frontier_head_off, actor"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "random", "--env-id", "Foo-v0", "--out", "o.csv"],
-         "egosearch evaluate: error: --env-id='Foo-v0'; allowed: EgoSearch-v0, EgoSearchNoHead-v0"),
+         "egosearch evaluate: error: --env-id='Foo-v0'; allowed: EgoSearch-v0, EgoSearchNoHead-v0, "
+         "EgoSearchMemory-v0, EgoSearchNoHeadMemory-v0"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "oracle", "--out", "o.csv"],
          "egosearch evaluate: error: s.csv: no such scenario file"),
         (["train", "--variant", "hed_on", "--out-dir", str(tmp_path / "run")],

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from egosearch.report.budget import BUDGET_COLUMNS, budget_figure, budget_frame, log_ticks
-from egosearch.report.stats import wilson_ci
+from egosearch.report.stats import two_level_ci, wilson_ci
 
 CURVE = ["env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss", "curl_loss",
          "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s"]
@@ -36,7 +37,12 @@ def test_budget_pools_seeds_and_counts_core_hours(tmp_path):
     assert chosen.core_hours == pytest.approx(1.5) and chosen.core_hours_per_seed == pytest.approx(0.5)
     assert chosen.env_steps_per_core_s == pytest.approx(3 * 150_000 / 5400)
     assert chosen.success_rate == pytest.approx(0.75) and chosen.episodes == 12
-    assert (chosen.low, chosen.high) == pytest.approx(wilson_ci(9, 12))
+    # the seeds ran the same 4 scenarios and agree on each: the interval is the two-level bootstrap of
+    # that (scenarios x seeds) matrix, not Wilson over 12 independent episodes; one seed is Wilson
+    same = np.array([[1, 1, 1], [1, 1, 1], [0, 0, 0], [1, 1, 1]], float)
+    assert (chosen.low, chosen.high) == pytest.approx(two_level_ci(same)[1:])
+    assert chosen.high - chosen.low > (lambda lo, hi: hi - lo)(*wilson_ci(9, 12))
+    assert (small.low, small.high) == pytest.approx(wilson_ci(1, 4))
     outs = budget_figure(df.reset_index(), tmp_path / "out" / "budget", chosen="chosen")
     assert [p.suffix for p in outs] == [".csv", ".png", ".pdf"] and all(p.stat().st_size > 0 for p in outs)
 

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+from egosearch.env import FLOOR_MAP_DIM, TARGET_MEMORY_DIM
 from egosearch.envs import ENV_IDS
 from egosearch.evaluate import evaluate, make_env
 from egosearch.policies import OraclePolicy, RandomPolicy
@@ -23,7 +24,10 @@ def test_spaces_match_the_learner_contract(env_id):
     env = gymnasium.make(env_id)
     obs, info = env.reset(seed=0)
     assert obs["depth"].shape == (5, 100, 100) and obs["depth"].dtype == np.uint8
-    assert obs["mask"].shape == (30,) and obs["proprio"].shape == (4,)
+    options = ENV_IDS[env_id]
+    extra = TARGET_MEMORY_DIM * options.get("target_memory", False) + FLOOR_MAP_DIM * options.get("floor_map", False)
+    assert obs["mask"].shape == (30 + extra,) and obs["proprio"].shape == (4,)
+    assert env.observation_space["mask"].shape == obs["mask"].shape
     assert env.action_space.shape == ((5,) if ENV_IDS[env_id]["head"] else (3,))
     # At reset the first frame is repeated K times.
     assert all(np.array_equal(obs["depth"][0], obs["depth"][k]) for k in range(5))

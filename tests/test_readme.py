@@ -80,9 +80,10 @@ def test_compare_block_lists_every_stored_comparison(tmp_path):
     folder = tmp_path / "results" / "p" / "compare"
     folder.mkdir(parents=True)
     row = dict(height=1.05, placement="everywhere", metric="success", reference=0.01, candidate=0.1, difference=0.09,
-               ci_low=0.05, ci_high=0.13, p_value=0.0001, p_holm=0.001, significant=True, n_scenarios=100,
+               ci_low=0.05, ci_high=0.13, p_uncorrected=0.0001, p_holm=0.001, significant_holm=True, n_scenarios=100,
                n_seeds_ref=3, n_seeds_cand=3)
-    pd.DataFrame([row, {**row, "metric": "spl", "p_value": 0.03, "p_holm": 0.06}]).to_csv(
+    pd.DataFrame([row, {**row, "metric": "spl", "p_uncorrected": 0.03, "p_holm": 0.06,
+                        "significant_holm": False}]).to_csv(
         folder / "my_new_variant_vs_head_on.csv", index=False)
     text = "<!-- egosearch:begin compare -->\n<!-- egosearch:end compare -->"
     assert "No stored comparison yet" in render_readme(text, tmp_path, "p2")
@@ -99,8 +100,11 @@ def _write_reading_inputs(root: Path) -> None:
     cells = [(0.45, "no_low_cabinets", 0.20, 0.15, 0.25), (1.05, "no_low_cabinets", 0.85, 0.80, 0.90),
              (0.45, "everywhere", 0.50, 0.45, 0.55), (1.05, "everywhere", 0.55, 0.50, 0.60)]
     for (h, pl, rate, lo, hi) in cells:
-        rows.append({"height": h, "placement": pl, "success_rate": rate, "wilson_low": lo, "wilson_high": hi,
+        rows.append({"home": "both", "height": h, "placement": pl, "success_rate": rate, "ci_low": lo, "ci_high": hi,
                      "random_success_rate": 0.0, "oracle_success_rate": 1.0})
+        # a home's own row is not the one set beside the paper: the reading must skip it
+        rows.append({"home": "kitchen_living", "height": h, "placement": pl, "success_rate": 0.99, "ci_low": 0.98,
+                     "ci_high": 1.0, "random_success_rate": 0.0, "oracle_success_rate": 1.0})
     pd.DataFrame(rows).to_csv(figs / "table1.csv", index=False)
     pd.DataFrame([{"variant": v, "env_steps": s, "success_rate": r, "low": lo, "high": hi}
                   for v, s, r, lo, hi in [("head_on", 0, 0.0, 0.0, 0.0), ("head_on", 100, 0.6, 0.5, 0.7),

@@ -28,6 +28,7 @@ from egosearch.report import (
     wilson_ci,
 )
 from egosearch.report.cli import cmd_compare, cmd_fig6, cmd_fig7, cmd_table1, cmd_table2
+from egosearch.report.stats import detectable_difference, scenario_seed_matrix, two_level_ci
 
 EPISODE_COLUMNS = ["scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
                    "episode_return"]
@@ -195,10 +196,10 @@ def test_compare_planted_difference():
     assert res["reference"] == pytest.approx(0.5) and res["candidate"] == pytest.approx(0.8)
     assert res["difference"] == pytest.approx(0.3)
     assert res["ci_low"] > 0 and res["ci_low"] < 0.3 < res["ci_high"]
-    assert res["p_value"] < 0.001 and res["significant"]
+    assert res["p_uncorrected"] < 0.001
     assert (res["n_scenarios"], res["n_seeds_ref"], res["n_seeds_cand"]) == (100, 3, 2)
     worse = compare_cells(cand, ref, "success")
-    assert worse["difference"] == pytest.approx(-0.3) and worse["ci_high"] < 0 and worse["significant"]
+    assert worse["difference"] == pytest.approx(-0.3) and worse["ci_high"] < 0 and worse["p_uncorrected"] < 0.001
 
 
 def test_compare_identical_copy():
@@ -207,7 +208,7 @@ def test_compare_identical_copy():
     for metric in ("success", "spl"):
         res = compare_cells(ref, ref.copy(), metric)
         assert res["difference"] == 0.0 and res["ci_low"] == 0.0 and res["ci_high"] == 0.0
-        assert res["p_value"] == pytest.approx(1.0) and not res["significant"]
+        assert res["p_uncorrected"] == pytest.approx(1.0)
 
 
 def test_compare_noise_not_significant_and_seed_averaging():
@@ -216,7 +217,7 @@ def test_compare_noise_not_significant_and_seed_averaging():
     cand = cell_frame(rng.random(100) < 0.5)
     res = compare_cells(ref, cand, "success")
     assert res["ci_low"] <= res["difference"] <= res["ci_high"]
-    assert res["p_value"] > 0.01
+    assert res["p_uncorrected"] > 0.01
     # two candidate seeds disagreeing on scenario 0: that scenario counts 0.5
     ref2 = cell_frame([0, 0])
     cand2 = pd.concat([cell_frame([1, 0], seed=0), cell_frame([0, 0], seed=1)], ignore_index=True)
@@ -241,17 +242,17 @@ def test_compare_exact_two_sided_permutation_p_value_by_hand():
     # their three mirrors: p = 6/16.
     ref = _paired([0.2, 0.3, 0.5, 0.1], "spl")
     cand = _paired([0.8, 0.6, 0.3, 0.15], "spl")
-    assert compare_cells(ref, cand, "spl")["p_value"] == pytest.approx(6 / 16, abs=1e-12)
+    assert compare_cells(ref, cand, "spl")["p_uncorrected"] == pytest.approx(6 / 16, abs=1e-12)
     # 5 scenarios, the candidate succeeds in every one the reference fails: only all + and
     # all - reach |sum| = 5: p = 2/32 (a one-sided test would say 1/32).
     res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success"), "success")
-    assert res["p_value"] == pytest.approx(2 / 32, abs=1e-12) and not res["significant"]
+    assert res["p_uncorrected"] == pytest.approx(2 / 32, abs=1e-12)
     # d = (1, 1, 1, 1, -1), sum 3: sums >= 3 need at most one minus sign (1 + 5 patterns): p = 12/32.
     res = compare_cells(_paired([0, 0, 0, 0, 1], "success"), _paired([1, 1, 1, 1, 0], "success"), "success")
-    assert res["p_value"] == pytest.approx(12 / 32, abs=1e-12)
+    assert res["p_uncorrected"] == pytest.approx(12 / 32, abs=1e-12)
     # Seeds are averaged per scenario first: two candidate seeds agreeing give the same p.
     res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success", seeds=(0, 1)), "success")
-    assert res["p_value"] == pytest.approx(2 / 32, abs=1e-12)
+    assert res["p_uncorrected"] == pytest.approx(2 / 32, abs=1e-12)
 
 
 def test_holm():
@@ -298,35 +299,69 @@ def test_table1(tmp_path):
         expected[(h, pl)] = {"k": total, "spl": sum(k * (0.25, 0.5, 1.0)[s] for (s, _), k in ks.items()) / 60,
                              "per_seed": [(ks[(s, 0)] + ks[(s, 1)]) / 20 for s in range(3)]}
     df = table1(group_eval_paths(paths), tmp_path / "out" / "table1", n_resamples=N_RES)
-    assert list(df.columns) == ["height", "placement", "n_episodes", "n_seeds", "success_rate", "wilson_low",
-                                "wilson_high", "seed_boot_low", "seed_boot_high", "spl", "paper_success_rate"]
-    assert [(r.height, r.placement) for r in df.itertuples()] == cells
-    for r in df.itertuples():
+    assert list(df.columns) == ["home", "height", "placement", "n_episodes", "n_scenarios", "n_seeds", "success_rate",
+                                "ci_low", "ci_high", "seed_boot_low", "seed_boot_high", "spl", "spl_low", "spl_high",
+                                "paper_success_rate"]
+    # each home alone, then both pooled (the rows set beside the paper)
+    assert [r.home for r in df.itertuples()] == ["bedroom"] * 6 + ["kitchen"] * 6 + ["both"] * 6
+    both = df[df["home"] == "both"]
+    assert [(r.height, r.placement) for r in both.itertuples()] == cells
+    for r in both.itertuples():
         e = expected[(r.height, r.placement)]
-        assert (r.n_episodes, r.n_seeds) == (60, 3)
-        assert r.success_rate == e["k"] / 60
-        assert (r.wilson_low, r.wilson_high) == pytest.approx(_wilson_by_hand(e["k"], 60), abs=1e-9)
+        assert (r.n_episodes, r.n_scenarios, r.n_seeds) == (60, 20, 3)
+        assert r.success_rate == pytest.approx(e["k"] / 60, abs=1e-12)
+        assert r.ci_low <= r.success_rate <= r.ci_high
         assert r.spl == pytest.approx(e["spl"], abs=1e-12)
         # A percentile bootstrap of the mean of the three per-seed rates stays within them.
         assert min(e["per_seed"]) - 1e-12 <= r.seed_boot_low <= r.seed_boot_high <= max(e["per_seed"]) + 1e-12
         assert r.paper_success_rate == PAPER_TABLE1[(r.height, r.placement)]
-    equal = df.iloc[2]
+    kitchen = df[(df["home"] == "kitchen")].iloc[0]
+    assert kitchen.success_rate == pytest.approx(sum((0 + s) % 11 for s in range(3)) / 30)
+    equal = both.iloc[2]
     assert (equal.success_rate, equal.seed_boot_low, equal.seed_boot_high) == (0.6, 0.6, 0.6)
     out = tmp_path / "out"
-    assert pd.read_csv(out / "table1.csv").shape == (6, 11)
+    assert pd.read_csv(out / "table1.csv").shape == (18, 15)
     md = (out / "table1.md").read_text()
-    assert "| Head height | Excluding cabinets | Everywhere |" in md
-    # The 1.05 m row from the numbers above: cells 2 and 3.
-    r3 = df.iloc[3]
-    lo, hi = _wilson_by_hand(expected[cells[3]]["k"], 60)
-    row = (f"| 1.05m | ours 0.60 [{_wilson_by_hand(36, 60)[0]:.2f}, {_wilson_by_hand(36, 60)[1]:.2f}] · paper "
-           f"{PAPER_TABLE1[cells[2]]:.2f} | ours {r3.success_rate:.2f} [{lo:.2f}, {hi:.2f}] · paper "
-           f"{PAPER_TABLE1[cells[3]]:.2f} |")
+    assert md.index("both homes pooled (bedroom and kitchen)") < md.index("Table 1 in bedroom alone")
+    assert "| Head height | Searcher | Excluding cabinets | Everywhere |" in md
+    r2, r3 = both.iloc[2], both.iloc[3]
+    row = (f"| 1.05m | ours | 0.60 [{r2.ci_low:.2f}, {r2.ci_high:.2f}] | {r3.success_rate:.2f} [{r3.ci_low:.2f}, "
+           f"{r3.ci_high:.2f}] |")
     assert row in md.splitlines(), md
-    assert "pooled over 3 seed(s) (60 episodes per cell)" in md and "Wilson" in md
+    assert f"| 1.05m | paper | {PAPER_TABLE1[cells[2]]:.2f} | {PAPER_TABLE1[cells[3]]:.2f} |" in md
+    assert "20 scenarios per cell, each run by 3 seed(s)" in md and "two-level bootstrap" in md
     tex = (out / "table1.tex").read_text()
-    assert r"\toprule" in tex and r"\bottomrule" in tex and "Wilson" in tex and r"\caption{" in tex
-    assert f"1.05m & ours 0.60 [{_wilson_by_hand(36, 60)[0]:.2f}, " in tex
+    assert r"\toprule" in tex and r"\bottomrule" in tex and r"\caption{" in tex
+    assert f"1.05m & ours & 0.60 [{r2.ci_low:.2f}, " in tex
+
+
+def test_two_level_interval_is_wider_than_pooled_wilson_when_seeds_share_scenarios():
+    # By hand: 20 scenarios, 3 seeds. A scenario is solved by every seed or by none (10 of each), so the
+    # seeds add no information: there are 20 independent draws, not 60. Wilson over the 60 pooled
+    # episodes is as narrow as 60 trials allow; the two-level interval is as wide as 20 trials.
+    success = np.repeat((np.arange(20) < 10)[:, None], 3, axis=1).astype(float)
+    mean, lo, hi = two_level_ci(success, n_resamples=20_000, seed=1)
+    assert mean == 0.5
+    w_lo, w_hi = wilson_ci(30, 60)
+    assert (hi - lo) > 1.5 * (w_hi - w_lo)
+    # 20 independent scenarios: the normal-theory width is 2 * 1.96 * sqrt(0.25 / 20) = 0.438
+    assert hi - lo == pytest.approx(0.438, abs=0.06)
+    # Seeds that disagree independently inside each scenario: the seed level adds spread.
+    rng = np.random.default_rng(0)
+    noisy = (rng.random((20, 3)) < 0.5).astype(float)
+    m2, lo2, hi2 = two_level_ci(noisy, n_resamples=20_000, seed=1)
+    assert lo2 <= m2 <= hi2
+    # one seed: the bootstrap over scenarios alone; a constant matrix: a point
+    assert two_level_ci(np.ones((5, 1))) == (1.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="missing"):
+        scenario_seed_matrix(pd.DataFrame({"scenario_id": [0, 1, 0], "seed": [0, 0, 1], "success": [1, 0, 1]}),
+                             "success")
+
+
+def test_detectable_difference_by_hand():
+    # (1.959964 + 0.841621) * 0.5 / sqrt(100) = 0.14008
+    assert detectable_difference(0.5, 100) == pytest.approx(0.140079, abs=1e-5)
+    assert detectable_difference(0.5, 400) == pytest.approx(0.140079 / 2, abs=1e-5)
 
 
 def test_table1_one_seed_and_directory_prefix(tmp_path):
@@ -368,8 +403,9 @@ def test_compare_report(tmp_path):
     assert (df["n_scenarios"] == 120).all()  # 60 scenarios x 2 layouts, layouts kept apart
     assert (df["n_seeds_ref"] == 2).all() and (df["n_seeds_cand"] == 3).all()
     succ = df[df.metric == "success"]
-    assert (succ["difference"] < -0.15).all() and succ["significant"].all()
-    assert (df["p_holm"] >= df["p_value"]).all()
+    assert (succ["difference"] < -0.15).all() and succ["significant_holm"].all()
+    assert (df["p_holm"] >= df["p_uncorrected"]).all()
+    assert (df["significant_holm"] == (df["p_holm"] < 0.05)).all() and "significant" not in df.columns
     assert pd.read_csv(tmp_path / "cmp.csv").shape == df.shape
     text = format_compare(df, "head_on", "head_off")
     assert "*" in text and "everywhere" in text and len(text.splitlines()) == 12 + 3

@@ -40,6 +40,16 @@ def test_dry_run_of_all_lists_every_stage():
         assert rule in out.stdout, rule
 
 
+def test_dry_run_of_generalise_reads_four_groups_of_homes():
+    out = run(["-n", "generalise", "--config", "profile=smoke"])
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    for group in ("generated_heldout", "generated_train", "kitchen_living", "bedroom_bath"):
+        assert f"eval/head_on_generated_homes/seed0/{group}/everywhere/h1.05.csv" in text, group
+    assert "group_scenarios" in text and "home900000:900020" not in text  # the homes go to the command
+    assert "generalise" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout
+
+
 def test_lint_is_clean():
     out = run(["--lint"])
     assert out.returncode == 0, out.stdout + out.stderr
@@ -68,13 +78,18 @@ def test_smoke_table1_end_to_end(checkout):
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     md = (checkout / "paper_figs/smoke/table1.md").read_text()
     assert "| 1.05m | paper | 0.92 | 0.75 |" in md and "| 0.45m | ours (head_on) | " in md
-    evals = sorted((checkout / "results/smoke/eval/head_on/seed0/kitchen_living").rglob("h*.csv"))
-    assert len(evals) == 6
-    # The bounds ran on the same scenario sets, and Table 1 shows them: the oracle finds targets.
-    for bound in ("random", "oracle"):
-        assert len(list((checkout / f"results/smoke/eval/{bound}/seed0/kitchen_living").rglob("h*.csv"))) == 6
+    for home in ("kitchen_living", "bedroom_bath"):  # both of the paper's homes
+        evals = sorted((checkout / f"results/smoke/eval/head_on/seed0/{home}").rglob("h*.csv"))
+        assert len(evals) == 6
+        # The bounds ran on the same scenario sets, and Table 1 shows them: the oracle finds targets.
+        for bound in ("random", "oracle"):
+            assert len(list((checkout / f"results/smoke/eval/{bound}/seed0/{home}").rglob("h*.csv"))) == 6
     table = pd.read_csv(checkout / "paper_figs/smoke/table1.csv")
-    assert (table["oracle_n_episodes"] == 4).all() and table["oracle_success_rate"].mean() > 0.5
+    assert sorted(set(table["home"])) == ["bedroom_bath", "both", "kitchen_living"]
+    per_home, both = table[table["home"] != "both"], table[table["home"] == "both"]
+    assert (per_home["oracle_n_episodes"] == 4).all() and (both["oracle_n_episodes"] == 8).all()
+    assert table["oracle_success_rate"].mean() > 0.5
+    assert md.index("both homes pooled") < md.index("Table 1 in bedroom_bath alone")
     assert "not run" not in md
     # The scenario sets are fixed: the same rows on a second generation.
     scen = checkout / "results/smoke/scenarios/kitchen_living/everywhere/h1.65.csv"
@@ -140,6 +155,9 @@ def test_a_variant_added_to_the_config_is_named_with_the_command_that_makes_it()
 def test_a_stored_comparison_gives_no_missing_input_line():
     if not (REPO / "results" / "cpu" / "compare" / "head_off_vs_head_on.csv").exists():
         pytest.skip("needs the stored cpu comparison head_off vs head_on")
+    homes = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())["homes"]
+    if not all((REPO / "results/cpu/eval/head_off/seed0" / home).exists() for home in homes):
+        pytest.skip("the stored cpu run predates the config's homes: its comparison lacks inputs (README: Status)")
     result = run(["-n", "compare", "--config", "variant=head_off"])
     assert result.returncode == 0, result.stderr
     # other rules' lines (a budget setting not trained yet) are not this test's business

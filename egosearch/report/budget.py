@@ -1,7 +1,9 @@
 """The budget study: what a learner setting buys per env step and per core-hour.
 
 One point per learner setting: success at one Table 1 cell (1.05 m, excluding low cabinets by
-default), pooled over the setting's seeds with a Wilson 95% interval, against the env steps it
+default), over the setting's seeds with a 95% interval (Wilson for one seed, whose episodes are
+independent; with several seeds, which ran the same scenarios, the two-level bootstrap over
+scenarios then seeds), against the env steps it
 trained for and the core-hours its training took (``wall_s`` of the last row of its curve.csv
 times its torch threads: the runs are one-thread jobs, so wall time on a core is core time). Core
 time is the machine's: each row names the CPU its runs trained on (``machine``).
@@ -24,7 +26,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLo
 
 from egosearch.report.data import _with, output_base, read_curves, read_episodes
 from egosearch.report.figures import OKABE_ITO, STYLE, _save
-from egosearch.report.stats import wilson_ci
+from egosearch.report.stats import scenario_seed_matrix, two_level_ci, wilson_ci
 
 PathLike = str | os.PathLike
 
@@ -60,7 +62,10 @@ def budget_frame(runs: Mapping[str, Iterable[tuple[PathLike, PathLike]]], thread
             raise ValueError(f"budget: setting {setting!r}: its runs end at different env steps {steps}")
         episodes = read_episodes([e for _, e in pairs])
         n, k = len(episodes), int(episodes["success"].sum())
-        low, high = wilson_ci(k, n)
+        if episodes["seed"].nunique() > 1:
+            _, low, high = two_level_ci(scenario_seed_matrix(episodes, "success")[0])
+        else:
+            low, high = wilson_ci(k, n)
         core_s = float(last["wall_s"].sum()) * threads
         rows.append({"setting": setting, "label": (labels or {}).get(setting, setting), "n_seeds": len(pairs),
                      "env_steps": steps[0], "core_hours": core_s / 3600,

@@ -31,13 +31,14 @@ def _say(paths: Iterable[Path]) -> None:
 
 
 def group_bounds(paths: Iterable[PathLike]) -> dict[str, dict]:
-    """Evaluation CSVs of the bound searchers (``.../eval/{random|oracle}/seed{N}/...``) ->
+    """Evaluation CSVs of the reference searchers (``.../eval/{random|frontier|...|oracle}/seed{N}/...``) ->
     ``{bound: {(seed, height, placement): [paths]}}``, every bound present (empty when not run)."""
     out: dict[str, list] = {bound: [] for bound in BOUNDS}
     for path in paths:
         bound = parse_eval_path(path)["variant"]
         if bound not in out:
-            raise ValueError(f"{path}: not a bound searcher's evaluation (expected .../eval/{{random|oracle}}/...)")
+            names = "|".join(BOUNDS)
+            raise ValueError(f"{path}: not a reference searcher's evaluation (expected .../eval/{{{names}}}/...)")
         out[bound].append(path)
     return {bound: group_eval_paths(files) for bound, files in out.items()}
 

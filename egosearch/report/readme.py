@@ -130,15 +130,35 @@ def block_compare(root: Path, profile: str) -> str:
         df = pd.read_csv(path)
         lines = [f"`{candidate}` vs `{reference}` (difference = {candidate} - {reference}; from "
                  f"`{path.relative_to(root)}`):", "",
-                 "| height | placement | metric | reference | candidate | difference (95% CI) | p | p (Holm) |",
+                 "| height | placement | metric | reference | candidate | difference (95% CI) | p (one cell) "
+                 "| p (Holm) |",
                  "|---|---|---|---|---|---|---|---|"]
         for r in df.itertuples():
             lines.append(f"| {r.height:g} | {r.placement} | {r.metric} | {r.reference:.3f} | {r.candidate:.3f} | "
-                         f"{r.difference:+.3f} [{r.ci_low:+.3f}, {r.ci_high:+.3f}] | {r.p_value:.3g} | "
+                         f"{r.difference:+.3f} [{r.ci_low:+.3f}, {r.ci_high:+.3f}] | {r.p_uncorrected:.3g} | "
                          f"{r.p_holm:.3g}{' *' if r.p_holm < 0.05 else ''} |")
         parts.append("\n".join(lines) + "\n")
-    note = "\\* Holm-adjusted p < 0.05. CI: paired bootstrap over scenarios; p: paired sign-flip test."
+    note = ("\\* Holm-adjusted p < 0.05 (over every row of its file). CI: paired two-level bootstrap (scenarios, "
+            "then seeds); p (one cell): paired sign-flip test over scenarios, uncorrected.")
     return "\n".join(parts) + "\n" + note + "\n"
+
+
+def block_power(root: Path, profile: str) -> str:
+    """What each stored comparison can detect: ``detectable_80`` of its success rows."""
+    folder = root / "results" / profile / "compare"
+    paths = sorted(folder.glob("*_vs_*.csv"))
+    lines = []
+    for path in paths:
+        df = pd.read_csv(path)
+        if "detectable_80" not in df.columns:
+            lines.append(f"- `{path.stem}`: written before `detectable_80` existed (`{path.relative_to(root)}`).")
+            continue
+        succ = df[df["metric"] == "success"]
+        lines.append(f"- `{path.stem}`: {int(succ['n_scenarios'].min())}–{int(succ['n_scenarios'].max())} scenarios "
+                     f"per cell ({', '.join(sorted(set(succ['homes'])))}); a success difference of "
+                     f"{_fmt(succ['detectable_80'].min())}–{_fmt(succ['detectable_80'].max())} is detected with "
+                     f"80% power (`{path.relative_to(root)}`).")
+    return "\n".join(lines) + "\n" if lines else "*No stored comparison yet.*\n"
 
 
 def block_departures(root: Path, profile: str) -> str:
@@ -182,8 +202,12 @@ def _apart(*intervals) -> str:
 
 
 def _reading_table1(df: pd.DataFrame) -> list[str]:
+    from egosearch.report.tables import BOTH_HOMES
     from egosearch.report.tables import PAPER_TABLE1 as PAPER
 
+    if "home" in df.columns:  # the rows set beside the paper's column: every home pooled, or the only one
+        homes = set(df["home"])
+        df = df[df["home"] == (BOTH_HOMES if BOTH_HOMES in homes else sorted(homes)[0])]
     df = df.assign(height=df["height"].round(2))
     cell = {(r.height, r.placement): r for r in df.itertuples(index=False)}
     out = []
@@ -204,8 +228,8 @@ def _reading_table1(df: pd.DataFrame) -> list[str]:
         ours = np.mean([t.success_rate for t in tall]) - low.success_rate
         paper = np.mean([PAPER[(t.height, pl)] for t in tall]) - PAPER[(0.45, pl)]
         taller = " and ".join(f"{t.height:g}" for t in tall)
-        sides = [f"{t.height:g} m against 0.45 m: " + _apart(t.success_rate, t.wilson_low, t.wilson_high,
-                                                            low.success_rate, low.wilson_low, low.wilson_high)
+        sides = [f"{t.height:g} m against 0.45 m: " + _apart(t.success_rate, t.ci_low, t.ci_high,
+                                                            low.success_rate, low.ci_low, low.ci_high)
                  for t in tall]
         out.append(f"- **Height, {pl.replace('_', ' ')}** (paper: tall cameras see more, a drop for the shortest): "
                    f"the mean of {taller} m minus 0.45 m is {ours:+.2f} (paper: {paper:+.2f}); "
@@ -216,7 +240,7 @@ def _reading_table1(df: pd.DataFrame) -> list[str]:
         if a is None or b is None:
             continue
         paper = PAPER[(h, "everywhere")] - PAPER[(h, "no_low_cabinets")]
-        apart = _apart(a.success_rate, a.wilson_low, a.wilson_high, b.success_rate, b.wilson_low, b.wilson_high)
+        apart = _apart(a.success_rate, a.ci_low, a.ci_high, b.success_rate, b.ci_low, b.ci_high)
         moves.append(f"{h:g} m {a.success_rate - b.success_rate:+.2f} (paper {paper:+.2f}; {apart})")
     if moves:
         out.append("- **Cabinets** (paper: tall cameras lose when targets may be inside low cabinets, the shortest "
@@ -284,6 +308,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
     "provenance": block_provenance,
     "compare": block_compare,
+    "power": block_power,
     "reading": block_reading,
 }
 

@@ -1,9 +1,16 @@
 """Confidence intervals and paired comparisons for the report (scipy.stats only).
 
-- :func:`wilson_ci`: Wilson score interval of a success rate from pooled episodes.
+- :func:`wilson_ci`: Wilson score interval of a success rate from independent episodes (one seed,
+  each scenario once: the bounds' rows);
+- :func:`two_level_ci`: the interval of a policy's mean when several seeds ran the SAME scenarios:
+  a bootstrap that resamples scenarios, then seeds, so that the scenario is the unit that repeats;
 - :func:`bootstrap_ci`: bootstrap interval of a statistic over a few per-seed values.
 - :func:`compare_cells`: candidate vs reference on one evaluation cell (same scenarios), paired
-  by scenario with seeds pooled: difference, bootstrap CI and sign-flip permutation p-value.
+  by scenario: difference, two-level paired bootstrap CI and sign-flip permutation p-value.
+
+Why not a Wilson interval over every episode of a cell: 3 seeds x 100 scenarios are not 300
+independent trials. A scenario that is hard for one seed is hard for the others, so the pooled
+interval is too narrow by up to sqrt(seeds) (tests/test_report.py builds such a case by hand).
 """
 
 from __future__ import annotations
@@ -59,6 +66,94 @@ def bootstrap_ci(values_per_seed, statistic: Callable = np.mean, confidence: flo
     return float(res.confidence_interval.low), float(res.confidence_interval.high)
 
 
+def scenario_seed_matrix(df: pd.DataFrame, value: str) -> tuple[np.ndarray, list]:
+    """Per-episode rows -> (scenarios x seeds) matrix of ``value`` and the scenario keys.
+
+    A scenario is ``(scenario_set, scenario_id)`` when the frame says which file it came from (ids
+    restart in every file). Every seed must cover every scenario (ValueError otherwise): the design
+    is crossed, and a hole would silently reweight the scenarios."""
+    missing = [c for c in ("scenario_id", "seed", value) if c not in df.columns]
+    if missing:
+        raise ValueError(f"episodes lack columns {missing}")
+    if df.empty:
+        raise ValueError("no episodes")
+    keys = ["scenario_set", "scenario_id"] if "scenario_set" in df.columns else ["scenario_id"]
+    if df.duplicated([*keys, "seed"]).any():
+        raise ValueError("a scenario appears twice for the same seed")
+    wide = df.pivot_table(index=keys, columns="seed", values=value, aggfunc="first", sort=True)
+    if wide.isna().to_numpy().any():
+        holes = int(wide.isna().to_numpy().sum())
+        raise ValueError(f"{holes} (scenario, seed) pair(s) missing: every seed must run every scenario")
+    return wide.to_numpy(dtype=float), list(wide.index)
+
+
+def _two_level_means(m: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Mean of ``m[rows_b][:, cols_b]`` for every resample b (rows (B, S), cols (B, K))."""
+    col_sums = m[rows].sum(axis=1)  # (B, K): the resampled scenarios' sum, per seed
+    return np.take_along_axis(col_sums, cols, axis=1).mean(axis=1) / m.shape[0]
+
+
+def two_level_ci(m: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_000,
+                 seed: int = 0) -> tuple[float, float, float]:
+    """Mean of a (scenarios x seeds) matrix and its two-level bootstrap interval.
+
+    Each resample draws the scenarios with replacement, then, independently, the seeds with
+    replacement (seeds and scenarios are crossed: every seed ran every scenario), and takes the
+    mean of the resampled matrix; the interval is the percentile interval of those means. With one
+    seed it is the ordinary bootstrap over scenarios; with one scenario the seeds alone.
+    ``(mean, nan, nan)`` for a 1 x 1 matrix."""
+    m = np.asarray(m, dtype=float)
+    if m.ndim != 2 or m.size == 0:
+        raise ValueError(f"two_level_ci needs a non-empty (scenarios x seeds) matrix, got shape {m.shape}")
+    mean = float(m.mean())
+    if m.size == 1:
+        return mean, math.nan, math.nan
+    if np.all(m == m.flat[0]):
+        return mean, mean, mean
+    rng = np.random.default_rng(seed)
+    n_s, n_k = m.shape
+    means = np.empty(n_resamples)
+    chunk = max(1, 4_000_000 // max(1, n_s * n_k))
+    for start in range(0, n_resamples, chunk):
+        b = min(chunk, n_resamples - start)
+        means[start:start + b] = _two_level_means(m, rng.integers(0, n_s, (b, n_s)), rng.integers(0, n_k, (b, n_k)))
+    alpha = (1 - confidence) / 2
+    lo, hi = np.quantile(means, [alpha, 1 - alpha])
+    return mean, float(lo), float(hi)
+
+
+def paired_two_level_ci(ref: np.ndarray, cand: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_000,
+                        seed: int = 0) -> tuple[float, float]:
+    """Interval of mean(cand) - mean(ref) over the same scenarios (rows), each side with its own seeds
+    (columns): one draw of scenarios serves both sides (the pairing), the seeds are drawn per side
+    (they are different training runs)."""
+    ref, cand = np.asarray(ref, float), np.asarray(cand, float)
+    if ref.shape[0] != cand.shape[0]:
+        raise ValueError("paired_two_level_ci: the two sides have different numbers of scenarios")
+    n_s = ref.shape[0]
+    rng = np.random.default_rng(seed)
+    diffs = np.empty(n_resamples)
+    chunk = max(1, 4_000_000 // max(1, n_s * max(ref.shape[1], cand.shape[1])))
+    for start in range(0, n_resamples, chunk):
+        b = min(chunk, n_resamples - start)
+        rows = rng.integers(0, n_s, (b, n_s))
+        diffs[start:start + b] = (_two_level_means(cand, rows, rng.integers(0, cand.shape[1], (b, cand.shape[1])))
+                                  - _two_level_means(ref, rows, rng.integers(0, ref.shape[1], (b, ref.shape[1]))))
+    alpha = (1 - confidence) / 2
+    lo, hi = np.quantile(diffs, [alpha, 1 - alpha])
+    return float(lo), float(hi)
+
+
+def detectable_difference(sd_paired: float, n_scenarios: int, alpha: float = 0.05, power: float = 0.8) -> float:
+    """Smallest true mean difference a paired two-sided test at level ``alpha`` detects with probability
+    ``power`` over ``n_scenarios`` scenarios whose seed-averaged paired differences have standard
+    deviation ``sd_paired``: ``(z_{1-alpha/2} + z_power) * sd / sqrt(n)`` (normal approximation)."""
+    if n_scenarios < 1:
+        raise ValueError(f"n_scenarios={n_scenarios}: must be >= 1")
+    z = stats.norm.ppf(1 - alpha / 2) + stats.norm.ppf(power)
+    return float(z * sd_paired / math.sqrt(n_scenarios))
+
+
 def _per_scenario(df: pd.DataFrame, metric: str, side: str) -> tuple[pd.Series, int]:
     missing = [c for c in ("scenario_id", "seed", metric) if c not in df.columns]
     if missing:
@@ -80,24 +175,30 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     ``scenario_set``, which file the scenario came from; see ``data.read_episodes``). Both sides
     must cover exactly the same scenarios (ValueError otherwise).
 
-    Method (scenarios are the unit; seeds are pooled within a scenario):
+    Method (the scenario is the unit that repeats):
 
     1. per side and scenario ``s``, average the metric over the seeds that side has for ``s``:
        ``r_s``, ``c_s``; ``reference = mean_s r_s``, ``candidate = mean_s c_s`` (equal to the pooled
        episode mean when every seed covers every scenario); ``difference = mean_s (c_s - r_s)``.
-    2. CI: paired bootstrap over scenarios, i.e. resample scenario ids with replacement (each
-       resampled scenario brings both of its seed-averaged values) and take the mean paired
-       difference; ``n_resamples`` resamples, percentile interval, ``rng=default_rng(seed)``.
-       All-equal differences give the point interval ``(d, d)``.
-    3. p-value: two-sided paired permutation (sign-flip) test over scenarios: under H0 the labels
-       reference/candidate are exchangeable within a scenario, so each ``d_s`` keeps or flips its
-       sign at random; statistic = mean ``d_s``; ``scipy.stats.permutation_test`` with
-       ``permutation_type="samples"``, ``n_resamples`` random flips (exact enumeration when
-       ``2**n_scenarios <= n_resamples``), ``rng=default_rng(seed)``. Identical sides give p = 1.
+    2. CI: a two-level paired bootstrap (:func:`paired_two_level_ci`): resample the scenarios with
+       replacement (one draw for both sides: the pairing), then each side's seeds with replacement
+       (different training runs), and take the difference of the means; percentile interval,
+       ``rng=default_rng(seed)``. Where a side's seeds do not all cover every scenario, the seeds are
+       averaged per scenario first and only the scenarios are resampled. All-equal differences give
+       the point interval ``(d, d)``.
+    3. p-value: two-sided paired permutation (sign-flip) test over scenarios on the seed-averaged
+       differences: under H0 the labels reference/candidate are exchangeable within a scenario, so
+       each ``d_s`` keeps or flips its sign at random; statistic = mean ``d_s``;
+       ``scipy.stats.permutation_test`` with ``permutation_type="samples"``, ``n_resamples`` random
+       flips (exact enumeration when ``2**n_scenarios <= n_resamples``), ``rng=default_rng(seed)``.
+       Identical sides give p = 1. It is per cell and UNCORRECTED; ``compare_report`` adds Holm's
+       adjustment over every row, and only that decides significance.
 
-    Returns ``{reference, candidate, difference, ci_low, ci_high, p_value, n_scenarios, n_seeds_ref,
-    n_seeds_cand, significant}`` with ``significant = p_value < 0.05`` (not corrected for the number of
-    cells compared; ``compare_report`` adds Holm-adjusted p-values).
+    4. ``detectable_80``: the difference this cell could detect, :func:`detectable_difference` of the
+       seed-averaged paired differences' SD over its scenarios (80% power, p < 0.05 uncorrected).
+
+    Returns ``{reference, candidate, difference, ci_low, ci_high, p_uncorrected, n_scenarios,
+    n_seeds_ref, n_seeds_cand, detectable_80}``.
     """
     if metric not in METRICS:
         raise ValueError(f"metric={metric!r}; allowed: {', '.join(METRICS)}")
@@ -115,9 +216,12 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     if d.size < 2 or np.all(d == d[0]):
         lo = hi = diff
     else:
-        res = stats.bootstrap((d,), np.mean, n_resamples=n_resamples, confidence_level=confidence,
-                              method="percentile", rng=np.random.default_rng(seed))
-        lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+        try:
+            ref_m, _ = scenario_seed_matrix(reference, metric)
+            cand_m, _ = scenario_seed_matrix(candidate, metric)
+        except ValueError:  # a seed lacks a scenario: resample the seed-averaged scenarios only
+            ref_m, cand_m = r[:, None], c[:, None]
+        lo, hi = paired_two_level_ci(ref_m, cand_m, confidence, n_resamples, seed)
     if np.all(d == 0):
         p = 1.0
     else:
@@ -126,8 +230,9 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
                                       alternative="two-sided", rng=np.random.default_rng(seed))
         p = float(min(1.0, perm.pvalue))
     return {"reference": float(r.mean()), "candidate": float(c.mean()), "difference": diff,
-            "ci_low": lo, "ci_high": hi, "p_value": p, "n_scenarios": int(d.size),
-            "n_seeds_ref": n_ref, "n_seeds_cand": n_cand, "significant": bool(p < 0.05)}
+            "ci_low": lo, "ci_high": hi, "p_uncorrected": p, "n_scenarios": int(d.size),
+            "n_seeds_ref": n_ref, "n_seeds_cand": n_cand,
+            "detectable_80": detectable_difference(float(d.std(ddof=1)), d.size) if d.size > 1 else math.nan}
 
 
 def holm(p_values) -> np.ndarray:

@@ -12,7 +12,15 @@ import numpy as np
 import pandas as pd
 
 from egosearch.report.data import _sorted_cells, _with, output_base, read_episodes
-from egosearch.report.stats import METRICS, bootstrap_ci, compare_cells, holm, wilson_ci
+from egosearch.report.stats import (
+    METRICS,
+    bootstrap_ci,
+    compare_cells,
+    holm,
+    scenario_seed_matrix,
+    two_level_ci,
+    wilson_ci,
+)
 
 PAPER_TABLE1: dict[tuple[float, str], float] = {
     (0.45, "no_low_cabinets"): 0.50, (1.05, "no_low_cabinets"): 0.92, (1.65, "no_low_cabinets"): 0.90,
@@ -22,13 +30,25 @@ PAPER_TABLE1: dict[tuple[float, str], float] = {
 
 PLACEMENT_LABELS = {"no_low_cabinets": "Excluding cabinets", "everywhere": "Everywhere"}
 
-TABLE1_COLUMNS = ("height", "placement", "n_episodes", "n_seeds", "success_rate", "wilson_low", "wilson_high",
-                  "seed_boot_low", "seed_boot_high", "spl", "paper_success_rate")
+TABLE1_COLUMNS = ("home", "height", "placement", "n_episodes", "n_scenarios", "n_seeds", "success_rate", "ci_low",
+                  "ci_high", "seed_boot_low", "seed_boot_high", "spl", "spl_low", "spl_high", "paper_success_rate")
+"""``ci_*``: the two-level bootstrap (scenarios, then seeds) of :func:`~egosearch.report.stats.two_level_ci`."""
+BOTH_HOMES = "both"
+"""The ``home`` of Table 1's rows pooled over every home evaluated: the rows set beside the paper's column,
+because the paper tests in both of its homes (Section 6) and gives one number per cell."""
 
-BOUNDS = ("random", "oracle")
-"""The searchers Table 1 puts each policy between, on the same scenario sets: uniform random actions,
-and the privileged oracle (knows the target and walks the shortest path to it)."""
-BOUND_LABELS = {"random": "random searcher", "oracle": "privileged oracle"}
+BOUNDS = ("random", "frontier", "frontier_head_off", "oracle")
+"""The searchers Table 1 sets beside each policy, on the same scenario sets: uniform random actions, the
+classical frontier searcher from the actor's observation and its own pose (head moving, then held
+fixed: ``egosearch.frontier``), and the privileged oracle (knows the target and walks the shortest path
+to it)."""
+BOUND_LABELS = {"random": "random searcher", "frontier": "frontier searcher (classical)",
+                "frontier_head_off": "frontier searcher, head fixed", "oracle": "privileged oracle"}
+BOUND_WHAT = {"random": "uniform random actions",
+              "frontier": "maps depth with its own pose, walks to the nearest frontier, scans with its head, "
+                          "then walks to the target it saw (a reference, not tuned)",
+              "frontier_head_off": "the same with the camera fixed to the body",
+              "oracle": "knows the target and walks the shortest path to it"}
 BOUND_COLUMNS = tuple(f"{b}_{c}" for b in BOUNDS for c in ("n_episodes", "success_rate", "wilson_low",
                                                             "wilson_high", "spl"))
 NOT_RUN = "not run"
@@ -65,15 +85,36 @@ def _md_escape(s: str) -> str:
 
 
 # --------------------------------------------------------------------------------------------- Table 1
+def _home_of(scenario_set: str) -> str:
+    """The home of an episode: the first directory of its scenario set (``kitchen_living/everywhere/h1.05.csv``)."""
+    parts = str(scenario_set).split("/")
+    return parts[0] if len(parts) >= 3 else "home"
+
+
 def _read_cells(episode_files: Mapping, what: str) -> dict[tuple, pd.DataFrame]:
-    """``{(seed, height, placement): paths}`` -> ``{(height, placement): episodes pooled over seeds}``."""
+    """``{(seed, height, placement): paths}`` -> ``{(home, height, placement): episodes pooled over seeds}``,
+    and ``(BOTH_HOMES, height, placement)`` pooling the homes when there are several."""
     cells: dict[tuple, list[pd.DataFrame]] = {}
     for key, paths in episode_files.items():
         if not (isinstance(key, tuple) and len(key) == 3):
             raise ValueError(f"{what}: key {key!r} is not (seed, height, placement)")
         s, h, pl = key
-        cells.setdefault((round(float(h), 4), str(pl)), []).append(read_episodes(paths, seed=int(s)))
-    return {cell: pd.concat(frames, ignore_index=True) for cell, frames in cells.items()}
+        df = read_episodes(paths, seed=int(s))
+        df = df.assign(home=df["scenario_set"].map(_home_of))
+        for home, part in df.groupby("home", sort=True):
+            cells.setdefault((str(home), round(float(h), 4), str(pl)), []).append(part)
+    out = {cell: pd.concat(frames, ignore_index=True) for cell, frames in cells.items()}
+    homes = sorted({c[0] for c in out})
+    if len(homes) > 1:
+        for h, pl in {c[1:] for c in out}:
+            parts = [out[(home, h, pl)] for home in homes if (home, h, pl) in out]
+            out[(BOTH_HOMES, h, pl)] = pd.concat(parts, ignore_index=True)
+    return out
+
+
+def _sorted_home_cells(cells) -> list[tuple]:
+    homes = sorted({c[0] for c in cells}, key=lambda h: (h == BOTH_HOMES, h))
+    return [(home, h, pl) for home in homes for h, pl in _sorted_cells({c[1:] for c in cells if c[0] == home})]
 
 
 def _bound_row(df: pd.DataFrame | None, bound: str, confidence: float) -> dict:
@@ -88,18 +129,21 @@ def _bound_row(df: pd.DataFrame | None, bound: str, confidence: float) -> dict:
 
 def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: int = 10_000,
                  seed: int = 0, bounds: Mapping[str, Mapping] | None = None) -> pd.DataFrame:
-    """The numbers of Table 1, one row per (height, placement) with :data:`TABLE1_COLUMNS`.
+    """The numbers of Table 1, one row per (home, height, placement) with :data:`TABLE1_COLUMNS`.
 
     ``episode_files``: ``{(seed, height, placement): path or [paths]}``; several paths per key are
-    pooled (e.g. the two layouts). Per cell: ``success_rate`` and ``spl`` are means over all
-    episodes pooled over seeds; ``wilson_*`` the Wilson interval of the pooled successes;
-    ``seed_boot_*`` a percentile bootstrap of the mean over the per-seed success rates (NaN with one
-    seed); ``paper_success_rate`` the paper's value (NaN where the paper has none).
+    the homes (``.../seed{N}/{home}/{placement}/h{height}.csv``). Each home gets its rows and, when
+    there are several, :data:`BOTH_HOMES` pools them. Per cell: ``success_rate`` and ``spl`` are
+    means over all episodes; ``ci_*`` / ``spl_low``, ``spl_high`` their two-level bootstrap interval
+    (scenarios, then seeds: every seed ran the same scenarios, so the scenario is the unit that
+    repeats, not the episode); ``seed_boot_*`` a percentile bootstrap over the per-seed success
+    rates (NaN with one seed); ``paper_success_rate`` the paper's value (NaN where it has none).
 
     ``bounds`` (``{"random" | "oracle": {(seed, height, placement): paths}}``, either side possibly
     empty) adds :data:`BOUND_COLUMNS`: the bound searchers' pooled success rate, Wilson interval and
-    SPL on each cell (NaN and 0 episodes where a bound was not run). They must have run on the
-    policy's scenario sets: a cell the policy lacks is an error.
+    SPL on each cell (NaN and 0 episodes where a bound was not run). A bound runs one seed, each
+    scenario once, so its episodes are independent and the Wilson interval is right for it. They
+    must have run on the policy's scenario sets: a cell the policy lacks is an error.
     """
     if not episode_files:
         raise ValueError("table1: no evaluation files given")
@@ -113,19 +157,20 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
         if extra:
             raise ValueError(f"table1: the {bound} files have cells the policy has not: {sorted(extra)}")
     rows = []
-    for h, pl in _sorted_cells(cells):
-        df = cells[(h, pl)]
-        n, k = len(df), int(df["success"].astype(int).sum())
-        lo, hi = wilson_ci(k, n, confidence)
+    for home, h, pl in _sorted_home_cells(cells):
+        df = cells[(home, h, pl)]
+        success, scenarios = scenario_seed_matrix(df, "success")
+        rate, lo, hi = two_level_ci(success, confidence, n_resamples, seed)
+        spl_mean, spl_lo, spl_hi = two_level_ci(scenario_seed_matrix(df, "spl")[0], confidence, n_resamples, seed)
         per_seed = df.groupby("seed")["success"].mean().to_numpy(dtype=float)
         blo, bhi = bootstrap_ci(per_seed, np.mean, confidence, n_resamples, seed)
-        rows.append({"height": h, "placement": pl, "n_episodes": n, "n_seeds": int(df["seed"].nunique()),
-                     "success_rate": k / n, "wilson_low": lo, "wilson_high": hi,
-                     "seed_boot_low": blo, "seed_boot_high": bhi, "spl": float(df["spl"].mean()),
-                     "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
+        rows.append({"home": home, "height": h, "placement": pl, "n_episodes": len(df), "n_scenarios": len(scenarios),
+                     "n_seeds": int(df["seed"].nunique()), "success_rate": rate, "ci_low": lo, "ci_high": hi,
+                     "seed_boot_low": blo, "seed_boot_high": bhi, "spl": spl_mean, "spl_low": spl_lo,
+                     "spl_high": spl_hi, "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
         if bounds is not None:
             for bound in BOUNDS:
-                rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((h, pl)), bound, confidence))
+                rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((home, h, pl)), bound, confidence))
     columns = list(TABLE1_COLUMNS) + (list(BOUND_COLUMNS) if bounds is not None else [])
     return pd.DataFrame(rows, columns=columns)
 
@@ -137,77 +182,54 @@ def _table1_grid(df: pd.DataFrame) -> tuple[list[float], list[str]]:
     return heights, placements
 
 
-def _table1_cell(df: pd.DataFrame, h: float, pl: str, tex: bool = False) -> str:
-    row = df[(df["height"] == h) & (df["placement"] == pl)]
-    paper = PAPER_TABLE1.get((round(h, 2), pl), math.nan)
-    paper_s = _fmt(paper)
-    sep = r" $\cdot$ " if tex else " · "
-    if row.empty:
-        ours = "–"
-    else:
-        r = row.iloc[0]
-        ours = f"{r.success_rate:.2f} [{r.wilson_low:.2f}, {r.wilson_high:.2f}]"
-    return f"ours {ours}{sep}paper {paper_s}"
-
-
 def _searcher_cell(df: pd.DataFrame, h: float, pl: str, who: str) -> str:
-    """One searcher on one cell: ``0.83 [0.76, 0.88]`` (Wilson), the paper's value, or "not run"."""
+    """One searcher on one cell: ``0.83 [0.76, 0.88]`` (ours: two-level bootstrap; bounds: Wilson), the
+    paper's value, or "not run"."""
     row = df[(df["height"] == h) & (df["placement"] == pl)]
     if who == "paper":
         return _fmt(PAPER_TABLE1.get((round(h, 2), pl), math.nan))
     if row.empty:
         return "–"
     r = row.iloc[0]
-    prefix = "" if who == "ours" else f"{who}_"
-    if who != "ours" and not r[f"{prefix}n_episodes"]:
+    if who == "ours":
+        return f"{r.success_rate:.2f} [{r.ci_low:.2f}, {r.ci_high:.2f}]"
+    if not r[f"{who}_n_episodes"]:
         return NOT_RUN
-    return f"{r[prefix + 'success_rate']:.2f} [{r[prefix + 'wilson_low']:.2f}, {r[prefix + 'wilson_high']:.2f}]"
+    return f"{r[who + '_success_rate']:.2f} [{r[who + '_wilson_low']:.2f}, {r[who + '_wilson_high']:.2f}]"
 
 
-def _table1_with_bounds(df: pd.DataFrame, base: Path, out_csv: Path, variant: str | None, seeds_s: str, eps_s: str,
-                        pct: str) -> None:
-    """Table 1 with, per height, four rows: random searcher, the policy, privileged oracle, paper."""
+def _home_label(home: str, homes: list[str]) -> str:
+    if home == BOTH_HOMES:
+        return "both homes pooled (" + " and ".join(h for h in homes if h != BOTH_HOMES) + ")"
+    return home
+
+
+def _table1_section(df: pd.DataFrame, title: str, variant: str | None, with_bounds: bool,
+                    label: str) -> tuple[list[str], list[str]]:
+    """One home's Table 1 as Markdown and LaTeX lines: per height the policy (and, with bounds, the random
+    searcher and the privileged oracle around it) and the paper."""
     heights, placements = _table1_grid(df)
     heads = [PLACEMENT_LABELS.get(p, p) for p in placements]
     ours = f"ours ({variant})" if variant else "ours"
-    searchers = [("random", "random searcher"), ("ours", ours), ("oracle", "privileged oracle"), ("paper", "paper")]
-    bound_eps = {b: "/".join(str(int(n)) for n in sorted(set(df[f"{b}_n_episodes"])) if n) or "0" for b in BOUNDS}
-    what = {"random": "uniform random actions", "oracle": "knows the target and walks the shortest path to it"}
-    notes = "; ".join(
-        f"{BOUND_LABELS[b]}: {what[b]}, "
-        + (f"{bound_eps[b]} episodes per cell on the same scenario sets" if bound_eps[b] != "0"
-           else f"{NOT_RUN} (no stored per-episode CSVs; rule `bound`)") for b in BOUNDS)
-    notes = notes[0].upper() + notes[1:]
-    pct_tex = pct.replace("%", r"\%")
-
-    md = ["Table 1: Success rate by head height and object placement: the search policy between the random "
-          "searcher and the privileged oracle, and the paper's policy.", "",
-          "| Head height | Searcher | " + " | ".join(heads) + " |", "|---|---|" + "---|" * len(heads)]
-    for h in heights:
-        for who, label in searchers:
-            md.append(f"| {_height_label(h)} | {label} | "
-                      + " | ".join(_searcher_cell(df, h, p, who) for p in placements) + " |")
-    md += ["", f"Success rate over all episodes of a cell (ours: pooled over {seeds_s} seed(s), {eps_s} episodes per "
-               f"cell); brackets: {pct} Wilson score interval. {notes}. The {pct} percentile bootstrap over ours' "
-               f"per-seed success rates and every SPL are in {out_csv.name}. Paper: Table 1 of Sorokin et al. 2021.",
-           ""]
-    _with(base, ".md").write_text("\n".join(md), encoding="utf-8")
-
-    cap = (f"Success rate by head height and object placement: the search policy between the random searcher and "
-           f"the privileged oracle, and the paper's Table 1. Ours: pooled over {seeds_s} seed(s) ({eps_s} episodes "
-           f"per cell); brackets: {pct_tex} Wilson score interval. {_tex_escape(notes)}.")
+    present = [b for b in BOUNDS if with_bounds and (b in ("random", "oracle") or df[f"{b}_n_episodes"].any())]
+    searchers = ([("random", BOUND_LABELS["random"])] if "random" in present else []) + [("ours", ours)]
+    searchers += [(b, BOUND_LABELS[b]) for b in present if b not in ("random", "oracle")]
+    searchers += ([("oracle", BOUND_LABELS["oracle"])] if "oracle" in present else []) + [("paper", "paper")]
+    md = [title, "", "| Head height | Searcher | " + " | ".join(heads) + " |", "|---|---|" + "---|" * len(heads)]
     tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{ll" + "c" * len(heads) + "}",
            r"\toprule", "Head height & Searcher & " + " & ".join(_tex_escape(x) for x in heads) + r" \\",
            r"\midrule"]
     for i, h in enumerate(heights):
         if i:
             tex.append(r"\midrule")
-        for j, (who, label) in enumerate(searchers):
-            tex.append(f"{_height_label(h) if j == 0 else ''} & {_tex_escape(label)} & "
-                       + " & ".join(_tex_escape(_searcher_cell(df, h, p, who)) for p in placements) + r" \\")
-    tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + cap + "}", r"\label{tab:table1}", r"\end{table}",
-            ""]
-    _with(base, ".tex").write_text("\n".join(tex), encoding="utf-8")
+        for j, (who, name) in enumerate(searchers):
+            cells = [_searcher_cell(df, h, p, who) for p in placements]
+            md.append(f"| {_height_label(h)} | {name} | " + " | ".join(cells) + " |")
+            tex.append(f"{_height_label(h) if j == 0 else ''} & {_tex_escape(name)} & "
+                       + " & ".join(_tex_escape(c) for c in cells) + r" \\")
+    tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + _tex_escape(title) + "}", r"\label{" + label + "}",
+            r"\end{table}", ""]
+    return md, tex
 
 
 def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.95, n_resamples: int = 10_000,
@@ -215,52 +237,57 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
     """Write ``{prefix}.csv``, ``.md`` and ``.tex`` (see :func:`output_base`; a directory gets ``table1.*``); return
     the frame.
 
-    See :func:`table1_frame` for ``episode_files`` and the numbers. The Markdown/LaTeX tables are
-    laid out like the paper (rows: head height; columns: Excluding cabinets / Everywhere), each
-    cell ``ours 0.83 [0.76, 0.88] · paper 0.92`` with the Wilson interval in brackets.
+    See :func:`table1_frame` for ``episode_files`` and the numbers. The Markdown/LaTeX tables are laid
+    out like the paper (rows: head height; columns: Excluding cabinets / Everywhere), each cell
+    ``0.83 [0.76, 0.88]``. The first table is the one set beside the paper's column: every home pooled
+    (the paper tests in both of its homes and gives one number per cell), or the one home evaluated;
+    a table per home follows when there are several.
 
-    With ``bounds`` (see :func:`table1_frame`; ``{}`` when none is stored) each height gets four
-    rows instead: random searcher, ours (``variant``), privileged oracle and paper, a bound that was
-    not run saying so.
+    With ``bounds`` (see :func:`table1_frame`; ``{}`` when none is stored) each height also gets the
+    random searcher and the privileged oracle, a bound that was not run saying so.
     """
     df = table1_frame(episode_files, confidence, n_resamples, seed, bounds=bounds)
     base = output_base(out_prefix, "table1")
     out_csv = _with(base, ".csv")
     df.to_csv(out_csv, index=False, float_format="%.6g")
-    heights, placements = _table1_grid(df)
-    heads = [PLACEMENT_LABELS.get(p, p) for p in placements]
-    n_seeds = sorted(set(df["n_seeds"]))
-    n_eps = sorted(set(df["n_episodes"]))
-    seeds_s = "/".join(str(s) for s in n_seeds)
-    eps_s = "/".join(str(s) for s in n_eps)
+    homes = sorted(set(df["home"]), key=lambda h: (h != BOTH_HOMES, h))
     pct = f"{confidence * 100:g}%"
-    pct_tex = pct.replace("%", r"\%")
-    if bounds is not None:
-        _table1_with_bounds(df, base, out_csv, variant, seeds_s, eps_s, pct)
-        return df
-
-    md = ["Table 1: Success rate of the search policy by head height and object placement (ours vs. paper).", "",
-          "| Head height | " + " | ".join(heads) + " |", "|---|" + "---|" * len(heads)]
-    for h in heights:
-        md.append(f"| {_height_label(h)} | " + " | ".join(_table1_cell(df, h, p) for p in placements) + " |")
-    md += ["", f"Ours: success rate over all episodes pooled over {seeds_s} seed(s) ({eps_s} episodes per cell); "
-               f"brackets: {pct} Wilson score interval over the pooled episodes. The {pct} percentile bootstrap over "
-               f"per-seed success rates is in {out_csv.name} (seed_boot_low/high). "
-               "Paper: Table 1 of Sorokin et al. 2021.", ""]
-    _with(base, ".md").write_text("\n".join(md), encoding="utf-8")
-
-    cap = (f"Success rate of the search policy by head height and object placement, ours vs.\\ the paper's Table 1. "
-           f"Ours: all episodes pooled over {seeds_s} seed(s) ({eps_s} episodes per cell); brackets: "
-           f"{pct_tex} Wilson score interval over the pooled episodes; the "
-           f"{pct_tex} percentile bootstrap interval over per-seed success rates is given "
-           f"in {_tex_escape(out_csv.name)}.")
-    tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{l" + "c" * len(heads) + "}", r"\toprule",
-           "Head height & " + " & ".join(_tex_escape(x) for x in heads) + r" \\", r"\midrule"]
-    for h in heights:
-        tex.append(f"{_height_label(h)} & " + " & ".join(_table1_cell(df, h, p, tex=True) for p in placements)
-                   + r" \\")
-    tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + cap + "}", r"\label{tab:table1}", r"\end{table}", ""]
-    _with(base, ".tex").write_text("\n".join(tex), encoding="utf-8")
+    seeds_s = "/".join(str(s) for s in sorted(set(df["n_seeds"])))
+    with_bounds = bounds is not None
+    md_all, tex_all = [], []
+    for i, home in enumerate(homes):
+        part = df[df["home"] == home]
+        scen = "/".join(str(s) for s in sorted(set(part["n_scenarios"])))
+        where = _home_label(home, homes)
+        title = (f"Table 1: Success rate by head height and object placement, {where}"
+                 + (": the search policy between the random searcher and the privileged oracle, and the paper's policy."
+                    if with_bounds else " (ours vs. paper)."))
+        if i:
+            title = f"Table 1 in {where} alone."
+        md, tex = _table1_section(part, title, variant, with_bounds, "tab:table1" + ("" if not i else f"_{home}"))
+        md_all += md + [""]
+        tex_all += tex
+        if not i:
+            if with_bounds:
+                bound_eps = {b: "/".join(str(int(n)) for n in sorted(set(part[f"{b}_n_episodes"])) if n) or "0"
+                             for b in BOUNDS}
+                shown = [b for b in BOUNDS if b in ("random", "oracle") or bound_eps[b] != "0"]
+                notes = " ".join(
+                    f"{BOUND_LABELS[b][0].upper() + BOUND_LABELS[b][1:]}: {BOUND_WHAT[b]}, "
+                    + (f"{bound_eps[b]} episodes per cell on the same scenarios, one seed (independent episodes: "
+                       f"{pct} Wilson interval)." if bound_eps[b] != "0"
+                       else f"{NOT_RUN} (no stored per-episode CSVs; rule `bound`).") for b in shown)
+            else:
+                notes = ""
+            md_all += [f"Ours: {scen} scenarios per cell, each run by {seeds_s} seed(s); brackets: {pct} two-level "
+                       "bootstrap interval (scenarios resampled, then seeds: the seeds ran the same scenarios, so "
+                       f"the scenario is the unit that repeats). {notes} "
+                       + ("The paper's column is set beside both homes pooled: the paper tests its policy in both "
+                          "homes (Section 6) and gives one number per cell. " if BOTH_HOMES in homes else "")
+                       + f"SPL and its interval, and the {pct} bootstrap over per-seed success rates, are in "
+                       f"{out_csv.name}. Paper: Table 1 of Sorokin et al. 2021.", ""]
+    _with(base, ".md").write_text("\n".join(md_all).rstrip("\n") + "\n", encoding="utf-8")
+    _with(base, ".tex").write_text("\n".join(tex_all), encoding="utf-8")
     return df
 
 
@@ -303,7 +330,12 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
 
 # --------------------------------------------------------------------------------------------- compare
 COMPARE_COLUMNS = ("height", "placement", "metric", "reference", "candidate", "difference", "ci_low", "ci_high",
-                   "p_value", "p_holm", "significant", "n_scenarios", "n_seeds_ref", "n_seeds_cand")
+                   "p_uncorrected", "p_holm", "significant_holm", "n_scenarios", "n_seeds_ref", "n_seeds_cand",
+                   "detectable_80", "homes")
+"""``p_uncorrected`` is one cell's test alone; ``significant_holm`` is ``p_holm < 0.05``, Holm's adjustment
+over every row of the file: the only column that says whether a difference is significant.
+``detectable_80``: the true difference the cell would detect with 80% power (uncorrected); ``homes``: the
+homes whose scenarios the cell pools."""
 
 
 def _cell_name(cell) -> str:
@@ -339,9 +371,11 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
                 res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed)
             except ValueError as e:
                 raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
-            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res})
+            homes = "+".join(sorted({_home_of(x) for x in ref["scenario_set"]}))
+            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res, "homes": homes})
     df = pd.DataFrame(rows)
-    df["p_holm"] = holm(df["p_value"].to_numpy())
+    df["p_holm"] = holm(df["p_uncorrected"].to_numpy())
+    df["significant_holm"] = df["p_holm"] < 0.05
     df = df[list(COMPARE_COLUMNS)]
     if out_csv is not None:
         out_csv = Path(out_csv)
@@ -351,16 +385,18 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
 
 
 def format_compare(df: pd.DataFrame, reference_name: str = "reference", candidate_name: str = "candidate") -> str:
-    """Fixed-width text of a :func:`compare_report` frame; ``*`` marks p < 0.05 (uncorrected)."""
+    """Fixed-width text of a :func:`compare_report` frame; ``*`` marks Holm-adjusted p < 0.05."""
     head = (f"{'height':>6}  {'placement':<16} {'metric':<7} {reference_name[:10]:>10} {candidate_name[:10]:>10} "
-            f"{'diff':>7}  {'95% CI':<17} {'p':>7} {'p_holm':>7}  {'scen':>4} {'seeds':>5}")
+            f"{'diff':>7}  {'95% CI':<17} {'p_unc':>7} {'p_holm':>7}  {'scen':>4} {'seeds':>5}")
     lines = [head, "-" * len(head)]
     for r in df.itertuples(index=False):
         ci = f"[{r.ci_low:+.3f}, {r.ci_high:+.3f}]"
-        star = "*" if r.significant else " "
+        star = "*" if r.significant_holm else " "
         lines.append(f"{float(r.height):>6.2f}  {str(r.placement):<16} {r.metric:<7} {r.reference:>10.3f} "
-                     f"{r.candidate:>10.3f} {r.difference:>+7.3f}  {ci:<17} {r.p_value:>7.4f} {r.p_holm:>7.4f}{star} "
+                     f"{r.candidate:>10.3f} {r.difference:>+7.3f}  {ci:<17} {r.p_uncorrected:>7.4f} "
+                     f"{r.p_holm:>7.4f}{star} "
                      f"{r.n_scenarios:>4d} {r.n_seeds_ref:>2d}/{r.n_seeds_cand:<2d}")
-    lines.append("* p < 0.05 (per-cell, uncorrected; p_holm: Holm-adjusted over all rows). diff = candidate - "
-                 "reference; CI: paired bootstrap over scenarios; p: paired sign-flip permutation test.")
+    lines.append("* Holm-adjusted p < 0.05 over all rows (p_unc: one cell's test alone). diff = candidate - "
+                 "reference; CI: paired two-level bootstrap (scenarios, then seeds); p: paired sign-flip "
+                 "permutation test over scenarios.")
     return "\n".join(lines)

@@ -430,6 +430,13 @@ def _make_env(env_id: str, env_kwargs: dict):
             import egosearch.envs  # noqa: F401  (registers the EgoSearch ids)
         except ImportError:
             pass
+    if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.home_pool)
+        from egosearch.home_pool import HomePoolEnv
+        from egosearch.scene.layouts import LAYOUT_NAMES
+
+        if env_kwargs["layout"] == "paper_homes":
+            return HomePoolEnv(env_id, home_names=LAYOUT_NAMES, **env_kwargs)
+        return HomePoolEnv(env_id, **env_kwargs)
     return gymnasium.make(env_id, **env_kwargs)
 
 

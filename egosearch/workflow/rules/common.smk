@@ -11,7 +11,8 @@ CONDA_ENV = "../envs/egosearch.yaml"
 
 PROFILE = config["profile"]
 PROF = config["profiles"][PROFILE]
-LAYOUT = config["layout"]
+LAYOUT = config["layout"]  # the full-body runs', the budget cell's and the pictures' home
+HOMES = config["homes"]  # Table 1's homes
 SEEDS = PROF["seeds"]
 HEIGHTS = [f"{h:g}" for h in config["heights"]]
 PLACEMENTS = config["placements"]
@@ -30,7 +31,7 @@ wildcard_constraints:
     seed="[0-9]+",
     height="[0-9.]+",
     placement="no_low_cabinets|everywhere",
-    layout="kitchen_living|bedroom_bath|studio|home[0-9]+",
+    layout="kitchen_living|bedroom_bath|studio|home[0-9]+|generated_heldout|generated_train",
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
 
 
@@ -38,9 +39,9 @@ def scenario_file(placement, height):
     return f"{RESULTS}/scenarios/{LAYOUT}/{placement}/h{height}.csv"
 
 
-def eval_files(variant):
-    return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{LAYOUT}/{{placement}}/h{{height}}.csv",
-                  seed=SEEDS, placement=PLACEMENTS, height=HEIGHTS)
+def eval_files(variant, homes=None):
+    return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
+                  seed=SEEDS, home=homes or HOMES, placement=PLACEMENTS, height=HEIGHTS)
 
 
 def curve_files(variant):
@@ -90,24 +91,27 @@ def compare_candidate(wildcards):
     return eval_files(config["variant"])
 
 
-# The floor and the ceiling of Table 1 on the very scenario sets the policies are evaluated on.
-# Their CSVs sit beside the variants' (eval/random, eval/oracle): a variant may not take those names.
-BOUNDS = ["random", "oracle"]
+# The floor, the classical searcher and the ceiling of Table 1, on the very scenario sets the policies
+# are evaluated on.
+# Their CSVs sit beside the variants' (eval/random, eval/frontier, ...): a variant may not take those names.
+BOUNDS = ["random", "frontier", "frontier_head_off", "oracle"]
 # One seed: the oracle is deterministic, and the random searcher's spread over 100 scenarios per
 # cell is far wider than its spread over seeds.
 BOUND_SEEDS = [0]
 
 
-def bound_files(bounds=BOUNDS, placements=None):
-    return expand(f"{RESULTS}/eval/{{bound}}/seed{{seed}}/{LAYOUT}/{{placement}}/h{{height}}.csv",
-                  bound=bounds, seed=BOUND_SEEDS, placement=placements or PLACEMENTS, height=HEIGHTS)
+def bound_files(bounds=BOUNDS, placements=None, homes=None):
+    return expand(f"{RESULTS}/eval/{{bound}}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
+                  bound=bounds, seed=BOUND_SEEDS, home=homes or HOMES, placement=placements or PLACEMENTS,
+                  height=HEIGHTS)
 
 
 def fig6_random_files():
     """The random searcher on the Table 1 cells of the placement scheme the reference trains and
     is evaluated in during training (Figure 6's curves): its level in that figure."""
     placement = VARIANTS[REF].train_env["placement"]
-    return bound_files(["random"], [placement]) if placement in PLACEMENTS else []
+    home = VARIANTS[REF].train_env["layout"]
+    return bound_files(["random"], [placement], [home]) if placement in PLACEMENTS and home in HOMES else []
 
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top
@@ -129,3 +133,22 @@ def budget_inputs():
     return runs
 
 
+# The generalisation benchmark (generalise.smk): each group of homes is one scenario file per
+# placement; GEN_GROUPS maps a group to its generated home seeds [first, stop).
+from egosearch.home_pool import HELDOUT_HOME_SEEDS
+
+GEN = config["generalise"]
+GEN_HEIGHT = f"{GEN['height']:g}"
+GEN_VARIANTS = {name: CHECKED_VARIANTS[name] for name in GEN["variants"]}
+_split = CHECKED_VARIANTS[GEN["generated_variant"]].train_env["home_seeds"]
+# group -> generated home seeds [first, stop)
+GEN_GROUPS = {
+    "generated_heldout": (HELDOUT_HOME_SEEDS.start, HELDOUT_HOME_SEEDS.stop),
+    "generated_train": (_split[0], min(_split[1], _split[0] + GEN["train_homes"])),
+}
+
+
+def generalise_files(who, seeds):
+    homes = list(GEN_GROUPS) + HOMES
+    return expand(f"{RESULTS}/eval/{who}/seed{{seed}}/{{home}}/{{placement}}/h{GEN_HEIGHT}.csv",
+                  seed=seeds, home=homes, placement=PLACEMENTS)

@@ -25,7 +25,8 @@ ruleorder: bound > evaluate
 
 
 rule bound:
-    """The random searcher or the privileged oracle (it knows the target) on one Table 1 cell."""
+    """A reference searcher on one Table 1 cell: the random searcher, the classical frontier searcher
+    (head moving or held fixed) or the privileged oracle (it knows the target)."""
     input:
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
@@ -35,7 +36,7 @@ rule bound:
     benchmark:
         "results/{profile}/benchmarks/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     wildcard_constraints:
-        bound="random|oracle",
+        bound="random|oracle|frontier|frontier_head_off",
     threads: 1
     resources:
         mem_mb=1500,

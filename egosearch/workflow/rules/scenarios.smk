@@ -6,6 +6,8 @@ rule scenarios:
         "results/{profile}/logs/scenarios/{layout}/{placement}/h{height}.log",
     benchmark:
         "results/{profile}/benchmarks/scenarios/{layout}/{placement}/h{height}.tsv"
+    wildcard_constraints:
+        layout="kitchen_living|bedroom_bath|studio|home[0-9]+",
     params:
         n=PROF["scenarios_per_cell"],
         seed=config["scenario_seed"],

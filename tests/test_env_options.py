@@ -1,0 +1,107 @@
+"""The env's options beyond the paper: the last-seen target memory (an observation lever) and the
+training-only coverage bonus."""
+
+import math
+
+import gymnasium
+import numpy as np
+import pytest
+
+import egosearch.envs  # noqa: F401
+from egosearch.env import MASK_FEATURE_DIM, TARGET_MEMORY_DIM
+
+
+def _run_until_seen(env, rng, max_episodes=30):
+    for ep in range(max_episodes):
+        obs, info = env.reset(seed=ep)
+        for _ in range(100):
+            obs, _, term, trunc, info = env.step(rng.uniform(-1, 1, env.action_space.shape[0]))
+            if info["visible"]:
+                return obs, info
+            if term or trunc:
+                break
+    raise AssertionError("the target was never seen")
+
+
+def test_target_memory_points_at_the_target_and_ages():
+    env = gymnasium.make("EgoSearchMemory-v0", layout="kitchen_living", placement="everywhere")
+    inner = env.unwrapped
+    assert env.observation_space["mask"].shape == (MASK_FEATURE_DIM + TARGET_MEMORY_DIM,)
+    obs, _ = env.reset(seed=0)
+    if not obs["mask"][MASK_FEATURE_DIM - 1]:  # not seen at the start: nothing remembered
+        assert obs["mask"][MASK_FEATURE_DIM:].tolist() == [0.0, 0.0, 0.0, 1.0, 0.0]
+    rng = np.random.default_rng(0)
+    obs, info = _run_until_seen(env, rng)
+    forward, left, _, since, seen = obs["mask"][MASK_FEATURE_DIM:]
+    s, t = inner.state, inner.target.center
+    dx, dy = t[0] - s.x, t[1] - s.y
+    c, sn = math.cos(s.theta), math.sin(s.theta)
+    true_fwd, true_left = c * dx + sn * dy, -sn * dx + c * dy
+    # the estimate from the depth under the mask lands on the object (targets are <= 0.3 m across)
+    assert math.hypot(5 * forward - true_fwd, 5 * left - true_left) < 0.3
+    assert (since, seen) == (0.0, 1.0)
+    # the body moves on: the remembered point stays put in the home, so its body-frame value moves
+    before = inner._memory_point.copy()
+    snap = inner.snapshot()
+    for _ in range(3):
+        obs, _, term, trunc, info = env.step(np.array([0.0, 0.0, 1.0, 0.0, 0.0], np.float32))
+        if term or trunc:
+            break
+        if not info["visible"]:
+            assert np.allclose(inner._memory_point, before)
+    inner.restore(snap)
+    assert np.allclose(inner._memory_point, before)
+
+
+def test_the_paper_env_is_unchanged_by_the_options():
+    env = gymnasium.make("EgoSearch-v0", layout="kitchen_living")
+    assert env.observation_space["mask"].shape == (MASK_FEATURE_DIM,)
+
+
+def test_coverage_bonus_pays_once_per_new_cell():
+    plain = gymnasium.make("EgoSearch-v0", layout="kitchen_living")
+    bonus = gymnasium.make("EgoSearch-v0", layout="kitchen_living", coverage_bonus=0.5)
+    plain.reset(seed=3)
+    bonus.reset(seed=3)
+    cells = {bonus.unwrapped._cell()}
+    rng = np.random.default_rng(1)
+    for _ in range(60):
+        a = rng.uniform(-1, 1, 5).astype(np.float32)
+        _, r0, t0, tr0, _ = plain.step(a)
+        _, r1, t1, tr1, info = bonus.step(a)
+        new = bonus.unwrapped._cell() not in cells
+        cells.add(bonus.unwrapped._cell())
+        assert r1 - r0 == pytest.approx(0.5 if new else 0.0) and info["r_cov"] == (0.5 if new else 0.0)
+        if t0 or tr0:
+            break
+    with pytest.raises(ValueError, match="coverage_bonus"):
+        gymnasium.make("EgoSearch-v0", coverage_bonus=-1.0)
+
+
+def test_floor_map_marks_what_the_body_saw_and_where_it_stood():
+    from egosearch.env import FLOOR_MAP_CELLS, FLOOR_MAP_DIM
+
+    env = gymnasium.make("EgoSearchMap-v0", layout="kitchen_living", placement="everywhere")
+    obs, _ = env.reset(seed=4)
+    start = MASK_FEATURE_DIM + TARGET_MEMORY_DIM
+    assert obs["mask"].shape == (start + FLOOR_MAP_DIM,)
+    seen, occupied, stood = obs["mask"][start:].reshape(3, FLOOR_MAP_CELLS, FLOOR_MAP_CELLS)
+    centre = FLOOR_MAP_CELLS // 2
+    # the camera looks ahead: the squares ahead are seen, the ones behind are not (row 0 is ahead)
+    assert seen[:centre].sum() > seen[centre + 1:].sum() == 0
+    assert stood[centre, centre] == 1.0 and stood.sum() == 1.0
+    assert np.all((obs["mask"][start:] >= 0) & (obs["mask"][start:] <= 1))
+    # walking forward: the square it stood on falls behind it
+    inner = env.unwrapped
+    before = (inner.state.x, inner.state.y)
+    for _ in range(4):
+        obs, *_ = env.step(np.array([1.0, 0.0, 0.0, 0.0, 0.0], np.float32))
+    moved = math.hypot(inner.state.x - before[0], inner.state.y - before[1])
+    stood = obs["mask"][start:].reshape(3, FLOOR_MAP_CELLS, FLOOR_MAP_CELLS)[2]
+    if moved > 0.6:
+        assert stood[centre + 1:].sum() >= 1.0
+    snap = inner.snapshot()
+    grid = inner._floor.grid.copy()
+    env.step(np.array([0.0, 0.0, 1.0, 0.0, 0.0], np.float32))
+    inner.restore(snap)
+    assert np.array_equal(inner._floor.grid, grid)
