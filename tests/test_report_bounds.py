@@ -3,11 +3,13 @@ when every bar is 0."""
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from egosearch.report.data import FULLBODY_COLUMNS
 from egosearch.report.figures import ALL_ZERO_NOTE, figure7, figure7_figure, figure7_frame
+from egosearch.report.stats import two_level_ci
 
 
 def _fullbody(root: Path, spl_of) -> list[Path]:
@@ -67,10 +69,20 @@ def test_table1_puts_the_policy_between_the_random_searcher_and_the_oracle(tmp_p
     md = (tmp_path / "out" / "table1.md").read_text()
     assert "| Head height | Searcher | Excluding cabinets | Everywhere |" in md
     assert "| 1.05m | random searcher | 0.20 [0.04, 0.62] | 0.20 [0.04, 0.62] |" in md
-    assert "| 1.05m | ours (head_on) | 0.25 [0.07, 0.59] | 0.25 [0.07, 0.59] |" in md
+    # ours: both seeds solve scenario 0 of 4, so the interval is the two-level bootstrap of that matrix
+    lo, hi = two_level_ci(np.array([[1, 1], [0, 0], [0, 0], [0, 0]], float))[1:]
+    assert f"| 1.05m | ours (head_on) | 0.25 [{lo:.2f}, {hi:.2f}] | 0.25 [{lo:.2f}, {hi:.2f}] |" in md
+    assert "frontier" not in md  # a reference searcher without files is left out, not "not run"
     assert "| 1.05m | privileged oracle | not run | 0.80 [0.38, 0.96] |" in md
     assert "| 1.05m | paper | 0.92 | 0.75 |" in md
     assert "privileged oracle" in (tmp_path / "out" / "table1.tex").read_text()
+    # The classical searcher, when stored, sits between the policy and the oracle.
+    frontier = [_eval_csv(tmp_path, "frontier", pl, h, [1, 1, 0, 1]) for pl, h in cells]
+    cmd_table1(ours, tmp_path / "out3" / "table1", variant="head_on", bounds=rand + oracle + frontier)
+    lines = (tmp_path / "out3" / "table1.md").read_text().splitlines()
+    row = "| 1.05m | frontier searcher (classical) | 0.75 [0.30, 0.95] | 0.75 [0.30, 0.95] |"
+    assert row in lines and lines.index(row) == lines.index(
+        "| 1.05m | ours (head_on) | " + f"0.25 [{lo:.2f}, {hi:.2f}] | 0.25 [{lo:.2f}, {hi:.2f}] |") + 1
     # Bounds of a cell the policy was not evaluated on were not run on its scenarios.
     stray = [_eval_csv(tmp_path, "random", "everywhere", 0.45, [0])]
     with pytest.raises(ValueError, match="cells the policy has not"):
