@@ -154,10 +154,11 @@ def block_power(root: Path, profile: str) -> str:
             lines.append(f"- `{path.stem}`: written before `detectable_80` existed (`{path.relative_to(root)}`).")
             continue
         succ = df[df["metric"] == "success"]
-        lines.append(f"- `{path.stem}`: {int(succ['n_scenarios'].min())}–{int(succ['n_scenarios'].max())} scenarios "
-                     f"per cell ({', '.join(sorted(set(succ['homes'])))}); a success difference of "
-                     f"{_fmt(succ['detectable_80'].min())}–{_fmt(succ['detectable_80'].max())} is detected with "
-                     f"80% power (`{path.relative_to(root)}`).")
+        lo, hi = int(succ["n_scenarios"].min()), int(succ["n_scenarios"].max())
+        homes = ", ".join(sorted(set(succ["homes"])))
+        lines.append(f"- `{path.stem}`: {lo if lo == hi else f'{lo}–{hi}'} scenarios per cell ({homes}); a success "
+                     f"difference of {_fmt(succ['detectable_80'].min())}–{_fmt(succ['detectable_80'].max())} is "
+                     f"detected with 80% power (`{path.relative_to(root)}`).")
     return "\n".join(lines) + "\n" if lines else "*No stored comparison yet.*\n"
 
 
