@@ -25,6 +25,7 @@ include: "egosearch/workflow/rules/fullbody.smk"
 include: "egosearch/workflow/rules/report.smk"
 include: "egosearch/workflow/rules/budget.smk"
 include: "egosearch/workflow/rules/generalise.smk"
+include: "egosearch/workflow/rules/traces.smk"
 
 
 rule all:
@@ -39,6 +40,7 @@ rule all:
         rules.fig7_oracle.output,
         rules.pictures.output,
         rules.video.output,
+        pathlength_files(),
         provenance_file(),
 
 

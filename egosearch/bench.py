@@ -1,12 +1,19 @@
 """``egosearch bench env``: sensor frames/s and env steps/s on one core; ``egosearch bench homes``: what
-building a generated home costs against a training episode, per episode and with the pool."""
+building a generated home costs against a training episode, per episode and with the pool.
+
+``--out`` stores a benchmark's result with what it was measured on (:func:`recorded`): the docs' speed
+figures are generated from such files (``results/<profile>/bench/*.json``), never typed.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
 import platform
+import subprocess
 import time
+from collections.abc import Callable
+from datetime import datetime, timezone
 
 import numpy as np
 
@@ -108,3 +115,48 @@ def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: 
             "training_episode_s": round(episode, 3), "build_share_per_episode": round(per_episode, 3),
             "build_share_pooled": round(pooled, 4), "pool_size": pool_size, "episodes_per_swap": episodes_per_swap,
             "pinned_core": core, "cpu": platform.processor() or platform.machine()}
+
+
+def _cpu_seconds_all() -> float | None:
+    """CPU time (s) every process of the machine has used since boot (/proc/stat), None off Linux."""
+    try:
+        with open("/proc/stat") as f:
+            fields = f.readline().split()[1:]
+        return (int(fields[0]) + int(fields[1]) + int(fields[2])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def _git(*args: str) -> str | None:
+    try:
+        return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+def recorded(command: str, run: Callable[[], dict]) -> dict:
+    """``run()``'s result with what it was measured on: the command, date, commit, CPU and core count,
+    and how busy the machine was. A speed figure means little without the load beside it: the load
+    average before and after, and ``other_load_cores``, the CPU time other processes used during the
+    run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
+    from egosearch.machine import cpu_model
+
+    load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
+    busy0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
+    result = run()
+    wall = time.perf_counter() - wall0
+    busy1, own = _cpu_seconds_all(), time.process_time() - own0
+    status = _git("status", "--porcelain", "--untracked-files=no")
+    return {
+        "command": command,
+        "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "commit": _git("rev-parse", "HEAD") or "unknown",
+        "commit_dirty": bool(status) if status is not None else None,
+        "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
+        "load_average_before": load_before,
+        "load_average_after": [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None,
+        "other_load_cores": (round(max(0.0, busy1 - busy0 - own) / wall, 2)
+                             if busy0 is not None and busy1 is not None and wall > 0 else None),
+        "wall_s": round(wall, 1),
+        "result": result,
+    }

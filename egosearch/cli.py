@@ -12,7 +12,10 @@ import sys
 
 
 def _cmd_scenarios(args) -> None:
+    from egosearch.outputs import check_outputs
     from egosearch.scenarios import generate_scenarios, write_scenarios
+
+    check_outputs(files={"--out": args.out})
 
     if args.n < 1:
         raise ValueError(f"--n={args.n}: a scenario set needs at least 1 scenario")
@@ -45,29 +48,36 @@ def _acting_threads(threads: int) -> None:
     torch.set_num_threads(torch_threads(threads))
 
 
-def _make_policy_factory(kind: str, weights: str | None, seed: int):
-    """(make_policy(env), the env id it acts in): a trained actor knows its own env id."""
+def _make_policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None):
+    """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
+    trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
+    here, before any episode."""
     from egosearch.policies import OraclePolicy, RandomPolicy
 
     if kind == "oracle":
-        return OraclePolicy, "EgoSearch-v0"
+        return OraclePolicy, env_id or "EgoSearch-v0"
     if kind == "random":
-        return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), "EgoSearch-v0"
+        return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), env_id or "EgoSearch-v0"
     if kind in ("frontier", "frontier_head_off"):
         from egosearch.frontier import FrontierPolicy
 
-        return FrontierPolicy, "EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0"
+        return FrontierPolicy, env_id or ("EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0")
     if kind == "actor":
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
         from egosearch.rl.train import ActorPolicy
 
         actor = ActorPolicy(weights)
-        return (lambda env: actor), actor.env_id or "EgoSearch-v0"
+        env_id = env_id or actor.trained_env_id() or "EgoSearch-v0"
+        actor.check_env(env_id)
+        return (lambda env: actor), env_id
     raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, actor")
 
 
 def _cmd_evaluate(args) -> None:
+    from egosearch.outputs import check_outputs
+
+    check_outputs(files={"--out": args.out, "--traces": args.traces})
     _acting_threads(args.threads)
     from egosearch.envs import ENV_IDS
     from egosearch.evaluate import evaluate, write_episodes
@@ -76,12 +86,20 @@ def _cmd_evaluate(args) -> None:
 
     if args.env_id and args.env_id not in ENV_IDS:
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
-    make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
+    make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id)
     scenarios = read_scenarios(args.scenarios)
-    env_id = args.env_id or env_id
+    recorder = None
+    if args.traces:
+        from egosearch.trace import TraceRecorder
+
+        if not args.traces.endswith(".npz"):
+            raise ValueError(f"--traces={args.traces!r}: a trace file must end in .npz")
+        recorder = TraceRecorder()
     rows = evaluate(env_id, make_policy, scenarios, seed=args.seed, progress=True,
-                    desc=f"evaluate {args.policy} on {env_id}")
+                    desc=f"evaluate {args.policy} on {env_id}", recorder=recorder)
     write_episodes(args.out, rows)
+    if recorder is not None:
+        print(f"wrote {recorder.write(args.traces)}: {len(recorder.columns['step'])} steps of {len(rows)} episodes")
     rate = sum(r["success"] for r in rows) / len(rows)
     value = spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
                 [r["path_length"] for r in rows])
@@ -90,10 +108,12 @@ def _cmd_evaluate(args) -> None:
 
 def _cmd_train(args) -> None:
     from egosearch.evaluate import scenario_evaluator
+    from egosearch.outputs import check_outputs
     from egosearch.rl.config import load_config
     from egosearch.rl.train import train
     from egosearch.variants import load_variant
 
+    check_outputs(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir})
     variant = load_variant(args.variant)
     overrides = {**variant.config, "seed": args.seed}
     if args.threads:
@@ -124,6 +144,9 @@ def _cmd_train(args) -> None:
 
 
 def _cmd_fullbody(args) -> None:
+    from egosearch.outputs import check_outputs
+
+    check_outputs(files={"--out": args.out})
     _acting_threads(args.threads)
     from egosearch.motion.replan import evaluate_fullbody, parse_setting, write_fullbody
     from egosearch.scenarios import read_scenarios
@@ -148,8 +171,20 @@ def _group_curves(paths: list[str]) -> dict[str, list[str]]:
     return groups
 
 
+def _report_outputs(args) -> None:
+    """Every path a report writes, checked before it reads anything."""
+    from egosearch.outputs import check_outputs
+
+    check_outputs(files={"--out": getattr(args, "out", None), "--out-csv": getattr(args, "out_csv", None),
+                         "--readme": None if args.what != "readme" or args.check else args.readme},
+                  dirs={"--out-dir": getattr(args, "out_dir", None)},
+                  prefixes={"--out-prefix": getattr(args, "out_prefix", None)})
+
+
 def _cmd_report(args) -> None:
     from egosearch.report import cli as report
+
+    _report_outputs(args)
 
     if args.what == "table1":
         report.cmd_table1(args.files, args.out_prefix, variant=args.variant, bounds=args.bounds)
@@ -180,14 +215,30 @@ def _cmd_report(args) -> None:
         trained_on = dict(item.partition("=")[::2] for item in args.trained_on)
         for path in generalise_report(args.files, args.bounds, args.out_prefix, trained_on, args.generated):
             print(f"wrote {path}")
+    elif args.what == "pathlength":
+        report.cmd_pathlength(args.files, args.scenarios, _success_radius(), args.out_prefix, out_csv=args.out_csv,
+                              bounds=args.bounds or [])
     elif args.what == "compare":
         report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
                            candidate_name="candidate")
+    elif args.what == "behaviour":
+        from egosearch.report.behaviour import behaviour_report
+
+        for path in behaviour_report(args.files, args.out_prefix, head_on=args.head_on, head_off=args.head_off):
+            print(f"wrote {path}")
+    elif args.what == "searches":
+        from egosearch.searches import searches_report
+
+        for path in searches_report(args.files, args.out_dir, seed=args.seed):
+            print(f"wrote {path}")
     elif args.what == "provenance":
         from egosearch.report.provenance import write_provenance
 
         record = write_provenance(args.profile, args.results, args.out, note=args.note or "")
-        print(f"wrote {args.out}: {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed']} s summed")
+        # The same line whether the record was rewritten or kept (no stored file changed): the
+        # workflow commits this log, and a rerun that changes nothing must leave it as it was.
+        print(f"{args.out}: sha256 of {len(record['files'])} stored files, {len(record['jobs'])} jobs, "
+              f"{record['wall_s_all_jobs_summed']} s summed")
     elif args.what == "regenerate":
         _regenerate(args.profile, args.variant)
     elif args.what == "verify":
@@ -202,15 +253,32 @@ def _cmd_report(args) -> None:
                              f"{results}/provenance.json ({ok} match)")
         print(f"{results}: all {ok} stored files match the sha256 recorded in {results}/provenance.json")
     elif args.what == "readme":
-        from egosearch.report.readme import update_readme
+        from egosearch.report.readme import pages, update_pages, update_readme
 
-        if update_readme(args.readme, args.profile, check=args.check):
-            print(f"{args.readme}: results blocks match results/{args.profile} and paper_figs/{args.profile}")
+        if args.readme:
+            checked = [args.readme]
+            stale = [] if update_readme(args.readme, args.profile, check=args.check) else checked
+        else:
+            checked, stale = pages("."), update_pages(".", args.profile, check=args.check)
+            if not checked:
+                raise ValueError("no README.md and no docs/*.md here: run it in the project's root, or give --readme")
+        names = ", ".join(str(page) for page in (stale or checked))
+        if not stale:
+            print(f"{names}: results blocks match results/{args.profile} and paper_figs/{args.profile}")
         elif args.check:
-            raise ValueError(f"{args.readme} is out of date with the stored results; "
+            raise ValueError(f"{names} out of date with the stored results; "
                              f"run `egosearch report readme --profile {args.profile}`")
         else:
-            print(f"rewrote the results blocks of {args.readme} from the {args.profile} results")
+            print(f"rewrote the results blocks of {names} from the {args.profile} results")
+
+
+def _success_radius() -> float:
+    """Distance (m) from a target's centre to the body's axis within which success is possible: success is
+    measured from the body's surface (egosearch.scenarios.SUCCESS_DISTANCE), so the body's radius adds."""
+    from egosearch.agent import AgentSpec
+    from egosearch.scenarios import SUCCESS_DISTANCE
+
+    return SUCCESS_DISTANCE + AgentSpec().body_radius
 
 
 def _regenerate(profile: str, reference: str | None) -> None:
@@ -219,6 +287,7 @@ def _regenerate(profile: str, reference: str | None) -> None:
     the files `snakemake all` would."""
     from pathlib import Path
 
+    from egosearch.outputs import check_outputs
     from egosearch.report import cli as report
     from egosearch.report.provenance import check_stored
     from egosearch.report.readme import variants_of_all, workflow_config
@@ -231,6 +300,7 @@ def _regenerate(profile: str, reference: str | None) -> None:
         raise ValueError(f"--profile={profile!r}; allowed: {', '.join(config['profiles'])}")
     reference = reference or config["reference_variant"]
     results, figs = Path("results") / profile, Path("paper_figs") / profile
+    check_outputs(dirs={"the figures folder": figs, "the path-length folder": results / "pathlength"})
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
     curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv"))
               for v in variants_of_all(config)}
@@ -255,47 +325,88 @@ def _regenerate(profile: str, reference: str | None) -> None:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:
         report.cmd_fig7(fullbody_oracle, figs / "fig7_oracle", planner="oracle")
+    # Table 1's homes only, as the DAG's pathlength rule: eval/ also holds the generalisation groups
+    homes = set(config["homes"])
+    scenarios = sorted(str(p) for home in homes for p in (results / "scenarios" / home).glob("*/h*.csv"))
+    home_bounds = [p for p in bounds if Path(p).parts[-3] in homes]
+    for variant in variants_of_all(config):
+        variant_evals = sorted(str(p) for p in (results / "eval" / variant).glob("seed*/*/*/h*.csv")
+                               if Path(p).parts[-3] in homes)
+        if variant_evals and scenarios:
+            report.cmd_pathlength(variant_evals, scenarios, _success_radius(), figs / f"pathlength_{variant}",
+                                  out_csv=results / "pathlength" / f"{variant}.csv", bounds=home_bounds)
     learner = config["profiles"][profile]["learner"]
     learner_cfg = load_config(learner)
     report.cmd_table2(table2_rows(learner_cfg), figs / "table2", departure_rows(learner_cfg))
 
 
 def _cmd_video(args) -> None:
+    from egosearch.outputs import check_outputs
+
+    check_outputs(files={"--out": args.out, "--still": args.still})
     _acting_threads(args.threads)
-    from egosearch.motion.video import write_search_video
+    from egosearch.motion.video import NotACleanSuccess, clean_successes, write_search_video
     from egosearch.scenarios import read_scenarios
 
     scenarios = {sc.scenario_id: sc for sc in read_scenarios(args.scenarios)}
-    scenario_id = args.scenario_id
+    candidates = []
     if args.first_success:
         import pandas as pd
 
-        runs = pd.read_csv(args.first_success)
-        found = sorted(runs.loc[runs["success"].astype(bool), "scenario_id"].astype(int))
-        if found:
-            scenario_id = found[0]
-        else:
-            print(f"note: no episode of {args.first_success} succeeded; filming scenario {scenario_id} instead")
-    if scenario_id not in scenarios:
-        raise ValueError(f"--scenario-id={scenario_id} is not in {args.scenarios}")
-    scenario = scenarios[scenario_id]
+        candidates = [i for i in clean_successes(pd.read_csv(args.first_success), args.min_steps) if i in scenarios]
+        if not candidates:
+            print(f"note: no episode of {args.first_success} succeeded in >= {args.min_steps} steps with no "
+                  f"penetrating pose; filming scenario {args.scenario_id} instead")
+    if not candidates and args.scenario_id not in scenarios:
+        raise ValueError(f"--scenario-id={args.scenario_id} is not in {args.scenarios}")
     make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
-    row = write_search_video(scenario.layout, args.character, make_policy, scenario, args.out,
-                             still_path=args.still, M=args.M, T=args.T, seed=args.seed, env_id=env_id)
-    print(f"{args.character}: success {row['success']} in {row['steps']} steps -> {args.out}, {args.still}")
+    row = None
+    # Seeded as `egosearch fullbody` seeds scenario k (--seed + k), the film replays the CSV's episode;
+    # should the replay differ, the film takes the next candidate rather than show a penetration.
+    for scenario_id in candidates:
+        try:
+            row = write_search_video(scenarios[scenario_id].layout, args.character, make_policy,
+                                     scenarios[scenario_id], args.out, still_path=args.still, M=args.M, T=args.T,
+                                     seed=args.seed + scenario_id, env_id=env_id, require_clean=True)
+            break
+        except NotACleanSuccess as err:
+            print(f"note: the replay differs from {args.first_success}: {err}; trying the next scenario")
+    if row is None:
+        if candidates:
+            raise ValueError(f"no episode of {args.first_success} replayed as a success with no penetrating pose")
+        scenario = scenarios[args.scenario_id]
+        row = write_search_video(scenario.layout, args.character, make_policy, scenario, args.out,
+                                 still_path=args.still, M=args.M, T=args.T, seed=args.seed + args.scenario_id,
+                                 env_id=env_id)
+    print(f"{args.character}: scenario {row['scenario_id']}, success {row['success']} in {row['steps']} steps, "
+          f"{row['penetrations']} penetrating pose(s) -> {args.out}, {args.still}")
 
 
 def _cmd_bench(args) -> None:
     from egosearch import bench
+    from egosearch.outputs import check_outputs
 
-    if args.what == "env":
-        result = bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
-    elif args.what == "homes":
-        result = bench.bench_homes()
-    else:
+    check_outputs(files={"--out": args.out})
+
+    def run() -> dict:
+        if args.what == "env":
+            return bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
+        if args.what == "homes":
+            return bench.bench_homes()
         from egosearch.rl.bench import bench_learner
 
-        result = bench_learner()
+        return bench_learner()
+
+    options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
+    record = bench.recorded(f"egosearch bench {args.what}{options}", run)
+    result = record["result"]
+    if args.out:
+        from pathlib import Path
+
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+        print(f"wrote {args.out} (other processes used {record['other_load_cores']} cores meanwhile)",
+              file=sys.stderr)
     if args.json:
         print(json.dumps(result))
     else:
@@ -304,7 +415,10 @@ def _cmd_bench(args) -> None:
 
 
 def _cmd_pictures(args) -> None:
+    from egosearch.outputs import check_outputs
     from egosearch.pictures import make_pictures
+
+    check_outputs(dirs={"--out-dir": args.out_dir})
 
     for path in make_pictures(args.layout, args.out_dir, seed=args.seed):
         print(path)
@@ -314,6 +428,10 @@ def _cmd_variant(args) -> None:
     from egosearch.variants import check_learner_config, load_variant, new_variant
 
     if args.what == "new":
+        from egosearch.outputs import check_outputs
+        from egosearch.variants import ABLATIONS_DIR
+
+        check_outputs(dirs={"the variants folder": ABLATIONS_DIR})
         path = new_variant(args.name, template=args.template)
         print(f"wrote {path}: edit it, then `snakemake --cores 2 compare --config variant={args.name}`")
         return
@@ -361,10 +479,22 @@ def _report_parsers(sub) -> None:
     r.add_argument("--chosen", help="the setting the profile uses (drawn filled)")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
 
-    r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell")
+    r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell "
+                                           "and per shortest-path bin")
     r.add_argument("--reference", nargs="+", required=True, help="the reference variant's evaluation CSVs")
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
-    r.add_argument("--out", help="write the comparison to this CSV as well as printing it")
+    r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
+                                 "pooled, to <out stem>_by_length.csv) as well as printing them")
+
+    r = reports.add_parser("pathlength", help="success by shortest path ℓ and by detour, with two-level intervals")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{home}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--scenarios", nargs="+", required=True, help="the scenario sets they ran: .../scenarios/{home}/"
+                                                                 "{placement}/h{height}.csv")
+    r.add_argument("--bounds", nargs="*", help="the reference searchers' evaluation CSVs on the same scenarios "
+                                               "(.../eval/{random,frontier,oracle}/...): a line each")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .png and .pdf"))
+    r.add_argument("--out-csv", help="the numbers (default: <out-prefix>.csv)")
 
     r = reports.add_parser("generalise", help="trained-on x evaluated-on: normalised scores per group of homes")
     r.add_argument("files", nargs="+", help="evaluation CSVs of the policies: .../{variant}/seed{seed}/{group}/"
@@ -375,6 +505,21 @@ def _report_parsers(sub) -> None:
     r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
                    help="what each variant trained in, for the labels")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))
+
+    traces = "trace files of `egosearch evaluate --traces`: .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
+    r = reports.add_parser("behaviour", help="how the policies search, from per-step traces, and the paper's "
+                                             "behaviour sentences (Section 6.3, Figure 6) read against them")
+    r.add_argument("files", nargs="+", help=traces)
+    r.add_argument("--head-on", default="head_on", help="the variant that moves its head (default: head_on)")
+    r.add_argument("--head-off", default="head_off", help="the variant without head movement (default: head_off)")
+    r.add_argument("--out-prefix", required=True,
+                   help=prefix.format("_episodes.csv, .csv, .md, _claims.csv and _claims.md"))
+
+    r = reports.add_parser("searches", help="top-down pictures of chosen searches and a gaze heatmap per cell, "
+                                            "from per-step traces")
+    r.add_argument("files", nargs="+", help=traces)
+    r.add_argument("--seed", type=int, default=0, help="the seed whose files give the pictured searches (default 0)")
+    r.add_argument("--out-dir", required=True, help="folder of the PNGs")
 
     r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
     r.add_argument("--profile", **profile)
@@ -389,10 +534,11 @@ def _report_parsers(sub) -> None:
     r = reports.add_parser("verify", help="check every stored result file against the sha256 in its provenance")
     r.add_argument("--profile", **profile)
 
-    r = reports.add_parser("readme", help="rewrite the README's results blocks from the stored results")
+    r = reports.add_parser("readme", help="rewrite the generated blocks of the README and the docs pages from the "
+                                          "stored results")
     r.add_argument("--profile", **profile)
-    r.add_argument("--readme", default="README.md", help="the file whose marked blocks are rewritten (default: "
-                                                         "README.md)")
+    r.add_argument("--readme", help="the one page whose marked blocks are rewritten (default: README.md and every "
+                                    "docs/*.md page of the current folder)")
     r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")
     p.set_defaults(func=_cmd_report)
 
@@ -433,6 +579,9 @@ def build_parser() -> argparse.ArgumentParser:
                                     "EgoSearchNoHead-v0 for frontier_head_off")
     p.add_argument("--seed", type=int, default=0, help=policy_seed)
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
+    p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
+                                                        "what the camera's centre looks at, distances) to this "
+                                                        "compressed file (egosearch.trace)")
     p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_evaluate)
 
@@ -481,6 +630,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
     p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
+                                 "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")
     p.set_defaults(func=_cmd_bench)
 
     p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
@@ -488,13 +639,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--scenario-id", type=int, default=0, help="the scenario_id of the row to search (default 0)")
     p.add_argument("--first-success", metavar="FULLBODY_CSV",
-                   help="film the first scenario that succeeded in this full-body CSV of the same settings "
-                        "(instead of --scenario-id)")
+                   help="film the first scenario (by scenario_id) that succeeded in this full-body CSV of the same "
+                        "settings with no penetrating pose, in at least --min-steps steps (instead of --scenario-id, "
+                        "which is filmed when none did)")
+    p.add_argument("--min-steps", type=int, default=0,
+                   help="--first-success: the fewest steps of a filmed episode (default 0)")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
     p.add_argument("--weights", help="actor.pt of the search policy")
     p.add_argument("--M", type=int, default=5, help="steps executed per plan")
     p.add_argument("--T", type=int, default=20, help="planning horizon")
-    p.add_argument("--seed", type=int, default=0, help=policy_seed)
+    p.add_argument("--seed", type=int, default=0,
+                   help="scenario k's episode is seeded with this + k, as `egosearch fullbody` seeds it (default 0)")
     p.add_argument("--out", required=True, help=".mp4 or .gif")
     p.add_argument("--still", required=True, help=".png of the moment the target is found")
     p.add_argument("--threads", type=int, default=1, help=threads)

@@ -13,8 +13,13 @@ def write_csv_atomic(path: str | os.PathLike, columns: Sequence[str], rows: Iter
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(columns))
-        writer.writeheader()
-        writer.writerows(rows)
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(columns))
+            writer.writeheader()
+            writer.writerows(rows)
+        os.replace(tmp, path)
+    except BaseException:
+        # a failed write (the path is a folder, the disk is full) must not leave the .tmp behind
+        tmp.unlink(missing_ok=True)
+        raise

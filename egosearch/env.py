@@ -34,7 +34,7 @@ Two ways to start an episode:
 - training (no scenario given): a random target on the placement scheme's surfaces, a random
   collision-free start, camera height U[1.0, 1.8] m per episode plus U[-0.1, 0.1] m per step;
   ``reset(options={"start_radius": r})`` draws the start within r m of the target (a training
-  curriculum: ``SacCurlConfig.curriculum_steps``);
+  curriculum: ``LearnerConfig.curriculum_steps``);
 - evaluation: ``reset(options={"scenario": s})`` with an :class:`egosearch.scenarios.Scenario`,
   at its fixed height without noise.
 """
@@ -81,6 +81,14 @@ FLOOR_MAP_DIM = 3 * FLOOR_MAP_CELLS * FLOOR_MAP_CELLS
 """Values the ``floor_map`` option appends to ``mask``."""
 MEMORY_HORIZON = 100
 """Steps since the target was last seen are divided by this (and capped at 1)."""
+PROPRIO_DIM = 4
+
+
+def space_dims(head: bool = True, target_memory: bool = False, floor_map: bool = False) -> dict[str, int]:
+    """Sizes of the action and of the observation's vectors for these options, without building an env:
+    what a trained actor must match (``SearchEnv`` builds its spaces from them)."""
+    mask = MASK_FEATURE_DIM + (TARGET_MEMORY_DIM if target_memory else 0) + (FLOOR_MAP_DIM if floor_map else 0)
+    return {"action": replace(AgentSpec(), head=bool(head)).action_dim, "mask": mask, "proprio": PROPRIO_DIM}
 
 
 DISTANCE_REWARDS = ("distance", "progress")
@@ -188,12 +196,11 @@ class SearchEnv(gymnasium.Env):
         self._rays = pixel_rays_camera(IMAGE_SIZE, IMAGE_SIZE, self.sensor.fov_deg) if self.target_memory else None
         # a coarse map is enough for a 0.6 m summary, and keeps the env step cheap (~1 ms)
         self._floor = FloorMap.for_sensor(self.sensor, pixel_stride=6, free_step=0.15) if floor_map else None
-        mask_dim = (MASK_FEATURE_DIM + (TARGET_MEMORY_DIM if self.target_memory else 0)
-                    + (FLOOR_MAP_DIM if floor_map else 0))
+        dims = space_dims(head, self.target_memory, floor_map)
         observation_spaces = {
             "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
-            "mask": spaces.Box(-4.0, 4.0, (mask_dim,), np.float32),
-            "proprio": spaces.Box(-4.0, 4.0, (4,), np.float32),
+            "mask": spaces.Box(-4.0, 4.0, (dims["mask"],), np.float32),
+            "proprio": spaces.Box(-4.0, 4.0, (dims["proprio"],), np.float32),
         }
         if self.with_state:
             observation_spaces["state"] = spaces.Box(-np.inf, np.inf, (PRIVILEGED_STATE_DIM,), np.float32)

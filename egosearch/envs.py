@@ -18,3 +18,10 @@ for _env_id, _kwargs in ENV_IDS.items():
     if _env_id not in registry:
         # SearchEnv enforces T_max itself (truncated=True at step 100), so no TimeLimit wrapper.
         register(id=_env_id, entry_point="egosearch.env:SearchEnv", kwargs=dict(_kwargs))
+
+
+def env_space_dims(env_id: str) -> dict[str, int]:
+    """``{"action", "mask", "proprio"}`` sizes of a registered id, without building its env."""
+    from egosearch.env import space_dims
+
+    return space_dims(**ENV_IDS[env_id])

@@ -21,14 +21,20 @@ def make_env(env_id: str, scenario: Scenario, **kwargs) -> gymnasium.Env:
                           height=scenario.height, **kwargs)
 
 
-def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0) -> dict:
-    """One deterministic episode of ``policy`` on ``scenario``."""
+def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0, recorder=None) -> dict:
+    """One deterministic episode of ``policy`` on ``scenario``; ``recorder`` (an
+    :class:`egosearch.trace.TraceRecorder`) is shown the state after the reset and after every step."""
     obs, info = env.reset(seed=seed, options={"scenario": scenario})
     policy.reset(seed=seed)
+    if recorder is not None:
+        recorder.start(env, scenario, info)
     total = 0.0
     done = False
     while not done:
-        obs, reward, terminated, truncated, info = env.step(policy.act(obs))
+        action = policy.act(obs)
+        obs, reward, terminated, truncated, info = env.step(action)
+        if recorder is not None:
+            recorder.step(env, action, info)
         total += float(reward)
         done = terminated or truncated
     success = bool(info["success"])
@@ -45,9 +51,9 @@ def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0) -
 
 
 def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
-             progress: bool = False, desc: str = "evaluate") -> list[dict]:
+             progress: bool = False, desc: str = "evaluate", recorder=None) -> list[dict]:
     """Run ``make_policy(env)`` on every scenario; the env is rebuilt only when the home or
-    height changes."""
+    height changes. ``recorder``: see :func:`run_episode`."""
     rows, env, env_key, policy = [], None, None, None
     iterator = scenarios
     if progress:
@@ -62,7 +68,7 @@ def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
                     env.close()
                 env, env_key = make_env(env_id, sc), key
                 policy = make_policy(env)
-            rows.append(run_episode(env, policy, sc, seed=seed + sc.scenario_id))
+            rows.append(run_episode(env, policy, sc, seed=seed + sc.scenario_id, recorder=recorder))
     finally:
         if env is not None:
             env.close()
@@ -74,7 +80,7 @@ def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
 
 
 def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = 7):
-    """``evaluate(policy) -> {success_rate, spl, episode_return}`` on ``n`` fixed held-out
+    """``evaluate(policy) -> {success_rate, spl, episode_return, episodes}`` on ``n`` fixed held-out
     scenarios of ``layout`` (a home, or a list of homes taken in turn), the three evaluation heights
     in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
     ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
@@ -97,7 +103,10 @@ def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: 
             if key not in envs:
                 envs[key] = make_env(env_id, sc)
             rows.append(run_episode(envs[key], policy, sc, seed=seed + sc.scenario_id))
-        return {"success_rate": sum(r["success"] for r in rows) / len(rows),
+        episodes = [{"home": sc.layout, "height": sc.height, "scenario_id": sc.scenario_id, "success": r["success"],
+                     "shortest_path": r["shortest_path"], "path_length": r["path_length"]}
+                    for sc, r in zip(scenarios, rows, strict=True)]
+        return {"episodes": episodes, "success_rate": sum(r["success"] for r in rows) / len(rows),
                 "spl": spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
                            [r["path_length"] for r in rows]),
                 "episode_return": sum(r["episode_return"] for r in rows) / len(rows)}

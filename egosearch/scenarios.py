@@ -102,6 +102,7 @@ def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
             raise ScenarioFileError(f"{path}: missing columns {', '.join(missing)}; "
                                     f"expected {', '.join(COLUMNS)}")
         out = []
+        first_line: dict[int, int] = {}
         for line, row in enumerate(reader, start=2):
             values = {}
             for name in COLUMNS:
@@ -115,16 +116,38 @@ def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
                     raise ScenarioFileError(f"{path}:{line}: {name}={raw!r} is not finite")
                 values[name] = value
             try:
-                layouts_mod.get_scene(values["layout"])
+                scene = layouts_mod.get_scene(values["layout"])
                 check_placement(values["placement"])
                 check_height(values["height"])
                 get_object(values["target_object"])
+                _check_in_home(values, scene)
             except ValueError as err:
                 raise ScenarioFileError(f"{path}:{line}: {err}") from None
+            # ℓ < 0 would give a failure SPL 0 and a success SPL 1 whatever the path; ℓ = 0 is a start
+            # that may already see the target
+            if values["shortest_path"] < 0:
+                raise ScenarioFileError(f"{path}:{line}: shortest_path={values['shortest_path']!r} is negative; "
+                                        "it is the length (m) of the shortest route to a success, >= 0")
+            if values["scenario_id"] in first_line:
+                raise ScenarioFileError(f"{path}:{line}: scenario_id={values['scenario_id']} repeats the id of line "
+                                        f"{first_line[values['scenario_id']]}; every scenario of a file needs its "
+                                        "own id (episodes are seeded and joined by it)")
+            first_line[values["scenario_id"]] = line
             out.append(Scenario(**values))
     if not out:
         raise ScenarioFileError(f"{path}: holds no scenarios")
     return out
+
+
+def _check_in_home(values: dict, scene: Scene) -> None:
+    """The start and the target lie within the home's bounds: outside, an episode would still run
+    and score a failure, or ℓ and the path length would mean nothing."""
+    x0, y0, x1, y1 = scene.bounds
+    for what in ("start", "target"):
+        x, y = values[f"{what}_x"], values[f"{what}_y"]
+        if not (x0 <= x <= x1 and y0 <= y <= y1):
+            raise ValueError(f"{what} ({x:g}, {y:g}) is outside the home {values['layout']}, whose floor spans "
+                             f"x in [{x0:g}, {x1:g}], y in [{y0:g}, {y1:g}] m")
 
 
 # -- generation ----------------------------------------------------------------------------

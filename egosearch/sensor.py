@@ -29,10 +29,13 @@ Camera convention (every other module relies on it)
 
 Backends (all give the same picture up to float rounding on triangle edges)
 ---------------------------------------------------------------------------
-- ``"raster"`` (default when a C compiler is available): a small z-buffer rasteriser written in
-  C (:data:`_RASTER_C`), compiled once per machine/CPU with the system compiler (``$CC``, cc,
-  gcc or clang; ``-O3 -march=native``) into ``$EGOSEARCH_CACHE_DIR`` or ``~/.cache/egosearch``
-  and loaded with ctypes (no Python headers, no extra packages). It
+- ``"raster"`` (the default): a small z-buffer rasteriser written in C (``raster.c``), built at
+  ``pip install`` into the package (``setup.py``, ``-O3 -march=native``; ``EGOSEARCH_NATIVE_BUILD=0``
+  builds it for any CPU) and loaded with ctypes (no Python headers, no extra packages). When the
+  install could not build it (no compiler there), or built it for another CPU or an older
+  ``raster.c``, it is compiled on first use with ``$CC``, cc, gcc or clang into
+  ``$EGOSEARCH_CACHE_DIR`` or ``~/.cache/egosearch`` if a compiler is found; else the sensor warns
+  once and uses Embree. It
   culls whole parts against the view frustum (bounding spheres), clips triangles against a near
   plane, and samples exactly the pixel centres (inclusive edge test, perspective-correct 1/z),
   so it is a drop-in for ray casting at a fraction of the cost.
@@ -60,9 +63,9 @@ import ctypes
 import functools
 import glob
 import hashlib
+import importlib.machinery
 import math
 import os
-import platform
 import shutil
 import subprocess
 import tempfile
@@ -72,6 +75,7 @@ from pathlib import Path
 
 import numpy as np
 
+from egosearch import rasterbuild
 from egosearch.scene.meshes import part_mesh, scene_meshes
 from egosearch.scene.parts import Part, Scene
 
@@ -252,8 +256,8 @@ class _Geometry:
 # Backend 1: the C rasteriser
 # ----------------------------------------------------------------------------------------------
 
-#: The rasteriser's C source, shipped beside this module and compiled on first use.
-_RASTER_C = (Path(__file__).with_name("raster.c")).read_text()
+#: The rasteriser's C source, shipped beside this module: built at install, or compiled on first use.
+_RASTER_C = rasterbuild.SOURCE.read_text()
 
 
 def _cache_dir() -> str:
@@ -271,21 +275,6 @@ def _cache_dir() -> str:
     raise OSError("no writable cache directory for the compiled rasteriser")
 
 
-def _cpu_signature() -> str:
-    """What the compiled code may assume about this CPU (part of the cache key)."""
-    text = platform.machine() + platform.processor()
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith(("flags", "Features", "model name")):
-                    text += line
-                    if line.startswith(("flags", "Features")):
-                        break
-    except OSError:
-        pass
-    return text
-
-
 def _find_compiler() -> str | None:
     for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
         if name and shutil.which(name):
@@ -293,36 +282,77 @@ def _find_compiler() -> str | None:
     return None
 
 
+def _installed_library() -> Path | None:
+    """The library ``pip install`` built beside this module (``setup.py``), if it did."""
+    here = Path(__file__).resolve().parent
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = here / f"{rasterbuild.LIBRARY}{suffix}"
+        if path.is_file():
+            return path
+    return None
+
+
+def _build_of(lib) -> str:
+    """What ``lib`` was built from and for (see :mod:`egosearch.rasterbuild`)."""
+    try:
+        fn = lib.egosearch_raster_build
+    except AttributeError:
+        return "unknown"
+    fn.argtypes, fn.restype = [], ctypes.c_char_p
+    return fn().decode()
+
+
+def _compile_into_cache() -> str:
+    """Compile the rasteriser (once per machine, CPU and source, cached on disk) and return its
+    path: the route when the install built none that fits. Raises without a C compiler."""
+    flag_sets = rasterbuild.flag_sets(native=True)
+    key = hashlib.sha1((_RASTER_C + repr(flag_sets) + rasterbuild.cpu_signature()).encode()).hexdigest()[:16]
+    path = os.path.join(_cache_dir(), f"egosearch_raster_{key}.so")
+    if os.path.exists(path):
+        return path
+    compiler = _find_compiler()
+    if compiler is None:
+        raise RuntimeError("no C compiler (cc/gcc/clang) found to build it on first use")
+    with tempfile.TemporaryDirectory() as tmp:
+        src = os.path.join(tmp, "raster.c")
+        with open(src, "w") as fh:
+            fh.write(_RASTER_C)
+        tmp_out = f"{path}.{os.getpid()}.tmp"
+        errors = ""
+        for flags in flag_sets:  # -march=native first (the file name carries the CPU signature), then portable
+            proc = subprocess.run([compiler, "-fPIC", "-shared", *flags, "-o", tmp_out, src, "-lm"],
+                                  capture_output=True, text=True, timeout=120)
+            if proc.returncode == 0:
+                break
+            errors += proc.stderr
+        else:
+            raise RuntimeError(f"compiling it on first use failed: {errors.strip()[:2000]}")
+        os.replace(tmp_out, path)  # atomic: parallel workers never load half a file
+    return path
+
+
 @functools.lru_cache(maxsize=1)
 def _load_raster_library():
-    """Compile (once per machine and CPU, cached on disk) and load the C rasteriser.
+    """The C rasteriser: the library built at install when it fits this CPU and source, else one
+    compiled on first use into a writable cache. Raises (saying why, for the sensor's one warning)
+    when neither can be had; the sensor then falls back to Embree."""
+    problems = []
+    installed = _installed_library()
+    if installed is None:
+        problems.append("not built at install")
+    else:
+        lib = ctypes.CDLL(str(installed))
+        why_not = rasterbuild.usable_here(_build_of(lib))
+        if why_not is None:
+            return _bind_render_frame(lib)
+        problems.append(f"{installed.name} not used: {why_not}")
+    try:
+        return _bind_render_frame(ctypes.CDLL(_compile_into_cache()))
+    except (OSError, RuntimeError, subprocess.SubprocessError) as err:
+        raise RuntimeError("; ".join([*problems, str(err)])) from None
 
-    Raises when no C compiler is available; the sensor then falls back to Embree.
-    """
-    base_flags = ["-O3", "-fPIC", "-shared", "-fno-math-errno"]
-    key = hashlib.sha1((_RASTER_C + " ".join(base_flags) + _cpu_signature()).encode()).hexdigest()[:16]
-    path = os.path.join(_cache_dir(), f"egosearch_raster_{key}.so")
-    if not os.path.exists(path):
-        compiler = _find_compiler()
-        if compiler is None:
-            raise RuntimeError("no C compiler (cc/gcc/clang) found to build the rasteriser")
-        with tempfile.TemporaryDirectory() as tmp:
-            src = os.path.join(tmp, "raster.c")
-            with open(src, "w") as fh:
-                fh.write(_RASTER_C)
-            tmp_out = f"{path}.{os.getpid()}.tmp"
-            errors = ""
-            # -march=native first (the file name carries the CPU signature), then portable.
-            for extra in (["-march=native"], []):
-                proc = subprocess.run([compiler, *base_flags, *extra, "-o", tmp_out, src, "-lm"],
-                                      capture_output=True, text=True, timeout=120)
-                if proc.returncode == 0:
-                    break
-                errors += proc.stderr
-            else:
-                raise RuntimeError(f"compiling the rasteriser failed: {errors.strip()[:2000]}")
-            os.replace(tmp_out, path)  # atomic: parallel workers never load half a file
-    lib = ctypes.CDLL(path)
+
+def _bind_render_frame(lib):
     fn = lib.render_frame
     vp, ci = ctypes.c_void_p, ctypes.c_int
     fn.argtypes = [vp, vp, vp, vp, ci, vp, vp, vp, vp, vp, ci, vp, vp, vp, vp, vp, ci, ci]

@@ -67,7 +67,7 @@ def _shown(path: Path) -> Path:
 def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> Variant:
     """The variant named ``name`` (``ablations/<name>.yaml``) or stored at a path.
 
-    Its ``config`` is checked against ``SacCurlConfig`` here (names and types): a typo fails on
+    Its ``config`` is checked against ``LearnerConfig`` here (names and types): a typo fails on
     reading, wherever a variant is read, not when a training job builds its config."""
     import jsonschema
 
@@ -107,17 +107,17 @@ def check_learner_config(variant: Variant, learner_profile: str) -> None:
 
 
 def _learner_overrides(config: dict, path: Path) -> dict:
-    """``config`` checked field by field against ``SacCurlConfig``. PyYAML reads ``1e-4`` (no dot)
+    """``config`` checked field by field against ``LearnerConfig``. PyYAML reads ``1e-4`` (no dot)
     as a string, so a float field also takes a string that reads as a finite number."""
-    from egosearch.rl.config import SacCurlConfig
+    from egosearch.rl.config import LearnerConfig
 
-    kinds = {f.name: f.type for f in fields(SacCurlConfig)}
+    kinds = {f.name: f.type for f in fields(LearnerConfig)}
     out = {}
     for key, value in config.items():
         if key not in kinds:
             close = difflib.get_close_matches(str(key), kinds, n=1)
             hint = f" (did you mean {close[0]}?)" if close else ""
-            raise VariantError(f"{path}: config: {key!r} is not a SacCurlConfig field{hint}")
+            raise VariantError(f"{path}: config: {key!r} is not a LearnerConfig field{hint}")
         kind = kinds[key]
         if kind == "float" and isinstance(value, str):
             try:
@@ -173,7 +173,7 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
             "env_id": base.env_id, "train_env": base.train_env, "config": base.config}
     path.write_text(
         f"# A variant of {template}: edit what differs. env_id: EgoSearch-v0 (head on) or EgoSearchNoHead-v0;\n"
-        "# train_env: the training home and placement scheme; config: SacCurlConfig fields\n"
+        "# train_env: the training home and placement scheme; config: LearnerConfig fields\n"
         "# (egosearch/rl/config.py) overridden on top of the profile.\n"
         + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
     load_variant(path)

@@ -81,6 +81,9 @@ def workflow_variants(config: dict, compare: bool = False, directory: Path = ABL
                                + generalise["variants"]))
     if compare and not config.get("variant"):
         raise VariantError("compare needs a variant: snakemake --cores 2 compare --config variant=NAME")
+    if compare and config["variant"] == config["reference_variant"]:
+        raise VariantError(f"variant={config['variant']!r} is the reference variant itself: compare needs another "
+                           "variant (or another reference_variant)")
     if config.get("variant"):
         names = list(dict.fromkeys(names + [config["variant"]]))
     learner = config["profiles"][config["profile"]]["learner"]

@@ -26,17 +26,21 @@ NOTICES = ("Using workflow specific profile profiles/default for setting default
 # a traceback.
 BAD_VARIANT_FILES = [
     ("lr_typo", HEAD + "config: {critic_lrr: 0.0005}\n",
-     "ablations/lr_typo.yaml: config: 'critic_lrr' is not a SacCurlConfig field (did you mean critic_lr?)"),
+     "ablations/lr_typo.yaml: config: 'critic_lrr' is not a LearnerConfig field (did you mean critic_lr?)"),
     ("lr_word", HEAD + "config: {critic_lr: fast}\n",
      "ablations/lr_word.yaml: config: critic_lr='fast' is not a float"),
     ("lr_negative", HEAD + "config: {critic_lr: -1.0}\n",
-     "ablations/lr_negative.yaml: config (on the cpu learner profile): SacCurlConfig.critic_lr=-1.0 is out of "
+     "ablations/lr_negative.yaml: config (on the cpu learner profile): LearnerConfig.critic_lr=-1.0 is out of "
      "range; allowed: > 0"),
     ("too_short", HEAD + "config: {train_height_min: 0.1}\n",
-     "ablations/too_short.yaml: config (on the cpu learner profile): SacCurlConfig.train_height_min=0.1 is out "
+     "ablations/too_short.yaml: config (on the cpu learner profile): LearnerConfig.train_height_min=0.1 is out "
      "of range; allowed: [0.3, 1.8] m (training heights are drawn from [this, 1.8] m)"),
     ("steps_float", HEAD + "config: {total_env_steps: 2.5e4}\n",
      "ablations/steps_float.yaml: config: total_env_steps='2.5e4' is not an int"),
+    ("steps_below_warmup", HEAD + "config: {total_env_steps: 500}\n",
+     "ablations/steps_below_warmup.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=500 is "
+     "out of range; allowed: >= 4000, the env step of the first update (after init_steps=4000 random steps, an "
+     "update every 4 steps): fewer train no update"),
     ("flag_word", HEAD + "config: {encoder_tanh: maybe}\n",
      "ablations/flag_word.yaml: config: encoder_tanh='maybe' is not a bool"),
     ("config_list", HEAD + "config: [1, 2]\n",
@@ -274,3 +278,163 @@ def test_report_subcommands_print_their_own_help(capsys):
         main(["report", "regenerate", "--help"])
     out = capsys.readouterr().out
     assert out.startswith("usage: egosearch report regenerate") and "--planner" not in out and "--variant" in out
+
+
+# --------------------------------------------------------------------------- output paths, before any work
+@pytest.fixture
+def no_work(monkeypatch):
+    """Episodes, training and scenario generation fail the test: a bad output path must be refused first."""
+    import egosearch.evaluate
+    import egosearch.rl.train
+    import egosearch.scenarios
+
+    def work(*args, **kwargs):
+        raise AssertionError("work started before the output paths were checked")
+
+    for module, name in ((egosearch.evaluate, "evaluate"), (egosearch.rl.train, "train"),
+                         (egosearch.scenarios, "generate_scenarios")):
+        monkeypatch.setattr(module, name, work)
+
+
+def test_output_paths_are_checked_before_any_work(tmp_path, capsys, monkeypatch, no_work):
+    monkeypatch.chdir(REPO)
+    folder, file = tmp_path / "a_folder", tmp_path / "a_file"
+    folder.mkdir()
+    file.write_text("x")
+    under_file = f"{file}/sub/out.csv"
+    is_folder = "is a folder; a file path is expected here"
+    no_folder = f"{file} is a file, so no folder can be created under it"
+    # The scenario file does not exist either: the output path is refused before it is read.
+    evaluate = ["evaluate", "--scenarios", "missing.csv", "--policy", "oracle"]
+    cases = [
+        ([*evaluate, "--out", str(folder)], f"egosearch evaluate: error: --out={folder} {is_folder}"),
+        ([*evaluate, "--out", under_file], f"egosearch evaluate: error: --out={under_file}: {no_folder}"),
+        ([*evaluate, "--out", str(tmp_path / "o.csv"), "--traces", str(folder)],
+         f"egosearch evaluate: error: --traces={folder} {is_folder}"),
+        (["train", "--variant", "head_on", "--out-dir", str(file)],
+         f"egosearch train: error: --out-dir={file} is a file; a folder is expected here"),
+        (["train", "--variant", "head_on", "--out-dir", str(tmp_path / "run"), "--work-dir", f"{file}/partial"],
+         f"egosearch train: error: --work-dir={file}/partial: {no_folder}"),
+        (["scenarios", "--out", str(folder)], f"egosearch scenarios: error: --out={folder} {is_folder}"),
+        (["fullbody", "--setting", "ours-M5-fetch", "--scenarios", "missing.csv", "--policy", "oracle", "--out",
+          under_file], f"egosearch fullbody: error: --out={under_file}: {no_folder}"),
+        (["video", "--scenarios", "missing.csv", "--policy", "oracle", "--out", str(tmp_path / "v.mp4"), "--still",
+          str(folder)], f"egosearch video: error: --still={folder} {is_folder}"),
+        (["report", "table1", "missing.csv", "--out-prefix", f"{file}/table1"],
+         f"egosearch report: error: --out-prefix={file}/table1: {no_folder}"),
+        (["report", "compare", "--reference", "a.csv", "--candidate", "b.csv", "--out", str(folder)],
+         f"egosearch report: error: --out={folder} {is_folder}"),
+        (["report", "provenance", "--results", str(tmp_path), "--out", str(folder)],
+         f"egosearch report: error: --out={folder} {is_folder}"),
+        (["report", "searches", "missing.npz", "--out-dir", str(file)],
+         f"egosearch report: error: --out-dir={file} is a file; a folder is expected here"),
+        (["pictures", "--out-dir", str(file)], f"egosearch pictures: error: --out-dir={file} is a file; a folder is "
+                                               "expected here"),
+    ]
+    for argv, message in cases:
+        assert cli_error(capsys, *argv) == message, argv
+    # nothing written: no half file, no .tmp, no probe, no folder made for a refused run
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "a_folder"] and not list(folder.iterdir())
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs /proc (a location nobody may write in)")
+def test_an_output_where_nothing_can_be_written_is_one_line(capsys, no_work):
+    # /proc refuses new files even to root, for whom a chmod-ed folder is writable
+    assert cli_error(capsys, "evaluate", "--scenarios", "missing.csv", "--policy", "oracle", "--out",
+                     "/proc/egosearch/out.csv").startswith(
+        "egosearch evaluate: error: --out=/proc/egosearch/out.csv: cannot write in /proc (")
+
+
+def test_a_failed_csv_write_leaves_no_tmp(tmp_path):
+    from egosearch.csvio import write_csv_atomic
+
+    (tmp_path / "out.csv").mkdir()
+    with pytest.raises(IsADirectoryError):
+        write_csv_atomic(tmp_path / "out.csv", ["a"], [{"a": 1}])
+    assert [p.name for p in tmp_path.iterdir()] == ["out.csv"]
+
+
+# --------------------------------------------------------------------------- nonsense that used to be scored
+def test_nonsense_scenarios_are_one_line_before_any_episode(tmp_path, capsys, no_work):
+    from dataclasses import replace
+
+    from egosearch.scenarios import read_scenarios, write_scenarios
+
+    stored = read_scenarios(REPO / "results/cpu/scenarios/kitchen_living/everywhere/h1.05.csv")[:3]
+    spoiled = {
+        "far_start": [replace(stored[0], start_x=stored[0].start_x + 500), *stored[1:]],
+        "negative_path": [stored[0], replace(stored[1], shortest_path=-2.0), stored[2]],
+        "duplicate_ids": [stored[0], stored[1], replace(stored[2], scenario_id=stored[0].scenario_id)],
+    }
+    expected = {
+        "far_start": f":2: start ({stored[0].start_x + 500:g}, {stored[0].start_y:g}) is outside the home "
+                     "kitchen_living, whose floor spans x in [0, 11], y in [0, 8] m",
+        "negative_path": ":3: shortest_path=-2.0 is negative; it is the length (m) of the shortest route to a "
+                         "success, >= 0",
+        "duplicate_ids": f":4: scenario_id={stored[0].scenario_id} repeats the id of line 2; every scenario of a "
+                         "file needs its own id (episodes are seeded and joined by it)",
+    }
+    for name, scenarios in spoiled.items():
+        path = tmp_path / f"{name}.csv"
+        write_scenarios(path, scenarios)
+        line = cli_error(capsys, "evaluate", "--scenarios", str(path), "--policy", "oracle", "--out",
+                         str(tmp_path / "o.csv"))
+        assert line == f"egosearch evaluate: error: {path}{expected[name]}", name
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_variant_compared_with_itself_is_one_line(tmp_path, capsys, suite, monkeypatch):
+    files = [str(tmp_path / "eval/head_on/seed0/kitchen_living/everywhere" / f"h{h}.csv") for h in ("0.45", "1.05")]
+    assert cli_error(capsys, "report", "compare", "--reference", *files, "--candidate", *files, "--out",
+                     str(tmp_path / "c.csv")) == (
+        f"egosearch report: error: {files[0]} is both a reference and a candidate file (1 more file(s) too): "
+        "compare two different variants (is the candidate the reference itself?)")
+    assert not (tmp_path / "c.csv").exists()
+    # and the workflow's `compare` target, before its DAG
+    monkeypatch.chdir(suite)
+    with pytest.raises(SystemExit):
+        checked_variants(config(variant="head_on"), argv=["compare"], directory=suite / "ablations")
+    assert capsys.readouterr().err == ("egosearch: error: variant='head_on' is the reference variant itself: compare "
+                                       "needs another variant (or another reference_variant)\n")
+
+
+def _actor_file(path: Path, action_dim: int, metadata: dict) -> Path:
+    from egosearch.rl.config import load_config
+    from egosearch.rl.train import make_agent
+
+    agent = make_agent(load_config("smoke", {"device": "cpu"}), action_dim, 30, 4, torch.device("cpu"))
+    torch.save(agent.actor_state(metadata), path)
+    return path
+
+
+def test_an_actor_in_the_wrong_env_is_one_line_naming_its_env(tmp_path, capsys, no_work):
+    """A head_off actor (3 action values) in EgoSearch-v0 (5) failed only in the first step, with numpy's
+    broadcasting error; its file records the env id, or the sizes tell it."""
+    from egosearch.rl.train import ActorPolicy
+
+    recorded = _actor_file(tmp_path / "recorded.pt", 3, {"variant": "head_off", "env_id": "EgoSearchNoHead-v0"})
+    unrecorded = _actor_file(tmp_path / "unrecorded.pt", 3, {})
+    assert ActorPolicy(unrecorded).trained_env_id() == "EgoSearchNoHead-v0"
+    for path in (recorded, unrecorded):
+        line = cli_error(capsys, "evaluate", "--scenarios", "missing.csv", "--weights", str(path), "--env-id",
+                         "EgoSearch-v0", "--out", str(tmp_path / "o.csv"))
+        assert line == (f"egosearch evaluate: error: {path}: this actor was trained in EgoSearchNoHead-v0 (3 action "
+                        "values, 34 observation values besides depth), not in EgoSearch-v0 (5 and 34): run it in "
+                        "EgoSearchNoHead-v0")
+    # without --env-id an actor whose file names no env id acts in the one its sizes fit (it got EgoSearch-v0)
+    assert cli_error(capsys, "evaluate", "--scenarios", "missing.csv", "--weights", str(unrecorded), "--out",
+                     str(tmp_path / "o.csv")) == "egosearch evaluate: error: missing.csv: no such scenario file"
+
+
+def test_the_sizes_an_actor_is_checked_against_are_the_envs():
+    import gymnasium
+
+    from egosearch.envs import env_space_dims
+
+    env = gymnasium.make("EgoSearchNoHeadMap-v0")
+    try:
+        space = env.observation_space
+        assert env_space_dims("EgoSearchNoHeadMap-v0") == {
+            "action": env.action_space.shape[0], "mask": space["mask"].shape[0], "proprio": space["proprio"].shape[0]}
+    finally:
+        env.close()

@@ -24,6 +24,7 @@ from egosearch.motion.replan import (
     evaluate_fullbody,
     run_fullbody_episode,
 )
+from egosearch.motion.video import TARGET_RING_COLOR
 from egosearch.policies import OraclePolicy
 from egosearch.scenarios import Scenario, generate_scenarios
 
@@ -334,6 +335,62 @@ def test_search_video(tmp_path, scenarios):
     assert still.shape[0] == 384 and still.shape[1] == 384 + 512
     frames = imageio.mimread(tmp_path / "search.gif")
     assert len(frames) == row["steps"] + 1
+    # The third-person half rings the target in the mask's red (the still is lossless); shading
+    # never gives that exact colour, so these pixels are the ring.
+    assert (still[:, 384:, :3] == TARGET_RING_COLOR).all(axis=2).sum() > 20
+    # The step, visibility and distance are written in the margins above and below the depth image.
+    first = np.asarray(frames[0])[..., :3]
+    assert (first[:40, :384] < 100).all(axis=2).any() and (first[-40:, :384] < 100).all(axis=2).any()
+
+
+def test_frame_label_and_clean_candidates():
+    import pandas as pd
+
+    from egosearch.motion.video import clean_successes, frame_label
+
+    assert frame_label(0, 100, False, 3.456, False) == ("step 0 / 100", "target not seen, 3.46 m away")
+    assert frame_label(7, 100, True, 0.4, True) == ("step 7 / 100", "target found, 0.40 m away")
+    runs = pd.DataFrame({"scenario_id": [4, 0, 1, 2, 3], "success": [1, 1, 1, 0, 1], "steps": [30, 40, 8, 100, 25],
+                         "penetrations": [0, 2, 0, 0, 0]})
+    # scenario 0 succeeded through the furniture, 1 too quickly, 2 not at all
+    assert clean_successes(runs, min_steps=20) == [3, 4]
+    assert clean_successes(runs) == [1, 3, 4]
+
+
+def test_gif_is_kept_under_its_size_by_dropping_steps(tmp_path):
+    import imageio.v2 as imageio
+
+    from egosearch.motion.video import write_gif
+
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 256, (64, 64, 3), dtype=np.uint8) for _ in range(21)]  # noise: no compression
+    k = write_gif(tmp_path / "a.gif", frames, max_bytes=10**9)
+    assert k == 1 and len(imageio.mimread(tmp_path / "a.gif")) == 21
+    one_frame = (tmp_path / "a.gif").stat().st_size / 21
+    k = write_gif(tmp_path / "b.gif", frames, max_bytes=int(8 * one_frame))
+    kept = imageio.mimread(tmp_path / "b.gif")
+    assert k > 1 and len(kept) == len(range(0, 20, k)) + 1 and (tmp_path / "b.gif").stat().st_size <= 8 * one_frame
+    assert np.array_equal(np.asarray(kept[-1])[..., :3], np.asarray(imageio.mimread(tmp_path / "a.gif")[-1])[..., :3])
+
+
+def test_video_refuses_to_film_a_penetrating_replay(tmp_path, scenarios, capsys):
+    """A full-body CSV that calls an episode clean is not trusted: the replay is checked, and a
+    replay with a limb inside the home is never filmed."""
+    import pandas as pd
+
+    from egosearch.cli import main
+    from egosearch.scenarios import write_scenarios
+
+    write_scenarios(tmp_path / "s.csv", scenarios)
+    # The oracle's humanoid brushes furniture in scenario 3 (its replay below has penetrating poses).
+    pd.DataFrame({"scenario_id": [3], "success": [1], "steps": [26], "penetrations": [0]}).to_csv(
+        tmp_path / "fb.csv", index=False)
+    code = main(["video", "--policy", "oracle", "--scenarios", str(tmp_path / "s.csv"), "--first-success",
+                 str(tmp_path / "fb.csv"), "--T", "10", "--out", str(tmp_path / "v.gif"), "--still",
+                 str(tmp_path / "v.png")])
+    captured = capsys.readouterr()
+    assert code == 2 and "the replay differs" in captured.out and "penetrating pose" in captured.err
+    assert not (tmp_path / "v.gif").exists()
 
 
 def test_fullbody_command_with_an_actor_needs_its_weights(tmp_path, capsys):

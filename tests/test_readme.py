@@ -53,8 +53,8 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     out = render_readme(README, tmp_path, "p")
     assert "stale" not in out and "| 0.42 | 0.17 |" in out and "text kept" in out
     # fig6: first, last (with its seed CI) and best evaluation of each variant
-    assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | 0.30 at 4,000 |" in out
-    assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | 0.05 at 0 |" in out
+    assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | seeds | 0.30 at 4,000 |" in out
+    assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | seeds | 0.05 at 0 |" in out
     assert "commit `0123456`" in out and "3 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
     # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it
     assert "summed time / 2, one-thread jobs): 1.01 h; the other 1.00 h are variant comparisons" in out
@@ -127,8 +127,8 @@ def test_reading_block_states_what_the_stored_numbers_show(tmp_path):
     assert "0.45 m no low cabinets 0.20 vs 0.50" in text and "1.05 m everywhere 0.55 vs 0.75" in text
     assert "every cell sits 0.20–0.85 of the way" in text
     # excluding cabinets: 0.85 - 0.20 = +0.65, paper 0.92 - 0.50 = +0.42; everywhere 0.55 - 0.50, paper 0.75 - 0.58
-    assert "minus 0.45 m is +0.65 (paper: +0.42); 1.05 m against 0.45 m: intervals apart" in text
-    assert "minus 0.45 m is +0.05 (paper: +0.17); 1.05 m against 0.45 m: intervals overlap" in text
+    assert "minus 0.45 m is +0.65 (paper: +0.42); 1.05 m minus 0.45 m +0.65: intervals apart" in text
+    assert "minus 0.45 m is +0.05 (paper: +0.17); 1.05 m minus 0.45 m +0.05: intervals overlap" in text
     assert "head-on minus head-off is +0.30 (seed-bootstrap intervals apart)" in text
     assert "1-step short 0.10 (ours' interval above theirs at 1 of 2 M)" in text
     assert "SPL falls from 0.50 at M=1 to 0.12 at M=20 (intervals apart); attempts fall from 60.0 to 3.0" in text
@@ -139,9 +139,13 @@ def test_unknown_block_is_an_error(tmp_path):
         render_readme("<!-- egosearch:begin tabel1 -->\n<!-- egosearch:end tabel1 -->", tmp_path, "p")
 
 
-def test_the_repository_readme_matches_the_stored_cpu_results():
-    assert update_readme(REPO / "README.md", "cpu", check=True), (
-        "README.md results blocks differ from results/cpu + paper_figs/cpu: run `egosearch report readme`")
+def test_the_repository_readme_and_docs_match_the_stored_cpu_results():
+    from egosearch.report.readme import pages, update_pages
+
+    assert REPO / "README.md" in pages(REPO) and REPO / "docs" / "results.md" in pages(REPO)
+    stale = update_pages(REPO, "cpu", check=True)
+    assert stale == [], (f"generated blocks of {', '.join(str(p.relative_to(REPO)) for p in stale)} differ from "
+                         "results/cpu + paper_figs/cpu: run `egosearch report readme --profile cpu`")
 
 
 @needs_stored_run

@@ -575,3 +575,67 @@ def test_wilson_brackets_the_rate(kn):
     lo, hi = wilson_ci(k, n)
     assert 0.0 <= lo <= k / n <= hi <= 1.0
     assert (lo, hi) == pytest.approx(_wilson_by_hand(k, n), abs=1e-9)
+
+
+def _draw_frame(draw_ids, success_by_draw, seeds=(0, 1, 2)):
+    from egosearch.report.stats import DRAW_COLUMNS
+
+    rows = []
+    for d, v in zip(draw_ids, success_by_draw, strict=True):
+        for s in seeds:
+            row = dict.fromkeys(DRAW_COLUMNS, 0.0)
+            row.update(layout="kitchen_living", target_object="mug", start_x=float(d), seed=s, success=float(v))
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def test_cell_contrast_pairs_shared_draws_and_not_disjoint_ones():
+    """Two cells on the same 60 draws, the first 0.2 easier on every draw: paired, the draws' spread
+    of difficulty cancels and the interval is the point +0.2. The same numbers on disjoint draws
+    keep that spread: the interval is wide, yet still centred on +0.2."""
+    from egosearch.report.stats import cell_contrast
+
+    difficulty = np.linspace(0.0, 0.8, 60)
+    paired = cell_contrast(_draw_frame(range(60), difficulty + 0.2), _draw_frame(range(60), difficulty))
+    assert paired["n_shared"] == 60
+    assert paired["difference"] == pytest.approx(0.2)
+    assert paired["ci_low"] == pytest.approx(0.2) and paired["ci_high"] == pytest.approx(0.2)
+    apart = cell_contrast(_draw_frame(range(60), difficulty + 0.2), _draw_frame(range(100, 160), difficulty))
+    assert apart["n_shared"] == 0
+    assert apart["difference"] == pytest.approx(0.2)
+    assert apart["ci_low"] < 0.12 and apart["ci_high"] > 0.28
+
+
+def test_cell_contrast_refuses_cells_run_by_different_seeds():
+    from egosearch.report.stats import cell_contrast
+
+    with pytest.raises(ValueError, match="different seeds"):
+        cell_contrast(_draw_frame(range(5), [1] * 5, seeds=(0, 1)), _draw_frame(range(5), [0] * 5, seeds=(0, 2)))
+
+
+def test_figure6_band_resamples_the_curve_episodes_when_every_seed_kept_them(tmp_path):
+    """Two seeds, 40 in-training scenarios, the same episodes at both evaluations: the band of the
+    step whose episodes every seed kept is the two-level interval of the (scenarios x seeds) matrix;
+    a step one seed lacks falls back to the seeds' bootstrap (and says so)."""
+    from egosearch.report.figures import CI_SEEDS, CI_TWO_LEVEL, figure6_frame
+    from egosearch.report.stats import two_level_ci
+
+    rng = np.random.default_rng(3)
+    success = rng.integers(0, 2, size=(40, 2))
+    paths = []
+    for s in (0, 1):
+        run = tmp_path / "head_on" / f"seed{s}"
+        run.mkdir(parents=True)
+        rates = success[:, s].mean()
+        pd.DataFrame({"env_steps": [0, 100], "success_rate": [rates, rates]}).to_csv(run / "curve.csv", index=False)
+        steps = (0, 100) if s == 0 else (100,)  # seed 1 kept no episodes at step 0
+        pd.DataFrame([{"env_steps": t, "home": "kitchen_living", "height": 1.05, "scenario_id": i,
+                       "success": int(success[i, s]), "shortest_path": 2.0, "path_length": 3.0}
+                      for t in steps for i in range(40)]).to_csv(run / "curve_episodes.csv", index=False)
+        paths.append(run / "curve.csv")
+    df = figure6_frame({"head_on": paths}, n_resamples=N_RES).set_index("env_steps")
+    mean, lo, hi = two_level_ci(success.astype(float), n_resamples=N_RES)
+    assert df.loc[100, "ci_unit"] == CI_TWO_LEVEL and df.loc[100, "n_scenarios"] == 40
+    assert df.loc[100, "success_rate"] == pytest.approx(mean)
+    assert (df.loc[100, "low"], df.loc[100, "high"]) == pytest.approx((lo, hi))
+    assert df.loc[0, "ci_unit"] == CI_SEEDS

@@ -133,6 +133,47 @@ def test_provenance_records_the_sha256_of_every_stored_file(tmp_path):
                              "bytes": files[0].stat().st_size}
 
 
+def test_provenance_is_rewritten_only_when_a_stored_file_changes(tmp_path, monkeypatch):
+    """`report regenerate` then `snakemake all` rewrote the committed record with a new commit and date
+    although every file was byte-identical: the record must stay byte for byte unless the results change."""
+    import json
+
+    from egosearch.report import provenance
+
+    results, files = _stored_run(tmp_path)
+    record = results / "provenance.json"
+    first = record.read_bytes()
+    monkeypatch.setattr(provenance, "_git", lambda *args: "a later commit")  # another commit, another date
+    files[0].write_bytes(files[0].read_bytes())  # rewritten, identical
+    provenance.write_provenance("p", results, record)
+    assert record.read_bytes() == first
+    files[0].write_text(files[0].read_text() + files[0].read_text().splitlines()[-1] + "\n")
+    provenance.write_provenance("p", results, record)
+    rewritten = json.loads(record.read_text())
+    assert rewritten["commit"] == "a later commit"
+    assert rewritten["files"] == provenance.record_files(results) != json.loads(first)["files"]
+    # a new note is a change of the record too; the old note survives a rerun without one
+    provenance.write_provenance("p", results, record, note="resumed by hand")
+    noted = record.read_bytes()
+    provenance.write_provenance("p", results, record)
+    assert record.read_bytes() == noted and json.loads(noted)["note"] == "resumed by hand"
+
+
+def test_the_provenance_log_line_is_the_same_whether_the_record_was_rewritten_or_kept(tmp_path, capsys):
+    """The workflow commits the command's output as its log: a rerun that keeps the record must not change it."""
+    from egosearch.cli import main
+
+    results, files = _stored_run(tmp_path)
+    record = results / "provenance.json"
+    argv = ["report", "provenance", "--profile", "p", "--results", str(results), "--out", str(record)]
+    files[0].write_text(files[0].read_text() + "0,0,100,1.0,1.0,0.0,0,0.0\n")
+    capsys.readouterr()
+    assert main(argv) == 0  # rewritten: a stored file changed
+    rewritten = capsys.readouterr().out
+    assert main(argv) == 0  # kept
+    assert capsys.readouterr().out == rewritten == f"{record}: sha256 of 4 stored files, 0 jobs, 0 s summed\n"
+
+
 def test_verify_and_compare_refuse_a_truncated_or_edited_csv(tmp_path, capsys):
     from egosearch.cli import main
     from egosearch.report.cli import cmd_compare

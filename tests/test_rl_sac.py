@@ -8,18 +8,9 @@ import numpy as np
 import pytest
 import torch
 
-from egosearch.rl.config import PROFILES, TABLE2_PAPER, SacCurlConfig, load_config, table2_rows
-from egosearch.rl.sac_curl import (
-    METRIC_KEYS,
-    AgentStateError,
-    SacCurlAgent,
-    center_crop,
-    conv_out_side,
-    crop_at,
-    crop_gather,
-    crop_loop,
-    load_actor_net,
-)
+from egosearch.rl.common import METRIC_KEYS, AgentStateError, center_crop, crop_at, crop_gather, crop_loop
+from egosearch.rl.config import PROFILES, TABLE2_PAPER, LearnerConfig, load_config, table2_rows
+from egosearch.rl.sac_curl import SacCurlAgent, conv_out_side, load_actor_net
 
 # A small but structurally complete config (100 -> 84 crops, K = 5, 4 conv layers).
 SMALL = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32,
@@ -66,7 +57,7 @@ def test_act_and_update_shapes(action_dim):
 
 
 def test_paper_architecture_sizes():
-    cfg = SacCurlConfig()
+    cfg = LearnerConfig()
     agent = SacCurlAgent(cfg, 5, device="cpu")
     assert conv_out_side(84, 4) == 35
     convs = agent.critic.convs.convs
@@ -272,14 +263,14 @@ def test_config_validation_errors_are_one_line_and_name_the_field(overrides, fie
 def test_unknown_profile_or_field():
     with pytest.raises(ValueError, match="unknown profile 'fast'; allowed: smoke, cpu, paper"):
         load_config("fast", {})
-    with pytest.raises(ValueError, match="unknown SacCurlConfig field"):
+    with pytest.raises(ValueError, match="unknown LearnerConfig field"):
         load_config("paper", {"learning_rate": 1e-3})
 
 
 def test_profiles_are_valid_and_paper_is_table2():
     for name in PROFILES:
         load_config(name, {})
-    assert load_config("paper", {}) == SacCurlConfig()
+    assert load_config("paper", {}) == LearnerConfig()
 
 
 # the paper's Table 2 (Appendix A), verbatim
@@ -315,7 +306,7 @@ def test_table2_rows_match_the_paper():
 
 
 def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
-    from egosearch.rl.config import HOUSEKEEPING_FIELDS, SacCurlConfig, departure_rows, field_docs
+    from egosearch.rl.config import HOUSEKEEPING_FIELDS, LearnerConfig, departure_rows, field_docs
 
     assert departure_rows(load_config("paper", {})) == []
     cfg = load_config("paper", {"batch_size": 64, "seed": 7, "algorithm": "sac_drq", "encoder_num_layers": 2})
@@ -324,7 +315,7 @@ def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
     assert rows["batch_size"][:2] == ("64", "32") and rows["batch_size"][2].startswith('Table 2 "Batch-size"')
     assert rows["algorithm"][2].startswith("Paper 4.2")
     docs = field_docs()  # every field documents its source, so every departure can name one
-    assert set(docs) == {f for f in SacCurlConfig.__dataclass_fields__} and all(docs.values())
+    assert set(docs) == {f for f in LearnerConfig.__dataclass_fields__} and all(docs.values())
     assert "seed" in HOUSEKEEPING_FIELDS
 
 

@@ -17,8 +17,8 @@ import pytest
 import torch
 
 from egosearch.machine import cpu_model
+from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
-from egosearch.rl.sac_curl import AgentStateError
 from egosearch.rl.train import (
     CHECKPOINT_NAME,
     CURVE_COLUMNS,
@@ -123,7 +123,7 @@ def test_interrupt_and_resume_continues_without_duplicate_rows(tmp_path):
     _, rows = read_csv(tmp_path / "train.csv")
     assert [int(r["env_steps"]) for r in rows][-1] == 200
     ckpt = torch.load(tmp_path / CHECKPOINT_NAME, weights_only=True)
-    assert ckpt["env_steps"] == 150 and ckpt["csv_rows"] == {"curve": 2, "train": 3}
+    assert ckpt["env_steps"] == 150 and ckpt["csv_rows"] == {"curve": 2, "train": 3, "curve_episodes": 0}
     # ... and the rerun drops them, resumes at 150 and ends with exactly one row per step
     seen = []
     train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=seen.append)
@@ -137,10 +137,10 @@ def test_kill_minus_9_and_rerun(tmp_path):
         import sys, time
         sys.path.insert(0, {str(TESTS)!r})
         from test_rl_fake_env import register_fake_envs, FAKE_ENV_ID
-        from egosearch.rl.config import SacCurlConfig
+        from egosearch.rl.config import LearnerConfig
         from egosearch.rl.train import train
         register_fake_envs()
-        cfg = SacCurlConfig.from_dict({cfg.to_dict()!r})
+        cfg = LearnerConfig.from_dict({cfg.to_dict()!r})
         train(FAKE_ENV_ID, cfg, {str(tmp_path)!r}, progress=False, on_step=lambda s: time.sleep(0.01))
     """)
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)

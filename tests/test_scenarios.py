@@ -66,6 +66,11 @@ def test_missing_column_is_named(tmp_path, scenarios):
     ("height", "9.0", "height=9.0"),
     ("target_object", "piano", "piano"),
     ("target_y", "nan", "not finite"),
+    # nonsense that used to be scored: a failure with path 0, an SPL of 1, two episodes joined as one
+    ("start_x", "500", "start (500, "),
+    ("target_y", "-30", "is outside the home bedroom_bath"),
+    ("shortest_path", "-1.5", "shortest_path=-1.5 is negative"),
+    ("scenario_id", "0", "scenario_id=0 repeats the id of line 2"),
 ])
 def test_malformed_value_is_one_line_naming_the_row(tmp_path, scenarios, field, value, message):
     path = tmp_path / "s.csv"

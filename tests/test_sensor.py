@@ -292,6 +292,97 @@ def test_backends_agree(furnished):
     assert seen >= 3
 
 
+# ----------------------------------------------------------------------------------------------
+# Where the rasteriser comes from: built at install, compiled on first use, or Embree instead
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def raster_frames(furnished):
+    """The furnished poses through the rasteriser as this install loads it (before any test below
+    takes it away)."""
+    scene, target, poses = furnished
+    fast = _sensor(scene, "raster")
+    fast.set_target(target)
+    return [fast.render(*pose) for pose in poses]
+
+
+@pytest.fixture
+def fresh_loader(monkeypatch, tmp_path):
+    """The loader forgets what it loaded, and compiles on first use into an empty cache."""
+    import egosearch.sensor as sensor_mod
+
+    monkeypatch.setenv("EGOSEARCH_CACHE_DIR", str(tmp_path))
+    sensor_mod._load_raster_library.cache_clear()
+    yield sensor_mod
+    sensor_mod._load_raster_library.cache_clear()
+
+
+def test_the_library_built_at_install_is_the_one_loaded(fresh_loader, tmp_path):
+    from pathlib import Path
+
+    installed = fresh_loader._installed_library()
+    if installed is None:
+        pytest.skip("the rasteriser was not built at install (pip install found no C compiler)")
+    assert installed.parent == Path(fresh_loader.__file__).resolve().parent
+    assert Path(fresh_loader._load_raster_library()._name) == installed
+    assert DepthMaskSensor(_scene(WALL_X3)).backend == "raster"
+    assert not list(tmp_path.iterdir())  # nothing compiled on first use
+
+
+def test_a_library_built_for_another_cpu_is_not_loaded_but_compiled_anew(fresh_loader, tmp_path, monkeypatch):
+    """An install shared by unlike machines: its -march=native build could stop on an illegal
+    instruction, so the sensor compiles its own (when a compiler is there)."""
+    import ctypes
+    from pathlib import Path
+
+    from egosearch import rasterbuild
+
+    installed = fresh_loader._installed_library()
+    if installed is None or fresh_loader._find_compiler() is None:
+        pytest.skip("needs the library built at install and a C compiler")
+    build = fresh_loader._build_of(ctypes.CDLL(str(installed)))
+    if build.endswith(f" {rasterbuild.PORTABLE}"):
+        pytest.skip("the library was built portable (EGOSEARCH_NATIVE_BUILD=0): it fits any CPU")
+    assert rasterbuild.usable_here(build) is None
+    monkeypatch.setattr(rasterbuild, "cpu_key", lambda: "0123456789abcdef")
+    assert rasterbuild.usable_here(build) == "it was tuned for another CPU (-march=native)"
+    assert Path(fresh_loader._load_raster_library()._name).parent == tmp_path
+
+
+def test_a_build_is_usable_only_from_this_source_and_for_this_cpu():
+    from egosearch import rasterbuild
+
+    here = f"{rasterbuild.source_key()} {rasterbuild.cpu_key()}"
+    assert rasterbuild.usable_here(here) is None
+    assert rasterbuild.usable_here(f"{rasterbuild.source_key()} {rasterbuild.PORTABLE}") is None
+    assert rasterbuild.usable_here(f"0000000000000000 {rasterbuild.PORTABLE}") == (
+        "it was built from another raster.c (reinstall: pip install -e .)")
+    assert rasterbuild.usable_here("unknown") is not None  # a library that does not say
+
+
+def test_without_the_library_or_a_compiler_the_sensor_uses_embree_and_sees_the_same(
+        furnished, raster_frames, fresh_loader, monkeypatch):
+    scene, target, poses = furnished
+    monkeypatch.setattr(fresh_loader, "_installed_library", lambda: None)
+    monkeypatch.setattr(fresh_loader, "_find_compiler", lambda: None)
+    with pytest.warns(RuntimeWarning, match=r"fell back to the 'embree' backend \(raster: not built at install; "
+                                            r"no C compiler \(cc/gcc/clang\) found to build it on first use\)"):
+        try:
+            slow = DepthMaskSensor(scene)
+        except RuntimeError as err:
+            pytest.skip(f"no Embree here either: {err}")
+    assert slow.backend == "embree"
+    slow.set_target(target)
+    # Both sample the pixel centres: they differ only on triangle edges (at most 0.2% of the pixels
+    # by more than 1 mm of depth, or in the mask).
+    for pose, (depth, mask) in zip(poses, raster_frames):
+        slow_depth, slow_mask = slow.render(*pose)
+        assert np.mean(np.abs(slow_depth - depth) > 1e-3) <= 0.002, pose
+        assert np.mean(slow_mask != mask) <= 0.002, pose
+    assert sum(mask.any() for _, mask in raster_frames) >= 3  # the target was in sight, so masks were compared
+
+
 def test_bench_sensor_reports():
     rng = np.random.default_rng(0)
     parts = [FLOOR] + [_box(f"b{i}", (rng.uniform(-4, 4), rng.uniform(-4, 4), 0.5), (0.5, 0.5, 1.0))

@@ -36,7 +36,7 @@ def test_dry_run_of_all_lists_every_stage():
     out = run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"])
     assert out.returncode == 0, out.stderr
     for rule in ("scenarios", "train", "evaluate", "fullbody", "fullbody_oracle", "table1", "table2", "fig6", "fig7",
-                 "fig7_oracle", "provenance"):
+                 "fig7_oracle", "pathlength", "provenance"):
         assert rule in out.stdout, rule
 
 
@@ -48,6 +48,18 @@ def test_dry_run_of_generalise_reads_four_groups_of_homes():
         assert f"eval/head_on_generated_homes/seed0/{group}/everywhere/h1.05.csv" in text, group
     assert "group_scenarios" in text and "home900000:900020" not in text  # the homes go to the command
     assert "generalise" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout
+
+
+def test_dry_run_of_behaviour_traces_both_variants_outside_all():
+    out = run(["-n", "-p", "behaviour", "searches", "--config", "profile=smoke"])
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    for variant in ("head_on", "head_off"):
+        for home in ("kitchen_living", "bedroom_bath"):
+            assert f"traces/{variant}/seed0/{home}/everywhere/h1.65.npz" in text, (variant, home)
+    assert "--traces results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz" in text
+    assert "searches/gaze_kitchen_living_everywhere_h1.65.png" in text
+    assert "trace" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout.split()
 
 
 def test_lint_is_clean():
@@ -74,8 +86,16 @@ def test_unknown_variant_is_named_before_any_job():
 
 
 def test_smoke_table1_end_to_end(checkout):
-    out = run(["--cores", "2", "table1", "--config", "profile=smoke"], cwd=checkout, timeout=900)
+    # the reference's success by path length reads the same evaluations: one more job
+    out = run(["--cores", "2", "table1", "paper_figs/smoke/pathlength_head_on.md", "--config", "profile=smoke"],
+              cwd=checkout, timeout=900)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    by_length = pd.read_csv(checkout / "results/smoke/pathlength/head_on.csv")
+    pooled = by_length[(by_length["searcher"] == "head_on") & (by_length["height"] == "all")]
+    # 2 homes x 6 cells x 4 scenarios, each in one bin of each binning
+    assert pooled.groupby("by")["n_scenarios"].sum().to_dict() == {"detour": 48, "length": 48}
+    assert {"random", "oracle"} <= set(by_length["searcher"])
+    assert (checkout / "paper_figs/smoke/pathlength_head_on.png").stat().st_size > 10_000
     md = (checkout / "paper_figs/smoke/table1.md").read_text()
     assert "| 1.05m | paper | 0.92 | 0.75 |" in md and "| 0.45m | ours (head_on) | " in md
     for home in ("kitchen_living", "bedroom_bath"):  # both of the paper's homes

@@ -15,6 +15,7 @@ import pandas as pd
 
 from egosearch.report.data import _with, cells_from_paths, group_eval_paths, output_base, parse_eval_path
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
+from egosearch.report.pathlength import by_length_path, compare_by_length, format_by_length, pathlength_report
 from egosearch.report.provenance import check_stored
 from egosearch.report.tables import BOUNDS, compare_report, format_compare, table1, table2
 
@@ -90,8 +91,16 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
     Refuses (:class:`~egosearch.report.provenance.StoredFileError`) a stored file that differs from
     the sha256 its results folder's provenance recorded; files the record does not list (a new
     candidate's) are used as they are."""
-    check_stored([p for side in (reference_files, candidate_files)
-                  for p in (_flat(side.values()) if isinstance(side, Mapping) else side)], require_record=False)
+    reference_list, candidate_list = (_flat(side.values()) if isinstance(side, Mapping) else list(side)
+                                      for side in (reference_files, candidate_files))
+    # A file on both sides (a variant compared with itself) gives differences of 0 that read as a result.
+    candidates = {Path(p).resolve() for p in candidate_list}
+    both = [p for p in reference_list if Path(p).resolve() in candidates]
+    if both:
+        more = f" ({len(both) - 1} more file(s) too)" if len(both) > 1 else ""
+        raise ValueError(f"{os.fspath(both[0])} is both a reference and a candidate file{more}: compare two "
+                         "different variants (is the candidate the reference itself?)")
+    check_stored([*reference_list, *candidate_list], require_record=False)
     if not isinstance(reference_files, Mapping):
         reference_files = cells_from_paths(reference_files)
     if not isinstance(candidate_files, Mapping):
@@ -100,4 +109,20 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
     print(format_compare(df, reference_name, candidate_name))
     if out_csv is not None:
         print(f"wrote {out_csv}")
+    by_csv = None if out_csv is None else by_length_path(out_csv)
+    print(format_by_length(compare_by_length(reference_files, candidate_files, by_csv)))
+    if by_csv is not None:
+        print(f"wrote {by_csv}")
     return df
+
+
+def cmd_pathlength(episode_files: Iterable[PathLike], scenario_files: Iterable[PathLike], success_radius: float,
+                   out_prefix: PathLike, out_csv: PathLike | None = None,
+                   bounds: Iterable[PathLike] = ()) -> list[Path]:
+    """Success by shortest path ℓ and by detour for one variant's evaluation CSVs (and the reference
+    searchers' ``bounds``), joined to the ``scenario_files`` they ran; ``success_radius`` (m) from the
+    target's centre to the body's axis (the caller knows the env's)."""
+    outs = pathlength_report(episode_files, scenario_files, success_radius, out_prefix, out_csv=out_csv,
+                             bound_files=bounds)
+    _say(outs)
+    return outs

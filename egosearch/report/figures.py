@@ -20,8 +20,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
-from egosearch.report.data import _with, output_base, read_curves, read_episodes, read_fullbody
-from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, wilson_ci
+from egosearch.report.data import _with, output_base, read_curves, read_episodes, read_fullbody, seed_from_path
+from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, scenario_seed_matrix, two_level_ci, wilson_ci
 
 PathLike = str | os.PathLike
 
@@ -57,7 +57,8 @@ PLANNER_TITLES = {"actor": None, "oracle": "Planner: privileged oracle (knows th
 RANDOM = "random"
 """Figure 6's row name of the random searcher (a dashed line: the level a policy must rise above)."""
 RANDOM_LABEL = "random searcher"
-FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "success_rate", "low", "high")
+FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "n_scenarios", "success_rate", "low", "high", "ci_unit")
+CI_TWO_LEVEL, CI_SEEDS, CI_WILSON = "scenarios, then seeds", "seeds", "episodes (Wilson)"
 FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
                 "success_rate", "spl", "spl_low", "spl_high", "attempts", "attempts_low", "attempts_high",
                 "penetration_rate", "collisions", "ci_unit")
@@ -87,11 +88,32 @@ def _save(fig: Figure, base: Path) -> list[Path]:
 
 
 # --------------------------------------------------------------------------------------------- Figure 6
+def _curve_episodes(curve_paths: list) -> pd.DataFrame | None:
+    """The episodes behind every seed's curve (``curve_episodes.csv`` beside each ``curve.csv``), with
+    ``seed`` and ``scenario_set`` (home and height: scenario ids restart in each); None unless every
+    run kept them."""
+    frames = []
+    for i, path in enumerate(curve_paths):
+        sibling = Path(path).with_name("curve_episodes.csv")
+        if not sibling.exists():
+            return None
+        try:
+            s = seed_from_path(path)
+        except ValueError:
+            s = i
+        eps = pd.read_csv(sibling)
+        frames.append(eps.assign(seed=s, scenario_set=eps["home"] + "/h" + eps["height"].map("{:g}".format)))
+    return pd.concat(frames, ignore_index=True) if frames else None
+
+
 def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str, str] | None = None,
                   confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
                   random_files: Iterable[PathLike] | None = None) -> pd.DataFrame:
     """Numbers behind Figure 6: per variant and evaluation step, the mean success rate over seeds and a
-    percentile bootstrap band over seeds (NaN where fewer than 2 seeds were evaluated at that step).
+    95% band. Where every seed's run kept the episodes behind its curve (``curve_episodes.csv`` beside
+    ``curve.csv``), the band is the two-level bootstrap over the evaluation's scenarios, then the seeds
+    (``ci_unit`` says which); otherwise a percentile bootstrap over the seeds' rates (NaN where fewer
+    than 2 seeds were evaluated at that step).
 
     Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
     ``random_files``: per-episode CSVs of the random searcher (``.../seed{N}/...``); their pooled
@@ -109,11 +131,21 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
         df = read_curves(paths)
         if df.empty:
             raise ValueError(f"figure6: the curves of {variant!r} have no evaluated rows")
+        episodes = _curve_episodes(paths)
         for step, g in df.groupby("env_steps", sort=True):
             v = g["success_rate"].to_numpy(dtype=float)
-            lo, hi = bootstrap_ci(v, np.mean, confidence, n_resamples, seed) if v.size >= 2 else (math.nan, math.nan)
+            at = None if episodes is None else episodes[episodes["env_steps"] == step]
+            if at is not None and set(at["seed"]) == set(g["seed"]) and not at.empty:
+                m, _ = scenario_seed_matrix(at, "success")
+                _, lo, hi = two_level_ci(m, confidence, n_resamples, seed)
+                unit, n_scen = CI_TWO_LEVEL, m.shape[0]
+            else:
+                lo, hi = (bootstrap_ci(v, np.mean, confidence, n_resamples, seed) if v.size >= 2
+                          else (math.nan, math.nan))
+                unit, n_scen = CI_SEEDS, math.nan
             rows.append({"variant": variant, "label": labels.get(variant, variant), "env_steps": int(step),
-                         "n_seeds": int(v.size), "success_rate": float(v.mean()), "low": lo, "high": hi})
+                         "n_seeds": int(v.size), "n_scenarios": n_scen, "success_rate": float(v.mean()),
+                         "low": lo, "high": hi, "ci_unit": unit})
     random_files = list(random_files or [])
     if random_files:
         if RANDOM in curves:
@@ -123,7 +155,8 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
         lo, hi = wilson_ci(k, n, confidence)
         for step in sorted({r["env_steps"] for r in rows}):
             rows.append({"variant": RANDOM, "label": RANDOM_LABEL, "env_steps": step,
-                         "n_seeds": int(eps["seed"].nunique()), "success_rate": k / n, "low": lo, "high": hi})
+                         "n_seeds": int(eps["seed"].nunique()), "n_scenarios": n, "success_rate": k / n,
+                         "low": lo, "high": hi, "ci_unit": CI_WILSON})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
 
 

@@ -1,14 +1,16 @@
-"""Keep the README's Results section equal to the stored results, so that no number in it is typed.
+"""Keep the README's and the docs' results equal to the stored results, so that no number in them is typed.
 
-The README marks generated blocks with HTML comments::
+The README and the pages under ``docs/`` mark generated blocks with HTML comments::
 
     <!-- egosearch:begin table1 -->
     ... replaced by `egosearch report readme` ...
     <!-- egosearch:end table1 -->
 
 Each block name maps to a function that renders Markdown from files under ``paper_figs/<profile>/``
-and ``results/<profile>/``. ``egosearch report readme --check`` fails when a block differs from
-what the stored files give (a test runs it), so the README cannot drift from the results.
+and ``results/<profile>/`` (paths relative to the project root, whichever page the block is in).
+A block may sit in any page (:func:`pages`), or in several. ``egosearch report readme --check``
+fails when a block differs from what the stored files give (a test runs it), so no page can drift
+from the results.
 """
 
 from __future__ import annotations
@@ -48,15 +50,15 @@ def block_fig6(root: Path, profile: str) -> str:
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
-    lines = ["| variant | seeds | success at step 0 | success at the last step (95% CI over seeds) | best mean |",
-             "|---|---|---|---|---|"]
+    lines = ["| variant | seeds | success at step 0 | success at the last step (95% CI) | CI resamples | best mean |",
+             "|---|---|---|---|---|---|"]
     for variant, g in df.groupby("variant", sort=False):
         g = g.sort_values("env_steps")
         first, last = g.iloc[0], g.iloc[-1]
         best = g.loc[g["success_rate"].idxmax()]
         lines.append(f"| {variant} | {int(last.n_seeds)} | {_fmt(first.success_rate)} | "
                      f"{_fmt(last.success_rate)} [{_fmt(last.low)}, {_fmt(last.high)}] at {int(last.env_steps):,} | "
-                     f"{_fmt(best.success_rate)} at {int(best.env_steps):,} |")
+                     f"{last.get('ci_unit', 'seeds')} | {_fmt(best.success_rate)} at {int(best.env_steps):,} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
@@ -117,10 +119,30 @@ def block_provenance(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+BY_LENGTH = "_by_length"
+"""Suffix of a comparison's split by shortest path, written beside its per-cell CSV."""
+
+
+def _cell_comparisons(folder: Path) -> list[Path]:
+    return sorted(p for p in folder.glob("*_vs_*.csv") if not p.stem.endswith(BY_LENGTH))
+
+
+def _by_length_line(path: Path, root: Path) -> str | None:
+    split = path.with_name(path.stem + BY_LENGTH + ".csv")
+    if not split.exists():
+        return None
+    df = pd.read_csv(split)
+    succ = df[df["metric"] == "success"]
+    bins = "; ".join(f"{r.length_bin} m {r.difference:+.3f} [{r.ci_low:+.3f}, {r.ci_high:+.3f}]"
+                     f"{' *' if r.p_holm < 0.05 else ''}" for r in succ.itertuples())
+    return f"By shortest path ℓ (success, every cell pooled; `{split.relative_to(root)}`): {bins}."
+
+
 def block_compare(root: Path, profile: str) -> str:
-    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``)."""
+    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``), and its
+    split by shortest path where stored."""
     folder = root / "results" / profile / "compare"
-    paths = sorted(folder.glob("*_vs_*.csv"))
+    paths = _cell_comparisons(folder)
     if not paths:
         return (f"*No stored comparison yet under `{folder.relative_to(root)}/` "
                 "(`snakemake --cores 2 compare --config variant=NAME`).*\n")
@@ -137,6 +159,9 @@ def block_compare(root: Path, profile: str) -> str:
             lines.append(f"| {r.height:g} | {r.placement} | {r.metric} | {r.reference:.3f} | {r.candidate:.3f} | "
                          f"{r.difference:+.3f} [{r.ci_low:+.3f}, {r.ci_high:+.3f}] | {r.p_uncorrected:.3g} | "
                          f"{r.p_holm:.3g}{' *' if r.p_holm < 0.05 else ''} |")
+        by_length = _by_length_line(path, root)
+        if by_length:
+            lines += ["", by_length]
         parts.append("\n".join(lines) + "\n")
     note = ("\\* Holm-adjusted p < 0.05 (over every row of its file). CI: paired two-level bootstrap (scenarios, "
             "then seeds); p (one cell): paired sign-flip test over scenarios, uncorrected.")
@@ -146,7 +171,7 @@ def block_compare(root: Path, profile: str) -> str:
 def block_power(root: Path, profile: str) -> str:
     """What each stored comparison can detect: ``detectable_80`` of its success rows."""
     folder = root / "results" / profile / "compare"
-    paths = sorted(folder.glob("*_vs_*.csv"))
+    paths = _cell_comparisons(folder)
     lines = []
     for path in paths:
         df = pd.read_csv(path)
@@ -202,7 +227,44 @@ def _apart(*intervals) -> str:
     return "intervals overlap" if _versus(*intervals) == "overlapping" else "intervals apart"
 
 
-def _reading_table1(df: pd.DataFrame) -> list[str]:
+def _contrast_text(res: dict | None, intervals: tuple) -> str:
+    if not res:
+        return _apart(*intervals)
+    side = "excludes 0" if res["ci_low"] > 0 or res["ci_high"] < 0 else "includes 0"
+    return (f"95% interval of the difference [{_fmt(res['ci_low'])}, {_fmt(res['ci_high'])}] {side}, "
+            f"paired on the {res['n_shared']} draws both cells share")
+
+
+def table1_contrast(root: Path, profile: str, variant: str = "head_on") -> Callable[[tuple, tuple], dict | None]:
+    """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every home it
+    was evaluated in and every seed, each episode joined to its scenario's draw (home, start, target)."""
+    from egosearch.report.stats import cell_contrast
+
+    def cell(height: float, placement: str) -> pd.DataFrame | None:
+        frames = []
+        runs = root / "results" / profile / "eval" / variant
+        for path in sorted(runs.glob(f"seed*/*/{placement}/h{height:g}.csv")):
+            home, seed = path.parent.parent.name, int(path.parent.parent.parent.name.removeprefix("seed"))
+            scen = root / "results" / profile / "scenarios" / home / placement / path.name
+            if not scen.exists():
+                return None
+            eps = pd.read_csv(path).merge(pd.read_csv(scen), on="scenario_id", validate="one_to_one")
+            frames.append(eps.assign(seed=seed))
+        return pd.concat(frames, ignore_index=True) if frames else None
+
+    def contrast(first: tuple, second: tuple) -> dict | None:
+        a, b = cell(*first), cell(*second)
+        if a is None or b is None or set(a["seed"]) != set(b["seed"]):
+            return None
+        return cell_contrast(a, b)
+
+    return contrast
+
+
+def _reading_table1(df: pd.DataFrame, contrast: Callable[[tuple, tuple], dict | None] | None = None) -> list[str]:
+    """``contrast((height, placement), (height, placement))``: the first cell minus the second from the
+    per-episode files (:func:`stats.cell_contrast`), or None where they are not stored; without it the
+    comparisons fall back to whether the cells' own intervals overlap."""
     from egosearch.report.tables import BOTH_HOMES
     from egosearch.report.tables import PAPER_TABLE1 as PAPER
 
@@ -229,8 +291,9 @@ def _reading_table1(df: pd.DataFrame) -> list[str]:
         ours = np.mean([t.success_rate for t in tall]) - low.success_rate
         paper = np.mean([PAPER[(t.height, pl)] for t in tall]) - PAPER[(0.45, pl)]
         taller = " and ".join(f"{t.height:g}" for t in tall)
-        sides = [f"{t.height:g} m against 0.45 m: " + _apart(t.success_rate, t.ci_low, t.ci_high,
-                                                            low.success_rate, low.ci_low, low.ci_high)
+        sides = [f"{t.height:g} m minus 0.45 m {t.success_rate - low.success_rate:+.2f}: " + _contrast_text(
+                     contrast and contrast((t.height, pl), (0.45, pl)),
+                     (t.success_rate, t.ci_low, t.ci_high, low.success_rate, low.ci_low, low.ci_high))
                  for t in tall]
         out.append(f"- **Height, {pl.replace('_', ' ')}** (paper: tall cameras see more, a drop for the shortest): "
                    f"the mean of {taller} m minus 0.45 m is {ours:+.2f} (paper: {paper:+.2f}); "
@@ -241,7 +304,8 @@ def _reading_table1(df: pd.DataFrame) -> list[str]:
         if a is None or b is None:
             continue
         paper = PAPER[(h, "everywhere")] - PAPER[(h, "no_low_cabinets")]
-        apart = _apart(a.success_rate, a.ci_low, a.ci_high, b.success_rate, b.ci_low, b.ci_high)
+        apart = _contrast_text(contrast and contrast((h, "everywhere"), (h, "no_low_cabinets")),
+                               (a.success_rate, a.ci_low, a.ci_high, b.success_rate, b.ci_low, b.ci_high))
         moves.append(f"{h:g} m {a.success_rate - b.success_rate:+.2f} (paper {paper:+.2f}; {apart})")
     if moves:
         out.append("- **Cabinets** (paper: tall cameras lose when targets may be inside low cabinets, the shortest "
@@ -257,7 +321,8 @@ def _reading_fig6(df: pd.DataFrame) -> list[str]:
     if any(math.isnan(x) for x in (on.low, on.high, off.low, off.high)):
         side = "one seed: no interval"
     else:
-        side = "seed-bootstrap " + _apart(on.success_rate, on.low, on.high, off.success_rate, off.low, off.high)
+        unit = "two-level" if on.get("ci_unit") == "scenarios, then seeds" else "seed-bootstrap"
+        side = f"{unit} " + _apart(on.success_rate, on.low, on.high, off.success_rate, off.low, off.high)
     return [f"- **Head on vs head off** (paper: head movement gives a 20% higher success rate): at "
             f"{int(on.env_steps):,} env steps, head-on minus head-off is {on.success_rate - off.success_rate:+.2f} "
             f"({side})."]
@@ -295,9 +360,24 @@ def block_reading(root: Path, profile: str) -> str:
     missing = [p for p in paths if not p.exists()]
     if missing:
         return _missing(root, missing[0])
-    lines = (_reading_table1(pd.read_csv(paths[0])) + _reading_fig6(pd.read_csv(paths[1]))
-             + _reading_fig7(pd.read_csv(paths[2])))
-    return "\n".join(lines) + "\n\nFrom `" + "`, `".join(str(p.relative_to(root)) for p in paths) + "`.\n"
+    lines = (_reading_table1(pd.read_csv(paths[0]), table1_contrast(root, profile))
+             + _reading_fig6(pd.read_csv(paths[1])) + _reading_fig7(pd.read_csv(paths[2])))
+    return ("\n".join(lines) + "\n\nFrom `" + "`, `".join(str(p.relative_to(root)) for p in paths)
+            + f"`; the height and cabinet contrasts from `results/{profile}/eval/head_on/` and the scenario sets.\n")
+
+
+def _block_speed(root: Path, profile: str) -> str:
+    """The stored benchmark records and trainings' speed (:mod:`egosearch.report.speed`)."""
+    from egosearch.report.speed import block_speed
+
+    return block_speed(root, profile)
+
+
+def _block_claims(root: Path, profile: str) -> str:
+    """The paper's behaviour sentences against the per-step traces (:mod:`egosearch.report.behaviour`)."""
+    from egosearch.report.behaviour import block_claims
+
+    return block_claims(root, profile)
 
 
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
@@ -311,7 +391,29 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "compare": block_compare,
     "power": block_power,
     "reading": block_reading,
+    "claims": _block_claims,
+    "speed": _block_speed,
 }
+
+DOCS = "docs"
+"""The folder of the documentation pages, beside the README (``mkdocs.yml``'s ``docs_dir``)."""
+
+
+def pages(root: Path) -> list[Path]:
+    """Every page whose blocks are generated: ``README.md`` and each ``docs/**/*.md`` under ``root``."""
+    root = Path(root)
+    found = [root / "README.md"] if (root / "README.md").is_file() else []
+    return found + sorted((root / DOCS).rglob("*.md"))
+
+
+def page_root(page: Path) -> Path:
+    """The project root a page's blocks read from: the page's own folder, or the one above ``docs/``
+    for a docs page."""
+    page = Path(page).resolve()
+    for folder in page.parents:
+        if folder.name == DOCS:
+            return folder.parent
+    return page.parent
 
 
 def render_readme(text: str, root: Path, profile: str) -> str:
@@ -325,13 +427,19 @@ def render_readme(text: str, root: Path, profile: str) -> str:
     return BLOCK.sub(replace, text)
 
 
-def update_readme(readme: Path, profile: str, check: bool = False) -> bool:
-    """Rewrite the marked blocks of ``readme`` (or with ``check`` only compare); True when it was up to date."""
+def update_readme(readme: Path, profile: str, check: bool = False, root: Path | None = None) -> bool:
+    """Rewrite the marked blocks of the page ``readme`` (or with ``check`` only compare), reading the stored
+    files under ``root`` (default: :func:`page_root`); True when it was up to date."""
     readme = Path(readme)
     text = readme.read_text(encoding="utf-8")
-    rendered = render_readme(text, readme.resolve().parent, profile)
+    rendered = render_readme(text, Path(root) if root is not None else page_root(readme), profile)
     if rendered == text:
         return True
     if not check:
         readme.write_text(rendered, encoding="utf-8")
     return False
+
+
+def update_pages(root: Path, profile: str, check: bool = False) -> list[Path]:
+    """:func:`update_readme` on every page of :func:`pages`; the pages that were out of date."""
+    return [page for page in pages(root) if not update_readme(page, profile, check=check, root=root)]

@@ -266,3 +266,60 @@ def cluster_bootstrap_mean(df: pd.DataFrame, value: str, cluster: str | list[str
         return m, math.nan, math.nan
     lo, hi = bootstrap_ci(per, np.mean, confidence=confidence, n_resamples=n_resamples, seed=seed)
     return m, lo, hi
+
+
+DRAW_COLUMNS = ("layout", "start_x", "start_y", "start_theta", "target_object", "target_x", "target_y", "target_z")
+"""What makes two scenarios of different cells the same draw: the home, the start and the target.
+Table 1's cells are drawn from one stream per home, so a height or placement contrast shares many
+draws (about three quarters between heights of one placement in the stored sets)."""
+
+
+def cell_contrast(a: pd.DataFrame, b: pd.DataFrame, value: str = "success", confidence: float = 0.95,
+                  n_resamples: int = 10_000, seed: int = 0) -> dict:
+    """mean(a) − mean(b) for two cells evaluated by the same seeds (one policy per seed), with a
+    bootstrap interval that resamples the draws and the seeds.
+
+    Each frame holds per-episode rows with ``seed``, ``value`` and the :data:`DRAW_COLUMNS`. A draw
+    run in both cells is one unit on both sides (the pairing: its difficulty cancels); draws run in
+    one cell only are units of that side alone. Each resample draws units from the union of draws
+    with replacement, then the seeds with replacement, and takes the difference of the two cells'
+    means over the drawn units each side has; percentile interval. Returns ``{difference, ci_low,
+    ci_high, n_shared, n_a, n_b, n_seeds}``."""
+    keys = list(DRAW_COLUMNS)
+    for side, df in (("a", a), ("b", b)):
+        missing = [c for c in (*keys, "seed", value) if c not in df.columns]
+        if missing:
+            raise ValueError(f"cell {side} lacks columns {missing}")
+    seeds = sorted(set(a["seed"]) | set(b["seed"]))
+    if set(a["seed"]) != set(b["seed"]):
+        raise ValueError(f"the two cells were run by different seeds ({sorted(set(a['seed']))} vs "
+                         f"{sorted(set(b['seed']))}): a contrast needs the same policies on both sides")
+    wide = {}
+    for side, df in (("a", a), ("b", b)):
+        wide[side] = df.pivot_table(index=keys, columns="seed", values=value, aggfunc="mean")
+    draws = wide["a"].index.union(wide["b"].index)
+    ma = wide["a"].reindex(index=draws, columns=seeds).to_numpy(float)  # NaN: the draw is not in that cell
+    mb = wide["b"].reindex(index=draws, columns=seeds).to_numpy(float)
+    in_a, in_b = ~np.isnan(ma[:, 0]), ~np.isnan(mb[:, 0])
+    if np.isnan(ma[in_a]).any() or np.isnan(mb[in_b]).any():
+        raise ValueError("every seed must run every scenario of a cell")
+    diff = float(np.nanmean(ma) - np.nanmean(mb))
+    rng = np.random.default_rng(seed)
+    n_u, n_k = ma.shape
+    za, zb = np.nan_to_num(ma), np.nan_to_num(mb)
+    out = np.empty(n_resamples)
+    chunk = max(1, 2_000_000 // max(1, n_u * n_k))
+    for start in range(0, n_resamples, chunk):
+        m = min(chunk, n_resamples - start)
+        rows = rng.integers(0, n_u, (m, n_u))
+        cols = rng.integers(0, n_k, (m, n_k))
+        count_a, count_b = in_a[rows].sum(axis=1), in_b[rows].sum(axis=1)
+        sum_a = np.take_along_axis(za[rows].sum(axis=1), cols, axis=1).mean(axis=1)
+        sum_b = np.take_along_axis(zb[rows].sum(axis=1), cols, axis=1).mean(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[start:start + m] = sum_a / count_a - sum_b / count_b
+    out = out[np.isfinite(out)]
+    alpha = (1 - confidence) / 2
+    lo, hi = np.quantile(out, [alpha, 1 - alpha]) if out.size else (math.nan, math.nan)
+    return {"difference": diff, "ci_low": float(lo), "ci_high": float(hi), "n_shared": int((in_a & in_b).sum()),
+            "n_a": int(in_a.sum()), "n_b": int(in_b.sum()), "n_seeds": n_k}

@@ -31,9 +31,10 @@ import numpy as np
 import torch
 
 from egosearch.env import PRIVILEGED_STATE_DIM
+from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import ReplayBuffer, replay_gb
-from egosearch.rl.sac_curl import SacCurlAgent, resolve_device
+from egosearch.rl.sac_curl import SacCurlAgent
 from egosearch.rl.train import make_agent, torch_threads
 
 

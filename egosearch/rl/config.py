@@ -1,6 +1,8 @@
-"""SAC + CURL hyper-parameters: every value of the paper's Table 2, plus the knobs it leaves out.
+"""Learner hyper-parameters: every value of the paper's Table 2, plus the knobs it leaves out.
 
-One typed dataclass, CleanRL style: each field carries its own docstring saying where the value
+One typed dataclass, :class:`LearnerConfig`, configures every learner (SAC + CURL of
+:mod:`egosearch.rl.sac_curl` and SAC-DrQ of :mod:`egosearch.rl.sac_drq`; ``algorithm`` picks one)
+and the training loop, CleanRL style: each field carries its own docstring saying where the value
 comes from — "Table 2" (the paper, Appendix A), "CURL" (the defaults of the reference code of
 Srinivas et al. 2020, github.com/MishaLaskin/curl, which Table 2 follows almost line by line)
 or "ours" (engineering choices of this project that do not change the algorithm).
@@ -32,8 +34,8 @@ CURRICULUM_START_RADIUS = 1.0
 """Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
 CURRICULUM_END_RADIUS = 12.0
 """Radius (m) the curriculum reaches at its end: more than any home's extent."""
-ALGORITHMS = ("sac_curl", "sac_drq")
-"""Learners :mod:`egosearch.rl.train` can run (see ``SacCurlConfig.algorithm``)."""
+ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent")
+"""Learners :mod:`egosearch.rl.train` can run (see ``LearnerConfig.algorithm``)."""
 DISTANCE_REWARDS = ("distance", "progress")
 """Forms of r_d (the env's ``egosearch.env.DISTANCE_REWARDS``; a test keeps them equal)."""
 
@@ -42,8 +44,10 @@ _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "
 
 
 @dataclass
-class SacCurlConfig:
-    """Hyper-parameters of one SAC + CURL training run (paper 4.2 and Table 2)."""
+class LearnerConfig:
+    """Hyper-parameters of one training run, whichever learner ``algorithm`` names (paper 4.2 and
+    Table 2). Checkpoints, config.json and actor files store it as a plain dict (:meth:`to_dict`),
+    never as a pickled class, so renaming it does not touch stored runs."""
 
     # ---- Table 2: observation and data -------------------------------------------------
     image_size: int = 100
@@ -170,7 +174,12 @@ class SacCurlConfig:
     "sac_drq" = ours, after DrQ-v2 (Yarats et al. 2021): SAC with ONE conv encoder trained by
     the critic only, random-shift augmentation, no contrastive loss and no target encoder
     (:mod:`egosearch.rl.sac_drq`); an update costs ~3 conv passes instead of CURL's ~9. This
-    CHANGES THE ALGORITHM: the cpu profile uses it, the paper profile never."""
+    CHANGES THE ALGORITHM: the cpu profile uses it, the paper profile never.
+    "sac_drq_recurrent" = ours, SAC-DrQ with a GRU memory in the actor and a separate one in the
+    critic, trained on replayed sequences with burn-in (:mod:`egosearch.rl.sac_drq_recurrent`;
+    Ni et al. 2022, Kapturowski et al. 2019): a recurrent policy, which CHANGES THE ALGORITHM
+    further (the paper's policy sees only the last ``frame_history`` frames); no profile uses it,
+    a variant sets it. Every "sac_drq" field applies to it as well."""
     num_envs: int = 1
     """Ours (CURL: 1): environments stepped in lockstep in one process, their actions computed
     in one batched forward pass (acting cost per env step falls ~N-fold). Each env has its own
@@ -204,13 +213,31 @@ class SacCurlConfig:
     uses the stored scenarios."""
 
     critic_privileged_state: bool = False
-    """Paper: False (the critic sees what the actor sees). True ("sac_drq" only): an asymmetric
+    """Paper: False (the critic sees what the actor sees). True ("sac_drq" and "sac_drq_recurrent"
+    only): an asymmetric
     actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
     and the target's positions, the target in the body's frame, its distance: see
     ``egosearch.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
     (history + state, not state alone). The actor, and so every policy and actor file, sees only
     the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
     ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""
+
+    recurrent_hidden_dim: int = 128
+    """Ni et al. 2022 (a separate GRU for the actor and for the critic; 128 units is ours),
+    "sac_drq_recurrent" only; the paper has no recurrent policy: units of the GRU state of the
+    actor and, separately, of the critic. A
+    recurrent policy CHANGES THE ALGORITHM (the paper's actor is memoryless given K frames)."""
+    sequence_length: int = 8
+    """Kapturowski et al. 2019 (R2D2: replayed sequences), "sac_drq_recurrent" only; the paper
+    replays single transitions: steps of each replayed sequence that carry the losses. An update
+    draws ``batch_size // sequence_length`` sequences, so ``batch_size`` still counts the steps a
+    loss is taken on. Training on sequences CHANGES THE ALGORITHM (a recurrent policy is not the
+    paper's)."""
+    burn_in: int = 8
+    """Kapturowski et al. 2019 (R2D2's burn-in; Ni et al. 2022 replay whole episodes instead),
+    "sac_drq_recurrent" only; the paper has none: steps before each replayed sequence that only
+    warm its hidden state up from zero (no gradient, no loss). Part of a recurrent learner, which
+    CHANGES THE ALGORITHM."""
 
     train_height_min: float = 1.0
     """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
@@ -264,19 +291,19 @@ class SacCurlConfig:
     and must never be committed)."""
 
     # -------------------------------------------------------------------------------------
-    def validate(self) -> SacCurlConfig:
+    def validate(self) -> LearnerConfig:
         """Raise ``ValueError`` (one line naming the field and its allowed range) if any value
         is out of range; return ``self`` otherwise."""
 
         def bad(name: str, allowed: str) -> None:
-            raise ValueError(f"SacCurlConfig.{name}={getattr(self, name)!r} is out of range; "
+            raise ValueError(f"LearnerConfig.{name}={getattr(self, name)!r} is out of range; "
                              f"allowed: {allowed}")
 
         for f in fields(self):
             value = getattr(self, f.name)
             expected = {"int": int, "float": (int, float), "str": str, "bool": bool}[f.type]
             if isinstance(value, bool) and f.type != "bool" or not isinstance(value, expected):
-                raise ValueError(f"SacCurlConfig.{f.name}={value!r} has the wrong type; "
+                raise ValueError(f"LearnerConfig.{f.name}={value!r} has the wrong type; "
                                  f"expected {f.type}")
             if f.type == "float" and not math.isfinite(value):
                 bad(f.name, "a finite number")
@@ -309,13 +336,20 @@ class SacCurlConfig:
             bad("aug_pad", "an integer >= 0")
         if not 0 <= self.encoder_stride2_layers <= self.encoder_num_layers:
             bad("encoder_stride2_layers", f"0..encoder_num_layers={self.encoder_num_layers}")
-        if self.critic_privileged_state and self.algorithm != "sac_drq":
+        if self.critic_privileged_state and self.algorithm == "sac_curl":
             # the cpu profile sets it, so a sac_curl variant there must say so
-            bad("critic_privileged_state", "False for algorithm sac_curl (only sac_drq has a privileged critic; "
+            bad("critic_privileged_state", "False for algorithm sac_curl (only the sac_drq learners have a "
+                "privileged critic; "
                 "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
-        if self.algorithm == "sac_drq":
+        # Updates fall on the multiples of update_every from the last warm-up step on (train._Run.update):
+        # a run that ends before the first of them saves the random initial actor as if it were trained.
+        first_update = -(-max(self.init_steps, 1) // self.update_every) * self.update_every
+        if self.total_env_steps < first_update:
+            bad("total_env_steps", f">= {first_update}, the env step of the first update (after init_steps="
+                f"{self.init_steps} random steps, an update every {self.update_every} steps): fewer train no update")
+        if self.algorithm in ("sac_drq", "sac_drq_recurrent"):
             side = self.image_size // self.obs_downsample
             for i in range(self.encoder_num_layers):
                 side = (side - 3) // (2 if i < self.encoder_stride2_layers else 1) + 1
@@ -326,6 +360,14 @@ class SacCurlConfig:
         elif (self.crop_size - 3) // 2 + 1 - 2 * (self.encoder_num_layers - 1) < 1:
             bad("encoder_num_layers", f"1..{((self.crop_size - 3) // 2 + 1 - 1) // 2 + 1} "
                 f"for crop_size={self.crop_size} (the conv output would be empty)")
+        if self.recurrent_hidden_dim < 1 or self.sequence_length < 1:
+            bad("recurrent_hidden_dim" if self.recurrent_hidden_dim < 1 else "sequence_length", "an integer >= 1")
+        if self.burn_in < 0:
+            bad("burn_in", "an integer >= 0")
+        window = self.burn_in + self.sequence_length
+        if self.algorithm == "sac_drq_recurrent" and self.init_steps // self.num_envs < window:
+            # each env ring must hold a whole window when the first update samples one
+            bad("init_steps", f">= num_envs * (burn_in + sequence_length) = {self.num_envs * window}")
         if not 0.3 <= self.train_height_min <= 1.8:
             bad("train_height_min", "[0.3, 1.8] m (training heights are drawn from [this, 1.8] m)")
         if not 0.0 < self.gamma <= 1.0:
@@ -366,12 +408,12 @@ class SacCurlConfig:
         return dataclasses.asdict(self)
 
     @classmethod
-    def from_dict(cls, values: dict[str, Any]) -> SacCurlConfig:
+    def from_dict(cls, values: dict[str, Any]) -> LearnerConfig:
         """Inverse of :meth:`to_dict`; unknown keys are a one-line ``ValueError``."""
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(values) - known)
         if unknown:
-            raise ValueError(f"unknown SacCurlConfig field(s): {', '.join(unknown)}")
+            raise ValueError(f"unknown LearnerConfig field(s): {', '.join(unknown)}")
         return cls(**values).validate()
 
 
@@ -488,7 +530,7 @@ PROFILES: dict[str, Callable[[], dict[str, Any]]] = {
 """Profile name -> function returning its overrides of the Table 2 defaults."""
 
 
-def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> SacCurlConfig:
+def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> LearnerConfig:
     """The config of ``profile`` with ``overrides`` on top, validated.
 
     Unknown profile or field names and out-of-range values are one-line ``ValueError``s.
@@ -497,7 +539,7 @@ def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None)
         raise ValueError(f"unknown profile {profile!r}; allowed: {', '.join(PROFILES)}")
     values = PROFILES[profile]()
     values.update(overrides or {})
-    return SacCurlConfig.from_dict(values)
+    return LearnerConfig.from_dict(values)
 
 
 # ---- Table 2 --------------------------------------------------------------------------------
@@ -512,7 +554,7 @@ def _steps(n: int) -> str:
     return f"{_num(n / 1e6)}M"
 
 
-def table2_rows(cfg: SacCurlConfig) -> list[tuple[str, str]]:
+def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
     """``cfg`` as the (parameter, setting) rows of the paper's Table 2, same order and wording.
 
     With the ``paper`` profile this reproduces Table 2 exactly (e.g. ("Batch-size", "32"),
@@ -567,7 +609,7 @@ def field_docs() -> dict[str, str]:
     import ast
     import inspect
 
-    tree = ast.parse(inspect.getsource(SacCurlConfig))
+    tree = ast.parse(inspect.getsource(LearnerConfig))
     body = tree.body[0].body
     docs = {}
     for node, after in zip(body, body[1:]):
@@ -577,10 +619,10 @@ def field_docs() -> dict[str, str]:
     return docs
 
 
-def departure_rows(cfg: SacCurlConfig) -> list[tuple[str, str, str, str]]:
+def departure_rows(cfg: LearnerConfig) -> list[tuple[str, str, str, str]]:
     """(field, this config's value, the paper's value, where each comes from) for every field that
     differs from the paper profile, housekeeping fields excepted: what a profile changes, generated."""
-    paper, docs = SacCurlConfig(), field_docs()
+    paper, docs = LearnerConfig(), field_docs()
     rows = []
     for f in fields(cfg):
         mine, theirs = getattr(cfg, f.name), getattr(paper, f.name)
@@ -590,8 +632,8 @@ def departure_rows(cfg: SacCurlConfig) -> list[tuple[str, str, str, str]]:
     return rows
 
 
-TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(SacCurlConfig()))
+TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(LearnerConfig()))
 """Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
 
-__all__ = ["ACTIVATIONS", "ALGORITHMS", "PROFILES", "SacCurlConfig", "TABLE2_PAPER", "cpu_profile", "departure_rows",
+__all__ = ["ACTIVATIONS", "ALGORITHMS", "PROFILES", "LearnerConfig", "TABLE2_PAPER", "cpu_profile", "departure_rows",
            "field_docs", "load_config", "paper_profile", "smoke_profile", "table2_rows"]

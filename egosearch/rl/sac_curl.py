@@ -46,77 +46,33 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.config import SacCurlConfig
+from egosearch.rl.common import (
+    ActorHead,
+    AgentStateError,
+    Projection,
+    activation,
+    actor_head,
+    actor_weights,
+    adam,
+    crop_at,
+    gaussian_entropy,
+    load_actor_weights,
+    metric_values,
+    mlp,
+    obs_to_tensors,
+    resolve_device,
+    squashed_sample,
+    weight_init,
+)
+from egosearch.rl.config import LearnerConfig
 
 AGENT_FORMAT = "egosearch-sac-curl-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-curl-actor-v1"
-METRIC_KEYS = ("critic_loss", "actor_loss", "alpha", "alpha_loss", "curl_loss", "entropy", "q_mean")
-_LOG_2PI = math.log(2.0 * math.pi)
-
-
-class AgentStateError(ValueError):
-    """A saved agent / actor does not match (format, variant, architecture) or is unreadable."""
-
-
-def resolve_device(name: str = "auto") -> torch.device:
-    """"auto" -> CUDA when available, else CPU."""
-    if name == "auto":
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
-    return torch.device(name)
-
-
-def _activation(name: str) -> nn.Module:
-    return {"relu": nn.ReLU, "elu": nn.ELU, "leaky_relu": nn.LeakyReLU, "gelu": nn.GELU,
-            "tanh": nn.Tanh}[name]()
-
-
-def weight_init(m: nn.Module) -> None:
-    """CURL's init: orthogonal Linear weights, delta-orthogonal convs, zero biases."""
-    if isinstance(m, nn.Linear):
-        nn.init.orthogonal_(m.weight.data)
-        m.bias.data.fill_(0.0)
-    elif isinstance(m, nn.Conv2d):
-        m.weight.data.fill_(0.0)
-        m.bias.data.fill_(0.0)
-        mid = m.weight.size(2) // 2
-        nn.init.orthogonal_(m.weight.data[:, :, mid, mid], nn.init.calculate_gain("relu"))
 
 
 def conv_out_side(crop_size: int, num_layers: int) -> int:
     """Side of the last conv map: 3x3 kernels, stride 2 then 1 (84 -> 41 -> 39 -> 37 -> 35)."""
     return (crop_size - 3) // 2 + 1 - 2 * (num_layers - 1)
-
-
-def mlp(in_dim: int, hidden_dim: int, out_dim: int, num_layers: int, activation: str) -> nn.Sequential:
-    """``num_layers`` Linear layers (the last one is the output layer), activation between."""
-    dims = [in_dim] + [hidden_dim] * (num_layers - 1) + [out_dim]
-    layers: list[nn.Module] = []
-    for i in range(num_layers):
-        layers.append(nn.Linear(dims[i], dims[i + 1]))
-        if i < num_layers - 1:
-            layers.append(_activation(activation))
-    return nn.Sequential(*layers)
-
-
-# ---- crops --------------------------------------------------------------------------------
-
-def crop_at(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -> torch.Tensor:
-    """Crop (B, C, H, W) at per-sample offsets (uint8 or float, any device): one strided copy
-    per sample on the CPU (~4x faster there than a gather), one gather on accelerators (no
-    host sync)."""
-    if x.device.type == "cpu":
-        return crop_loop(x, oy, ox, size)
-    return crop_gather(x, oy, ox, size)
-
-
-def crop_loop(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -> torch.Tensor:
-    ys, xs = oy.tolist(), ox.tolist()
-    return torch.stack([x[i, :, y:y + size, xx:xx + size] for i, (y, xx) in enumerate(zip(ys, xs))])
-
-
-def crop_gather(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -> torch.Tensor:
-    windows = x.unfold(2, size, 1).unfold(3, size, 1)  # (B, C, H-size+1, W-size+1, size, size) view
-    return windows[torch.arange(x.shape[0], device=x.device), :, oy, ox]
 
 
 def crop_offsets(batch: int, image_size: int, crop_size: int,
@@ -128,24 +84,18 @@ def crop_offsets(batch: int, image_size: int, crop_size: int,
     return oy, ox
 
 
-def center_crop(x: torch.Tensor, size: int) -> torch.Tensor:
-    """CURL's centre crop: top = (H - size) // 2, left = (W - size) // 2."""
-    top, left = (x.shape[-2] - size) // 2, (x.shape[-1] - size) // 2
-    return x[..., top:top + size, left:left + size]
-
-
 # ---- networks -----------------------------------------------------------------------------
 
 class ConvEncoder(nn.Module):
     """The conv layers of CURL's pixel encoder: uint8 or float pixels -> flat features."""
 
-    def __init__(self, in_channels: int, num_layers: int, num_filters: int, activation: str,
+    def __init__(self, in_channels: int, num_layers: int, num_filters: int, act: str,
                  crop_size: int):
         super().__init__()
         self.convs = nn.ModuleList([nn.Conv2d(in_channels, num_filters, 3, stride=2)])
         for _ in range(num_layers - 1):
             self.convs.append(nn.Conv2d(num_filters, num_filters, 3, stride=1))
-        self.act = _activation(activation)
+        self.act = activation(act)
         self.out_dim = num_filters * conv_out_side(crop_size, num_layers) ** 2
 
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
@@ -155,51 +105,10 @@ class ConvEncoder(nn.Module):
         return h.flatten(1)  # (C, H, W) order whatever the memory layout
 
 
-class Projection(nn.Module):
-    """Linear + LayerNorm (+ tanh if ``tanh``) after the convs: the 128-d embedding."""
-
-    def __init__(self, in_dim: int, latent_dim: int, tanh: bool):
-        super().__init__()
-        self.fc = nn.Linear(in_dim, latent_dim)
-        self.ln = nn.LayerNorm(latent_dim)
-        self.tanh = tanh
-
-    def forward(self, h: torch.Tensor) -> torch.Tensor:
-        z = self.ln(self.fc(h))
-        return torch.tanh(z) if self.tanh else z
-
-
-class ActorHead(nn.Module):
-    """Actor on conv features: own projection, concat [mask, proprio], MLP -> (mu, log_std)."""
-
-    def __init__(self, conv_dim: int, latent_dim: int, extra_dim: int, action_dim: int,
-                 hidden_dim: int, num_layers: int, activation: str, log_std_min: float,
-                 log_std_max: float, tanh: bool):
-        super().__init__()
-        self.proj = Projection(conv_dim, latent_dim, tanh)
-        self.trunk = mlp(latent_dim + extra_dim, hidden_dim, 2 * action_dim, num_layers, activation)
-        self.log_std_min, self.log_std_max = float(log_std_min), float(log_std_max)
-
-    def forward(self, h: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        mu, log_std = self.trunk(torch.cat([self.proj(h), extra], dim=-1)).chunk(2, dim=-1)
-        log_std = torch.tanh(log_std)
-        log_std = self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
-        return mu, log_std
-
-
-def squashed_sample(mu: torch.Tensor, log_std: torch.Tensor, noise: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """CURL's reparameterised tanh-Gaussian sample: (tanh(mu + std * noise), log pi)."""
-    pi = mu + noise * log_std.exp()
-    log_pi = (-0.5 * noise.pow(2) - log_std).sum(-1, keepdim=True) - 0.5 * _LOG_2PI * noise.size(-1)
-    pi = torch.tanh(pi)
-    log_pi = log_pi - torch.log(F.relu(1 - pi.pow(2)) + 1e-6).sum(-1, keepdim=True)
-    return pi, log_pi
-
-
 class Critic(nn.Module):
     """Pixel encoder (convs + projection) and twin Q-functions on [embedding, mask, proprio, a]."""
 
-    def __init__(self, cfg: SacCurlConfig, extra_dim: int, action_dim: int):
+    def __init__(self, cfg: LearnerConfig, extra_dim: int, action_dim: int):
         super().__init__()
         self.convs = ConvEncoder(cfg.frame_history, cfg.encoder_num_layers, cfg.encoder_num_filters,
                                  cfg.encoder_activation, cfg.crop_size)
@@ -231,10 +140,7 @@ class ActorNet(nn.Module):
         self.convs = ConvEncoder(arch["frame_history"], arch["encoder_num_layers"],
                                  arch["encoder_num_filters"], arch["encoder_activation"],
                                  arch["crop_size"])
-        self.head = ActorHead(self.convs.out_dim, arch["encoder_latent_dim"], arch["extra_dim"],
-                              arch["action_dim"], arch["actor_hidden_dim"], arch["actor_num_layers"],
-                              arch["actor_activation"], arch["actor_log_std_min"],
-                              arch["actor_log_std_max"], arch["encoder_tanh"])
+        self.head = actor_head(self.convs.out_dim, arch)
 
     def forward(self, depth: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         return self.head(self.convs(depth), extra)
@@ -247,24 +153,12 @@ _ARCH_FIELDS = ("frame_history", "image_size", "crop_size", "encoder_num_layers"
                 "curl_latent")
 
 
-def obs_to_tensors(obs: dict, device: torch.device, crop_size: int) -> tuple[torch.Tensor, torch.Tensor]:
-    """One env observation (or a batch of them) -> (centre-cropped uint8 depth (B, K, S, S),
-    [mask, proprio] float (B, D)) on ``device``."""
-    depth = torch.as_tensor(np.asarray(obs["depth"]))
-    mask = torch.as_tensor(np.asarray(obs["mask"], np.float32))
-    proprio = torch.as_tensor(np.asarray(obs["proprio"], np.float32))
-    if depth.ndim == 3:
-        depth, mask, proprio = depth[None], mask[None], proprio[None]
-    depth = center_crop(depth, crop_size).to(device)
-    return depth, torch.cat([mask, proprio], dim=-1).to(device)
-
-
 # ---- the agent ----------------------------------------------------------------------------
 
 class SacCurlAgent:
     """SAC + CURL learner. ``act`` for one observation, ``update`` for one batch."""
 
-    def __init__(self, cfg: SacCurlConfig, action_dim: int, mask_dim: int = 30,
+    def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30,
                  proprio_dim: int = 4, impl: str = "fast", device: str | torch.device | None = None):
         if impl not in ("fast", "reference"):
             raise ValueError(f"impl={impl!r}; allowed: fast, reference")
@@ -272,12 +166,9 @@ class SacCurlAgent:
         self.impl = impl
         self.device = resolve_device(cfg.device) if device is None else torch.device(device)
         self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
-        extra = self.mask_dim + self.proprio_dim
-        self.critic = Critic(cfg, extra, self.action_dim)
+        self.critic = Critic(cfg, self.mask_dim + self.proprio_dim, self.action_dim)
         self.critic.apply(weight_init)
-        self.actor = ActorHead(self.critic.convs.out_dim, cfg.encoder_latent_dim, extra, self.action_dim,
-                               cfg.actor_hidden_dim, cfg.actor_num_layers, cfg.actor_activation,
-                               cfg.actor_log_std_min, cfg.actor_log_std_max, cfg.encoder_tanh)
+        self.actor: ActorHead = actor_head(self.critic.convs.out_dim, self.arch())
         self.actor.apply(weight_init)
         self.critic.to(self.device)
         self.actor.to(self.device)
@@ -301,10 +192,7 @@ class SacCurlAgent:
     def _adam(self, params, lr: float, betas: tuple[float, float]) -> torch.optim.Adam:
         if self.impl == "reference":
             return torch.optim.Adam(params, lr=lr, betas=betas, foreach=False)
-        try:
-            return torch.optim.Adam(params, lr=lr, betas=betas, fused=True)
-        except (RuntimeError, ValueError):  # fused not supported for this device / dtype
-            return torch.optim.Adam(params, lr=lr, betas=betas, foreach=True)
+        return adam(params, lr, betas)
 
     def _build_optimisers(self) -> None:
         cfg = self.cfg
@@ -389,9 +277,7 @@ class SacCurlAgent:
             out = self._update_reference(batch)
         else:
             out = self._update_fast(batch)
-        nan = torch.tensor(float("nan"), device=self.device)
-        values = torch.stack([out.get(k, nan).detach().float().reshape(()) for k in METRIC_KEYS]).tolist()
-        return dict(zip(METRIC_KEYS, values))
+        return metric_values(out, self.device)
 
     def _batch_parts(self, batch):
         extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
@@ -483,7 +369,7 @@ class SacCurlAgent:
             self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
             self.alpha_opt.step()
             out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
-            out["entropy"] = (0.5 * log_std.shape[1] * (1.0 + _LOG_2PI) + log_std.sum(dim=-1)).mean()
+            out["entropy"] = gaussian_entropy(log_std)
 
         # -- Polyak averaging of the target critic and key encoder --------------------------
         if do_polyak:
@@ -585,7 +471,7 @@ class SacCurlAgent:
             alpha_loss.backward()
             self.alpha_opt.step()
             out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
-            out["entropy"] = (0.5 * log_std.shape[1] * (1.0 + _LOG_2PI) + log_std.sum(dim=-1)).mean()
+            out["entropy"] = gaussian_entropy(log_std)
 
         if step % cfg.critic_target_update_freq == 0:
             self._polyak()
@@ -658,11 +544,7 @@ class SacCurlAgent:
         projection alone is 2.5M weights at the cpu profile), keeping a committed actor under
         10 MB; actions then differ from the live agent's by ~1e-3. :func:`load_actor_net` rounds
         through float16 whatever the storage, so every reported number is of the float16 actor."""
-        weights = {f"convs.{k}": v for k, v in self.critic.convs.state_dict().items()}
-        weights.update({f"head.{k}": v for k, v in self.actor.state_dict().items()})
-        weights = {k: v.detach().to("cpu", dtype=storage_dtype if v.is_floating_point() else v.dtype,
-                                    memory_format=torch.contiguous_format).clone()
-                   for k, v in weights.items()}
+        weights = actor_weights({"convs": self.critic.convs, "head": self.actor}, storage_dtype)
         return {"format": ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights,
                 "metadata": dict(metadata or {})}
 
@@ -672,12 +554,4 @@ def load_actor_net(state: dict[str, Any], device: str | torch.device = "cpu") ->
     if not isinstance(state, dict) or state.get("format") != ACTOR_FORMAT:
         raise AgentStateError("not an actor file (format="
                               f"{state.get('format') if isinstance(state, dict) else None!r})")
-    net = ActorNet(state["arch"])
-    # The stored policy is the float16 actor: weights saved in float32 (older files) are rounded
-    # the same way, so an actor file's actions do not depend on how it was stored.
-    weights = {k: v.to(torch.float16) if v.is_floating_point() else v for k, v in state["state_dict"].items()}
-    try:
-        net.load_state_dict(weights)
-    except RuntimeError as err:
-        raise AgentStateError(f"actor weights do not match their arch: {str(err).splitlines()[0]}") from None
-    return net.to(device).eval()
+    return load_actor_weights(ActorNet(state["arch"]), state, device)

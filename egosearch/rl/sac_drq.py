@@ -2,7 +2,9 @@
 
 What it keeps from SAC + CURL (:mod:`egosearch.rl.sac_curl`): the soft actor-critic losses,
 twin critics with Polyak targets, the tanh-Gaussian actor, the automatic temperature, the inputs
-(K depth frames + mask feature + proprioception) and every learning rate and beta.
+(K depth frames + mask feature + proprioception) and every learning rate and beta. The pieces
+both learners build from (actor head, layers, crops, observation tensors, actor files) live in
+:mod:`egosearch.rl.common`.
 
 What it changes, after DrQ-v2 (Yarats et al. 2021, github.com/facebookresearch/drqv2), to make
 one update several times cheaper:
@@ -36,20 +38,25 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.config import SacCurlConfig
-from egosearch.rl.sac_curl import (
-    _LOG_2PI,
-    METRIC_KEYS,
+from egosearch.rl.common import (
     ActorHead,
     AgentStateError,
     Projection,
+    activation,
+    actor_head,
+    actor_weights,
+    adam,
     crop_at,
+    gaussian_entropy,
+    load_actor_weights,
+    metric_values,
     mlp,
     obs_to_tensors,
     resolve_device,
     squashed_sample,
     weight_init,
 )
+from egosearch.rl.config import LearnerConfig
 
 AGENT_FORMAT = "egosearch-sac-drq-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-drq-actor-v1"
@@ -75,16 +82,14 @@ class PooledConvEncoder(nn.Module):
     update can shift the pooled images before the convs."""
 
     def __init__(self, in_channels: int, image_size: int, downsample: int, num_layers: int,
-                 num_filters: int, stride2_layers: int, activation: str):
+                 num_filters: int, stride2_layers: int, act: str):
         super().__init__()
-        from egosearch.rl.sac_curl import _activation
-
         self.downsample = int(downsample)
         self.convs = nn.ModuleList()
         for i in range(num_layers):
             self.convs.append(nn.Conv2d(in_channels if i == 0 else num_filters, num_filters, 3,
                                         stride=2 if i < stride2_layers else 1))
-        self.act = _activation(activation)
+        self.act = activation(act)
         side = conv_sides(pooled_side(image_size, downsample), num_layers, stride2_layers)[-1]
         self.out_dim = num_filters * side * side
 
@@ -131,7 +136,7 @@ def random_shift(x: torch.Tensor, pad: int) -> torch.Tensor:
 class DrqCritic(nn.Module):
     """Projection of the conv features and twin Q-heads (the part that has a Polyak target)."""
 
-    def __init__(self, conv_dim: int, cfg: SacCurlConfig, extra_dim: int, action_dim: int):
+    def __init__(self, conv_dim: int, cfg: LearnerConfig, extra_dim: int, action_dim: int):
         """``extra_dim``: the mask and proprio values, plus the privileged state's when the
         critic reads it (the caller concatenates them)."""
         super().__init__()
@@ -164,10 +169,7 @@ class DrqActorNet(nn.Module):
         super().__init__()
         self.arch = dict(arch)
         self.encoder = _encoder(arch)
-        self.head = ActorHead(self.encoder.out_dim, arch["encoder_latent_dim"], arch["extra_dim"],
-                                 arch["action_dim"], arch["actor_hidden_dim"], arch["actor_num_layers"],
-                                 arch["actor_activation"], arch["actor_log_std_min"], arch["actor_log_std_max"],
-                                 arch["encoder_tanh"])
+        self.head = actor_head(self.encoder.out_dim, arch)
 
     def forward(self, depth: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         return self.head(self.encoder(self.encoder.pool(depth)), extra)
@@ -177,7 +179,7 @@ class SacDrqAgent:
     """SAC with the DrQ-v2-style update (module docstring). ``update`` takes a batch with an
     optional ``discount`` (B, 1) column (gamma^n of n-step returns; default gamma)."""
 
-    def __init__(self, cfg: SacCurlConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
+    def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
                  device: str | torch.device | None = None, state_dim: int = 0):
         self.cfg = cfg.validate()
         self.device = resolve_device(cfg.device) if device is None else torch.device(device)
@@ -188,9 +190,7 @@ class SacDrqAgent:
         arch = self.arch()
         self.encoder = _encoder(arch)
         self.critic = DrqCritic(self.encoder.out_dim, cfg, arch["extra_dim"] + self.state_dim, self.action_dim)
-        self.actor = ActorHead(self.encoder.out_dim, cfg.encoder_latent_dim, arch["extra_dim"], self.action_dim,
-                                  cfg.actor_hidden_dim, cfg.actor_num_layers, cfg.actor_activation,
-                                  cfg.actor_log_std_min, cfg.actor_log_std_max, cfg.encoder_tanh)
+        self.actor: ActorHead = actor_head(self.encoder.out_dim, arch)
         for net in (self.encoder, self.critic, self.actor):
             net.apply(weight_init)
             net.to(self.device)
@@ -200,19 +200,12 @@ class SacDrqAgent:
         self.log_alpha = torch.tensor(math.log(cfg.init_temperature), device=self.device, requires_grad=True)
         self.target_entropy = -float(self.action_dim)
         self.num_updates = 0
-        self.critic_opt = self._adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
+        self.critic_opt = adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
                                       {"params": self.encoder.parameters(), "lr": cfg.encoder_lr}],
                                      cfg.critic_lr, (cfg.critic_beta1, cfg.critic_beta2))
-        self.actor_opt = self._adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
-        self.alpha_opt = self._adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
+        self.actor_opt = adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
+        self.alpha_opt = adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
         self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
-
-    @staticmethod
-    def _adam(params, lr, betas) -> torch.optim.Adam:
-        try:
-            return torch.optim.Adam(params, lr=lr, betas=betas, fused=True)
-        except (RuntimeError, ValueError):
-            return torch.optim.Adam(params, lr=lr, betas=betas, foreach=True)
 
     @property
     def alpha(self) -> float:
@@ -288,16 +281,14 @@ class SacDrqAgent:
             self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
             self.alpha_opt.step()
             out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
-            out["entropy"] = (0.5 * log_std.shape[1] * (1.0 + _LOG_2PI) + log_std.sum(dim=-1)).mean()
+            out["entropy"] = gaussian_entropy(log_std)
 
         if self.num_updates % cfg.critic_target_update_freq == 0:
             with torch.no_grad():
                 torch._foreach_lerp_(list(self.critic_target.parameters()), list(self.critic.parameters()),
                                      cfg.critic_tau)
         out["alpha"] = self.log_alpha.detach().exp()
-        nan = torch.tensor(float("nan"), device=self.device)
-        values = torch.stack([out.get(k, nan).detach().float().reshape(()) for k in METRIC_KEYS]).tolist()
-        return dict(zip(METRIC_KEYS, values))
+        return metric_values(out, self.device)
 
     # ---- persistence -----------------------------------------------------------------------
     def arch(self) -> dict[str, Any]:
@@ -333,18 +324,9 @@ class SacDrqAgent:
     def actor_state(self, metadata: dict[str, Any] | None = None,
                     storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
         """Actor-only weights (encoder + actor head), float16 like SAC+CURL's actor files."""
-        weights = {f"encoder.{k}": v for k, v in self.encoder.state_dict().items()}
-        weights.update({f"head.{k}": v for k, v in self.actor.state_dict().items()})
-        weights = {k: v.detach().to("cpu", dtype=storage_dtype if v.is_floating_point() else v.dtype).clone()
-                   for k, v in weights.items()}
+        weights = actor_weights({"encoder": self.encoder, "head": self.actor}, storage_dtype)
         return {"format": ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights, "metadata": dict(metadata or {})}
 
 
 def load_drq_actor_net(state: dict[str, Any], device: str | torch.device = "cpu") -> DrqActorNet:
-    net = DrqActorNet(state["arch"])
-    weights = {k: v.to(torch.float16) if v.is_floating_point() else v for k, v in state["state_dict"].items()}
-    try:
-        net.load_state_dict(weights)
-    except RuntimeError as err:
-        raise AgentStateError(f"actor weights do not match their arch: {str(err).splitlines()[0]}") from None
-    return net.to(device).eval()
+    return load_actor_weights(DrqActorNet(state["arch"]), state, device)

@@ -1,4 +1,5 @@
-"""Train SAC + CURL on an egosearch env, resumably; and ``ActorPolicy`` to run the result.
+"""Train a learner (SAC + CURL or SAC-DrQ, ``cfg.algorithm``) on an egosearch env, resumably; and
+``ActorPolicy`` to run the result.
 
 ``train(env_id, cfg, out_dir)`` writes into ``out_dir``:
 
@@ -6,6 +7,8 @@
 - ``curve.csv``: one row per evaluation (every ``eval_every`` env steps, at step 0 and at the
   end) with the fixed columns :data:`CURVE_COLUMNS`;
 - ``train.csv``: one row every ``log_every`` env steps with :data:`TRAIN_COLUMNS`;
+- ``curve_episodes.csv``: the episodes behind each curve.csv row (:data:`CURVE_EPISODE_COLUMNS`),
+  when the evaluator reports them: Figure 6's interval resamples them by scenario, then by seed;
 - ``ckpt/train_state.ckpt``: the resumable state (agent + optimisers + replay + RNG states + step
   counter + CSV row counts), rewritten atomically every ``checkpoint_every`` env steps and
   deleted at the end unless ``cfg.keep_checkpoint`` (it holds the replay buffer: up to ~1 GB,
@@ -39,26 +42,21 @@ import numpy as np
 import torch
 
 from egosearch.machine import cpu_model
-from egosearch.rl.config import SacCurlConfig
+from egosearch.rl.common import METRIC_KEYS, AgentStateError, obs_to_tensors, resolve_device
+from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.sac_curl import (
-    METRIC_KEYS,
-    AgentStateError,
-    SacCurlAgent,
-    load_actor_net,
-    obs_to_tensors,
-    resolve_device,
-)
+from egosearch.rl.sac_curl import SacCurlAgent, load_actor_net
 
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
 """The resumable state inside ``out_dir`` (``*.ckpt`` is git-ignored: it holds the replay)."""
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
+CURVE_EPISODE_COLUMNS = ("env_steps", "home", "height", "scenario_id", "success", "shortest_path", "path_length")
 TRAIN_COLUMNS = ("env_steps", "episodes", "updates", "train_return", "train_success", "critic_loss",
                  "actor_loss", "alpha_loss", "curl_loss", "alpha", "entropy", "q_mean", "steps_per_s",
                  "updates_per_s", "wall_s")
-_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ"}
+_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recurrent": "recurrent SAC-DrQ"}
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
@@ -136,6 +134,9 @@ class CsvLogger:
         values = []
         for c in self.columns:
             v = row.get(c, float("nan"))
+            if isinstance(v, str):  # a name (a home): the writer's own columns never hold commas
+                values.append(v)
+                continue
             values.append(str(int(v)) if isinstance(v, (int, np.integer)) and not isinstance(v, bool)
                           else repr(float(v)))
         with open(self.path, "a") as f:
@@ -171,25 +172,30 @@ class AgentPolicy:
         self.agent = agent
 
     def reset(self, seed: int | None = None) -> None:
-        pass
+        reset_state = getattr(self.agent, "reset_policy_state", None)  # a recurrent agent's memory
+        if reset_state is not None:
+            reset_state()
 
     def act(self, obs: dict) -> np.ndarray:
         return self.agent.act(obs, deterministic=True)
 
 
 def load_any_actor_net(state: dict, device) -> torch.nn.Module:
-    """An actor file's network, SAC+CURL's or SAC-DrQ's (by its ``format``)."""
-    from egosearch.rl import sac_drq
+    """An actor file's network, SAC+CURL's, SAC-DrQ's or recurrent SAC-DrQ's (by its ``format``)."""
+    from egosearch.rl import sac_drq, sac_drq_recurrent
 
     if isinstance(state, dict) and state.get("format") == sac_drq.ACTOR_FORMAT:
         return sac_drq.load_drq_actor_net(state, device)
+    if isinstance(state, dict) and state.get("format") == sac_drq_recurrent.ACTOR_FORMAT:
+        return sac_drq_recurrent.load_recurrent_actor_net(state, device)
     return load_actor_net(state, device)
 
 
 class ActorPolicy:
     """A trained actor (``actor.pt``) behind the project's policy interface:
-    ``reset(seed=None)`` (no-op: the actor is memoryless given the env's frame history) and
-    ``act(obs) -> np.ndarray`` (deterministic: tanh of the Gaussian mean, in [-1, 1])."""
+    ``reset(seed=None)`` (no-op: the actor is memoryless given the env's frame history; a recurrent
+    actor's hidden state is zeroed) and ``act(obs) -> np.ndarray`` (deterministic: tanh of the
+    Gaussian mean, in [-1, 1]; a recurrent actor carries its hidden state to the next call)."""
 
     def __init__(self, path: str | os.PathLike, device: str = "auto"):
         path = Path(path)
@@ -209,20 +215,62 @@ class ActorPolicy:
             self.net = load_any_actor_net(state, self.device)
         except AgentStateError as err:
             raise AgentStateError(f"{path}: {err}") from None
+        self.path = path
         self.arch = state["arch"]
         self.metadata = state.get("metadata", {})
         self.variant = self.metadata.get("variant")
         self.env_id = self.metadata.get("env_id")
         self.config = self.metadata.get("config")
         self.action_dim = int(self.arch["action_dim"])
+        self.recurrent = bool(getattr(self.net, "recurrent", False))
+        self._h = None
+
+    def fits(self, env_id: str) -> bool:
+        """Whether the actor's action and observation sizes are those of the registered ``env_id``."""
+        from egosearch.envs import env_space_dims
+
+        dims = env_space_dims(env_id)
+        if "mask_dim" in self.arch and "proprio_dim" in self.arch:
+            return (self.action_dim, int(self.arch["mask_dim"]), int(self.arch["proprio_dim"])) == (
+                dims["action"], dims["mask"], dims["proprio"])
+        return (self.action_dim, int(self.arch["extra_dim"])) == (dims["action"], dims["mask"] + dims["proprio"])
+
+    def trained_env_id(self) -> str | None:
+        """The env id the actor was trained in: the one its file records, else the one registered id
+        whose sizes it fits (None when no single id does)."""
+        from egosearch.envs import ENV_IDS
+
+        if self.env_id:
+            return self.env_id
+        fitting = [env_id for env_id in ENV_IDS if self.fits(env_id)]
+        return fitting[0] if len(fitting) == 1 else None
+
+    def check_env(self, env_id: str) -> None:
+        """Raise :class:`AgentStateError` (one line naming the env id it was trained for) unless the
+        actor can act in ``env_id``: a mismatch otherwise surfaces only as a broadcasting error in
+        the first episode's step."""
+        if self.fits(env_id):
+            return
+        from egosearch.envs import env_space_dims
+
+        trained = self.trained_env_id()
+        dims = env_space_dims(env_id)
+        told = f"was trained in {trained}" if trained else "fits no registered env id"
+        hint = f": run it in {trained}" if trained else ""
+        raise AgentStateError(f"{self.path}: this actor {told} ({self.action_dim} action values, "
+                              f"{self.arch['extra_dim']} observation values besides depth), not in {env_id} "
+                              f"({dims['action']} and {dims['mask'] + dims['proprio']}){hint}")
 
     def reset(self, seed: int | None = None) -> None:
-        pass
+        self._h = None
 
     def act(self, obs: dict) -> np.ndarray:
         with torch.inference_mode():
             depth, extra = obs_to_tensors(obs, self.device, self.arch["crop_size"])
-            mu, _ = self.net(depth.float(), extra)
+            if self.recurrent:
+                mu, _, self._h = self.net(depth.float(), extra, self._h)
+            else:
+                mu, _ = self.net(depth.float(), extra)
             return torch.tanh(mu)[0].cpu().numpy().astype(np.float32)
 
 
@@ -359,14 +407,16 @@ def _kwargs_key(env_kwargs: dict) -> str:
 
 
 def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str, env_kwargs: dict,
-                    cfg: SacCurlConfig) -> None:
+                    cfg: LearnerConfig) -> None:
     if saved.get("variant") != variant or saved.get("env_id") != env_id:
         raise CheckpointError(f"{path} belongs to variant={saved.get('variant')!r} env_id={saved.get('env_id')!r}, "
                               f"not variant={variant!r} env_id={env_id!r}; use another out_dir")
     if saved.get("env_kwargs") != _kwargs_key(env_kwargs):
         raise CheckpointError(f"{what} {path} was written with env_kwargs {saved.get('env_kwargs')}, "
                               f"not {_kwargs_key(env_kwargs)}; use another out_dir")
-    mine, theirs = cfg.to_dict(), saved.get("config", {})
+    # runs saved before the recurrent learner's fields existed ran without them, i.e. as their defaults
+    theirs = {**_RECURRENT_DEFAULTS, **saved.get("config", {})}
+    mine = cfg.to_dict()
     diff = sorted(k for k in set(mine) | set(theirs) if k not in RESUMABLE_FIELDS and mine.get(k) != theirs.get(k))
     if diff:
         shown = ", ".join(f"{k}={theirs.get(k)!r} (now {mine.get(k)!r})" for k in diff[:4])
@@ -374,7 +424,11 @@ def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: st
                               f"{' ...' if len(diff) > 4 else ''}; use another out_dir")
 
 
-def _env_spaces(env, cfg: SacCurlConfig) -> tuple[int, int, int]:
+_RECURRENT_DEFAULTS = {f: LearnerConfig.__dataclass_fields__[f].default
+                       for f in ("recurrent_hidden_dim", "sequence_length", "burn_in")}
+
+
+def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
     space = env.observation_space
     try:
         depth, mask, proprio = space["depth"], space["mask"], space["proprio"]
@@ -442,7 +496,7 @@ def _make_env(env_id: str, env_kwargs: dict):
 
 # ---- training -----------------------------------------------------------------------------
 
-def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwargs: dict | None = None,
+def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwargs: dict | None = None,
           evaluate_fn: Callable[[Any], dict] | None = None, *, variant: str | None = None,
           progress: bool = True, on_step: Callable[[int], None] | None = None) -> dict:
     """Train (or resume, or return at once if ``done.json`` is there) and return the summary.
@@ -467,7 +521,8 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
             raise CheckpointError(f"cannot read {done_path} ({_describe(err)})") from None
         _check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
         return done
-    ours = {CHECKPOINT_NAME.name, "actor.pt", "done.json", "config.json", "curve.csv", "train.csv"}
+    ours = {CHECKPOINT_NAME.name, "actor.pt", "done.json", "config.json", "curve.csv", "curve_episodes.csv",
+            "train.csv"}
     for stale in [*out_dir.glob(".tmp*"), *(out_dir / CHECKPOINT_NAME.parent).glob(".tmp*")]:
         if stale.name.split(".", 2)[-1] in ours:  # temp files of a killed run of ours
             stale.unlink()
@@ -489,7 +544,7 @@ def train(env_id: str, cfg: SacCurlConfig, out_dir: str | os.PathLike, env_kwarg
         torch.set_num_threads(threads_before)
 
 
-def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
+def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     """The training envs' keyword arguments: the variant's, with r_d's form
     (``train_distance_reward``) and the training heights (``train_height_min``) from the learner
     config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
@@ -508,10 +563,14 @@ def train_env_kwargs(cfg: SacCurlConfig, env_kwargs: dict) -> dict:
     return {**aids, **env_kwargs}
 
 
-def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
+def make_agent(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
                state_dim: int = 0):
     """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state);
     ``state_dim``: size of the env's privileged state (``critic_privileged_state``)."""
+    if cfg.algorithm == "sac_drq_recurrent":
+        from egosearch.rl.sac_drq_recurrent import SacDrqRecurrentAgent
+
+        return SacDrqRecurrentAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
     if cfg.algorithm == "sac_drq":
         from egosearch.rl.sac_drq import SacDrqAgent
 
@@ -520,224 +579,307 @@ def make_agent(cfg: SacCurlConfig, action_dim: int, mask_dim: int, proprio_dim: 
 
 
 def _act_batch(agent, observations: list[dict]) -> list[np.ndarray]:
-    if len(observations) == 1 or not hasattr(agent, "act_batch"):
+    # a recurrent agent's act() is the evaluation episode's: training envs always go through act_batch
+    if (len(observations) == 1 and not hasattr(agent, "reset_state")) or not hasattr(agent, "act_batch"):
         return [agent.act(o, deterministic=False) for o in observations]
     stacked = {k: np.stack([o[k] for o in observations]) for k in observations[0]}
     return list(agent.act_batch(stacked, deterministic=False))
 
 
-def _train(envs: list, env_id: str, cfg: SacCurlConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
+def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
+    """Size of the env's privileged state when the critic reads it (``critic_privileged_state``), else 0."""
+    if not cfg.critic_privileged_state:
+        return 0
+    if "state" not in env.observation_space.spaces:
+        raise ValueError(f"critic_privileged_state needs an env whose observations hold a 'state' "
+                         f"entry (privileged_state=True); {env_id} gives none")
+    return int(env.observation_space["state"].shape[0])
+
+
+def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
            progress: bool, on_step, ckpt: dict | None) -> dict:
-    ckpt_path = out_dir / CHECKPOINT_NAME
-    done_path = out_dir / "done.json"
-    device = resolve_device(cfg.device)
-    random.seed(cfg.seed)
-    np.random.seed(cfg.seed)
-    torch.manual_seed(cfg.seed)
-    env = envs[0]
-    action_dim, mask_dim, proprio_dim = _env_spaces(env, cfg)
-    state_dim = 0
-    if cfg.critic_privileged_state:
-        if "state" not in env.observation_space.spaces:
-            raise ValueError(f"critic_privileged_state needs an env whose observations hold a 'state' "
-                             f"entry (privileged_state=True); {env_id} gives none")
-        state_dim = int(env.observation_space["state"].shape[0])
-    for i, e in enumerate(envs):
-        e.action_space.seed(cfg.seed + 7 * i)
-    agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
-    to_replay = getattr(agent, "replay_obs", lambda o: o)
-    replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, getattr(agent, "replay_image_size", cfg.image_size),
-                         cfg.frame_history, mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
-                         device=device, seed=cfg.seed, state_dim=state_dim)
-    curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
-    train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
-
-    step, episodes, wall_before = 0, 0, 0.0
-    recent: deque[tuple[float, float]] = deque(maxlen=20)  # (return, success) of train episodes
-    if ckpt is not None:
-        try:
-            agent.load_state_dict(ckpt["agent"])
-            replay.load_state_dict(_to_numpy(ckpt["replay"]))
-            _restore_rng_states(ckpt["rng"], envs)
-        except (AgentStateError, ValueError, KeyError, RuntimeError) as err:
-            raise CheckpointError(f"checkpoint {ckpt_path} does not fit this run ({_describe(err)})") from None
-        step, episodes, wall_before = int(ckpt["env_steps"]), int(ckpt["episodes"]), float(ckpt["wall_s"])
-        recent.extend((float(r), float(s)) for r, s in ckpt["recent"])
-        curve.truncate(int(ckpt["csv_rows"]["curve"]))
-        train_log.truncate(int(ckpt["csv_rows"]["train"]))
-        # The run that was not stopped cut its episodes here too (see restart_episodes below).
-        replay.end_episodes()
-        reset_seeds = [cfg.seed + 7919 * step + 104_729 * i for i in range(len(envs))]
-    else:
-        curve.truncate(0)
-        train_log.truncate(0)
-        reset_seeds = [cfg.seed + 104_729 * i for i in range(len(envs))]
-    def reset(e, seed=None):
-        radius = cfg.start_radius(step)
-        return e.reset(seed=seed, options=None if radius is None else {"start_radius": radius})[0]
-
-    observations = [reset(e, sd) for e, sd in zip(envs, reset_seeds)]
-    stored = [to_replay(o) for o in observations]  # as the replay stores them, each computed once
-    ep_returns = [0.0] * len(envs)
-
-    def restart_episodes() -> None:
-        """Cut every env's episode at a checkpoint and reset it with a seed of the step, exactly as
-        a run resumed from that checkpoint does: so killing and resuming gives the same run as not
-        stopping (the cut transitions count as truncated, so they still bootstrap)."""
-        replay.end_episodes()
-        for i, e in enumerate(envs):
-            observations[i] = reset(e, cfg.seed + 7919 * step + 104_729 * i)
-            stored[i] = to_replay(observations[i])
-            ep_returns[i] = 0.0
-    del ckpt
-    atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
-                                          "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict()})
-
+    """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
+    run = _Run(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt)
     own_eval = evaluate_fn is None
     evaluate_fn = evaluate_fn or default_evaluator(env_id, env_kwargs, cfg.eval_episodes)
-    policy = AgentPolicy(agent)
-    threads = torch.get_num_threads()
-    say = print
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=cfg.total_env_steps, initial=step, unit="step", dynamic_ncols=True,
-                   mininterval=1.0, desc=f"{variant} seed {cfg.seed}")
-        say = bar.write
-    say(f"{_ALGORITHM_NAMES[cfg.algorithm]} {variant} on {env_id} -> {out_dir} | device {device}, "
-        f"{threads} torch threads, {cfg.num_envs} env(s) | "
-        f"{'resuming at step ' + str(step) if step else 'fresh start'}")
-    say("config: " + json.dumps(cfg.to_dict(), sort_keys=True))
-
-    t_start = time.perf_counter()
-    marks = {"curve": (step, agent.num_updates, t_start, 0.0), "train": (step, agent.num_updates, t_start, 0.0)}
-    eval_time = 0.0
-    means = {"curve": _Mean(), "train": _Mean()}
-
-    def wall() -> float:
-        return wall_before + time.perf_counter() - t_start
-
-    def rates(key: str) -> tuple[float, float]:
-        s0, u0, t0, e0 = marks[key]
-        dt = max(time.perf_counter() - t0 - (eval_time - e0), 1e-9)
-        marks[key] = (step, agent.num_updates, time.perf_counter(), eval_time)
-        if step == s0:
-            return float("nan"), float("nan")
-        return (step - s0) / dt, (agent.num_updates - u0) / dt
-
-    def do_eval() -> dict:
-        nonlocal eval_time
-        t0 = time.perf_counter()
-        result = evaluate_fn(policy)
-        eval_time += time.perf_counter() - t0
-        sps, ups = rates("curve")
-        m = means["curve"].mean()
-        means["curve"] = _Mean()
-        row = {"env_steps": step, "success_rate": result.get("success_rate", float("nan")),
-               "spl": result.get("spl", float("nan")), "episode_return": result.get("episode_return", float("nan")),
-               "critic_loss": m["critic_loss"], "actor_loss": m["actor_loss"], "curl_loss": m["curl_loss"],
-               "alpha": agent.alpha, "entropy": m["entropy"], "steps_per_s": sps, "updates_per_s": ups,
-               "wall_s": wall()}
-        curve.write(row)
-        say(f"eval @ {step}: success {row['success_rate']:.3f}  return {row['episode_return']:.2f}  "
-            f"spl {row['spl']:.3f}  ({sps:.1f} steps/s, {ups:.1f} updates/s)")
-        return row
-
-    def save_checkpoint() -> None:
-        state = {
-            "format": CHECKPOINT_FORMAT, "variant": variant, "env_id": env_id,
-            "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict(),
-            "env_steps": step, "episodes": episodes, "wall_s": wall(),
-            "csv_rows": {"curve": curve.rows(), "train": train_log.rows()},
-            "recent": [list(x) for x in recent],
-            "agent": agent.state_dict(), "replay": _to_tensors(replay.state_dict()), "rng": _rng_states(envs),
-        }
-        atomic_write(ckpt_path, lambda f: torch.save(state, f))
-
+    bar = run.open_progress(progress)
+    run.start_clock()
     last_row = None
     try:
-        if step == 0 and curve.rows() == 0:
-            last_row = do_eval()
-        def crossed(every: int, before: int) -> bool:
-            return step // every > before // every or step == cfg.total_env_steps
-
-        while step < cfg.total_env_steps:
-            before = step
-            live = envs[: cfg.total_env_steps - step]  # the last round may need fewer envs
-            if step < cfg.init_steps:
-                actions = [e.action_space.sample() for e in live]
-            else:
-                actions = _act_batch(agent, observations[: len(live)])
-            for i, (e, action) in enumerate(zip(live, actions)):
-                next_obs, reward, terminated, truncated, info = e.step(action)
-                next_stored = to_replay(next_obs)
-                replay.add(i, stored[i], action, reward, next_stored, terminated, truncated)
-                step += 1
-                ep_returns[i] += float(reward)
-                if terminated or truncated:
-                    episodes += 1
-                    recent.append((ep_returns[i], float(terminated)))
-                    ep_returns[i] = 0.0
-                    observations[i] = reset(e)
-                    stored[i] = to_replay(observations[i])
-                else:
-                    observations[i], stored[i] = next_obs, next_stored
-            if step >= cfg.init_steps:
-                first_due = max(before, cfg.init_steps - 1)
-                for _ in range((step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step):
-                    metrics = agent.update(replay.sample(cfg.batch_size))
-                    means["curve"].add(metrics)
-                    means["train"].add(metrics)
-            if step // cfg.log_every > before // cfg.log_every:
-                sps, ups = rates("train")
-                m = means["train"].mean()
-                means["train"] = _Mean()
-                ret = float(np.mean([r for r, _ in recent])) if recent else float("nan")
-                succ = float(np.mean([s for _, s in recent])) if recent else float("nan")
-                train_log.write({"env_steps": step, "episodes": episodes, "updates": agent.num_updates,
-                                 "train_return": ret, "train_success": succ, **m, "alpha": agent.alpha,
-                                 "steps_per_s": sps, "updates_per_s": ups, "wall_s": wall()})
-                if bar is not None:
-                    bar.set_postfix(success=f"{succ:.2f}", ret=f"{ret:.1f}", ups=f"{ups:.1f}", refresh=False)
-            if crossed(cfg.eval_every, before):
-                last_row = do_eval()
-            if crossed(cfg.checkpoint_every, before):
-                save_checkpoint()
-                if step < cfg.total_env_steps:
-                    restart_episodes()
+        if run.step == 0 and run.curve.rows() == 0:
+            last_row = run.evaluate(evaluate_fn)
+        while run.step < cfg.total_env_steps:
+            before = run.step
+            live = envs[: cfg.total_env_steps - run.step]  # the last round may need fewer envs
+            run.step_and_store(live, run.actions(live))
+            run.update(before)
+            if run.step // cfg.log_every > before // cfg.log_every:
+                run.log_train(bar)
+            if run.crossed(cfg.eval_every, before):
+                last_row = run.evaluate(evaluate_fn)
+            if run.crossed(cfg.checkpoint_every, before):
+                run.save_checkpoint()
+                if run.step < cfg.total_env_steps:
+                    run.restart_episodes()
             if bar is not None:
-                bar.update(step - before)
+                bar.update(run.step - before)
             if on_step is not None:
-                on_step(step)
+                on_step(run.step)
     finally:
         if bar is not None:
             bar.close()
         if own_eval:
             evaluate_fn.close()
+    return run.finish(last_row)
 
-    if last_row is None:  # resumed exactly at the end: the last curve row is already written
-        import csv
 
-        with open(curve.path) as f:
-            rows = list(csv.DictReader(f))
-        last_row = {k: float(v) for k, v in rows[-1].items()} if rows else {}
-    meta = {"variant": variant, "env_id": env_id, "env_kwargs": _kwargs_key(env_kwargs),
-            "config": cfg.to_dict(), "env_steps": step,
-            "updates": agent.num_updates, "seed": cfg.seed, "torch": str(torch.__version__)}
-    atomic_write(out_dir / "actor.pt", lambda f: torch.save(agent.actor_state(meta), f))
-    summary = {"variant": variant, "env_id": env_id, "env_kwargs": _kwargs_key(env_kwargs),
-               "env_steps": step, "updates": agent.num_updates,
-               "episodes": episodes, "wall_s": round(wall(), 3), "actor": "actor.pt",
-               "final_eval": {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in last_row.items()},
-               # wall_s is core time only on the machine that ran it: the budget study shows which
-               "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
-               "config": cfg.to_dict()}
-    atomic_json(done_path, summary)
-    if not cfg.keep_checkpoint and ckpt_path.exists():
-        ckpt_path.unlink()
+class _Run:
+    """One training run's live state (agent, replay, envs, counters, CSV logs) and the steps of its
+    loop, each a method, after DrQ-v2's ``Workspace``.
+
+    Everything that draws random numbers runs in one fixed order (seeding, the agent's init, the
+    replay, a checkpoint's RNG states, the envs' resets; then per round: actions, env steps,
+    resets, updates), so that a resumed run equals the one that was not stopped."""
+
+    def __init__(self, envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, variant: str,
+                 ckpt: dict | None):
+        self.envs, self.env_id, self.cfg, self.variant = envs, env_id, cfg, variant
+        self.out_dir, self.env_kwargs = out_dir, env_kwargs
+        self.ckpt_path, self.done_path = out_dir / CHECKPOINT_NAME, out_dir / "done.json"
+        self.device = resolve_device(cfg.device)
+        random.seed(cfg.seed)
+        np.random.seed(cfg.seed)
+        torch.manual_seed(cfg.seed)
+        action_dim, mask_dim, proprio_dim = _env_spaces(envs[0], cfg)
+        state_dim = _privileged_state_dim(envs[0], env_id, cfg)
+        for i, e in enumerate(envs):
+            e.action_space.seed(cfg.seed + 7 * i)
+        self.agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, self.device, state_dim)
+        self.to_replay = getattr(self.agent, "replay_obs", lambda o: o)
+        self.replay = MultiReplay(cfg.num_envs, cfg.replay_capacity,
+                                  getattr(self.agent, "replay_image_size", cfg.image_size), cfg.frame_history,
+                                  mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
+                                  device=self.device, seed=cfg.seed, state_dim=state_dim)
+        self.curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
+        self.train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
+        self.curve_episodes = CsvLogger(out_dir / "curve_episodes.csv", CURVE_EPISODE_COLUMNS)
+        self.step, self.episodes, self.wall_before = 0, 0, 0.0
+        self.recent: deque[tuple[float, float]] = deque(maxlen=20)  # (return, success) of train episodes
+        reset_seeds = self._resume(ckpt) if ckpt is not None else self._fresh()
+        self.observations = [self.reset(e, sd) for e, sd in zip(envs, reset_seeds)]
+        self.stored = [self.to_replay(o) for o in self.observations]  # as the replay stores them, each computed once
+        self.ep_returns = [0.0] * len(envs)
+        atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
+                                              "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict()})
+        self.policy = AgentPolicy(self.agent)
+        self.say = print
+        self.means = {"curve": _Mean(), "train": _Mean()}
+
+    # ---- start ----------------------------------------------------------------------------
+    def _fresh(self) -> list[int]:
+        self.curve.truncate(0)
+        self.train_log.truncate(0)
+        self.curve_episodes.truncate(0)
+        return [self.cfg.seed + 104_729 * i for i in range(len(self.envs))]
+
+    def _resume(self, ckpt: dict) -> list[int]:
+        """Load the agent, replay and RNG states; drop the CSV rows written after the checkpoint."""
         try:
-            ckpt_path.parent.rmdir()
-        except OSError:  # not empty: leave other files alone
-            pass
-    return summary
+            self.agent.load_state_dict(ckpt["agent"])
+            self.replay.load_state_dict(_to_numpy(ckpt["replay"]))
+            _restore_rng_states(ckpt["rng"], self.envs)
+        except (AgentStateError, ValueError, KeyError, RuntimeError) as err:
+            raise CheckpointError(f"checkpoint {self.ckpt_path} does not fit this run ({_describe(err)})") from None
+        self.step, self.episodes = int(ckpt["env_steps"]), int(ckpt["episodes"])
+        self.wall_before = float(ckpt["wall_s"])
+        self.recent.extend((float(r), float(s)) for r, s in ckpt["recent"])
+        self.curve.truncate(int(ckpt["csv_rows"]["curve"]))
+        self.train_log.truncate(int(ckpt["csv_rows"]["train"]))
+        # a checkpoint from before the per-episode file: its episodes start at this resume
+        self.curve_episodes.truncate(int(ckpt["csv_rows"].get("curve_episodes", 0)))
+        # The run that was not stopped cut its episodes here too (see restart_episodes).
+        self.replay.end_episodes()
+        return self._restart_seeds()
+
+    def _restart_seeds(self) -> list[int]:
+        return [self.cfg.seed + 7919 * self.step + 104_729 * i for i in range(len(self.envs))]
+
+    def open_progress(self, progress: bool):
+        """The tqdm bar (None without ``progress``) and the run's first two lines."""
+        cfg, bar = self.cfg, None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=cfg.total_env_steps, initial=self.step, unit="step", dynamic_ncols=True,
+                       mininterval=1.0, desc=f"{self.variant} seed {cfg.seed}")
+            self.say = bar.write
+        self.say(f"{_ALGORITHM_NAMES[cfg.algorithm]} {self.variant} on {self.env_id} -> {self.out_dir} | device "
+                 f"{self.device}, {torch.get_num_threads()} torch threads, {cfg.num_envs} env(s) | "
+                 f"{'resuming at step ' + str(self.step) if self.step else 'fresh start'}")
+        self.say("config: " + json.dumps(cfg.to_dict(), sort_keys=True))
+        return bar
+
+    # ---- clocks ---------------------------------------------------------------------------
+    def start_clock(self) -> None:
+        """Zero the run's clocks: wall_s goes on from the checkpoint's, the rates start here."""
+        self.t_start = time.perf_counter()
+        self.eval_time = 0.0
+        self.marks = {key: (self.step, self.agent.num_updates, self.t_start, 0.0) for key in ("curve", "train")}
+
+    def wall(self) -> float:
+        return self.wall_before + time.perf_counter() - self.t_start
+
+    def rates(self, key: str) -> tuple[float, float]:
+        """Env steps and updates per second since the last row of ``key``, evaluations excluded."""
+        s0, u0, t0, e0 = self.marks[key]
+        dt = max(time.perf_counter() - t0 - (self.eval_time - e0), 1e-9)
+        self.marks[key] = (self.step, self.agent.num_updates, time.perf_counter(), self.eval_time)
+        if self.step == s0:
+            return float("nan"), float("nan")
+        return (self.step - s0) / dt, (self.agent.num_updates - u0) / dt
+
+    def crossed(self, every: int, before: int) -> bool:
+        return self.step // every > before // every or self.step == self.cfg.total_env_steps
+
+    # ---- acting and storing ---------------------------------------------------------------
+    def reset(self, e, seed: int | None = None) -> dict:
+        radius = self.cfg.start_radius(self.step)
+        return e.reset(seed=seed, options=None if radius is None else {"start_radius": radius})[0]
+
+    def actions(self, live: list) -> list[np.ndarray]:
+        """Uniform random actions during the warm-up, the agent's samples after it."""
+        if self.step < self.cfg.init_steps:
+            return [e.action_space.sample() for e in live]
+        return _act_batch(self.agent, self.observations[: len(live)])
+
+    def step_and_store(self, live: list, actions: list[np.ndarray]) -> None:
+        """Step each live env once, store the transitions, reset the envs whose episode ended."""
+        for i, (e, action) in enumerate(zip(live, actions)):
+            next_obs, reward, terminated, truncated, info = e.step(action)
+            next_stored = self.to_replay(next_obs)
+            self.replay.add(i, self.stored[i], action, reward, next_stored, terminated, truncated)
+            self.step += 1
+            self.ep_returns[i] += float(reward)
+            if terminated or truncated:
+                self.episodes += 1
+                self.recent.append((self.ep_returns[i], float(terminated)))
+                self.ep_returns[i] = 0.0
+                self.observations[i] = self.reset(e)  # the curriculum radius of the step just counted
+                self.reset_agent_state(i)
+                self.stored[i] = self.to_replay(self.observations[i])
+            else:
+                self.observations[i], self.stored[i] = next_obs, next_stored
+
+    def restart_episodes(self) -> None:
+        """Cut every env's episode at a checkpoint and reset it with a seed of the step, exactly as
+        a run resumed from that checkpoint does: so killing and resuming gives the same run as not
+        stopping (the cut transitions count as truncated, so they still bootstrap)."""
+        self.replay.end_episodes()
+        for i, (e, seed) in enumerate(zip(self.envs, self._restart_seeds())):
+            self.observations[i] = self.reset(e, seed)
+            self.stored[i] = self.to_replay(self.observations[i])
+            self.ep_returns[i] = 0.0
+            self.reset_agent_state(i)
+
+    def reset_agent_state(self, env_index: int) -> None:
+        """A recurrent agent forgets env ``env_index``'s episode (memoryless agents have no such hook)."""
+        reset_state = getattr(self.agent, "reset_state", None)
+        if reset_state is not None:
+            reset_state(env_index)
+
+    # ---- updating -------------------------------------------------------------------------
+    def update(self, before: int) -> None:
+        """The updates due for the env steps ``before`` -> ``step``: ``updates_per_step`` at every
+        ``update_every``-th step from the last warm-up step on."""
+        cfg = self.cfg
+        if self.step < cfg.init_steps:
+            return
+        first_due = max(before, cfg.init_steps - 1)
+        for _ in range((self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step):
+            metrics = self.agent.update(self.sample())
+            self.means["curve"].add(metrics)
+            self.means["train"].add(metrics)
+
+    def sample(self) -> dict:
+        """An update's batch: transitions, or the agent's own draw (a recurrent agent's sequences)."""
+        sample_batch = getattr(self.agent, "sample_batch", None)
+        return self.replay.sample(self.cfg.batch_size) if sample_batch is None else sample_batch(self.replay)
+
+    # ---- logging and evaluating -----------------------------------------------------------
+    def log_train(self, bar=None) -> None:
+        """A row of train.csv: update metrics since the last row, the last 20 training episodes."""
+        sps, ups = self.rates("train")
+        m = self.means["train"].mean()
+        self.means["train"] = _Mean()
+        ret = float(np.mean([r for r, _ in self.recent])) if self.recent else float("nan")
+        succ = float(np.mean([s for _, s in self.recent])) if self.recent else float("nan")
+        self.train_log.write({"env_steps": self.step, "episodes": self.episodes, "updates": self.agent.num_updates,
+                              "train_return": ret, "train_success": succ, **m, "alpha": self.agent.alpha,
+                              "steps_per_s": sps, "updates_per_s": ups, "wall_s": self.wall()})
+        if bar is not None:
+            bar.set_postfix(success=f"{succ:.2f}", ret=f"{ret:.1f}", ups=f"{ups:.1f}", refresh=False)
+
+    def evaluate(self, evaluate_fn) -> dict:
+        """A row of curve.csv: ``evaluate_fn`` on the deterministic policy, update metrics since the
+        last row. Its time is left out of the rates."""
+        t0 = time.perf_counter()
+        result = evaluate_fn(self.policy)
+        self.eval_time += time.perf_counter() - t0
+        sps, ups = self.rates("curve")
+        m = self.means["curve"].mean()
+        self.means["curve"] = _Mean()
+        row = {"env_steps": self.step, "success_rate": result.get("success_rate", float("nan")),
+               "spl": result.get("spl", float("nan")), "episode_return": result.get("episode_return", float("nan")),
+               "critic_loss": m["critic_loss"], "actor_loss": m["actor_loss"], "curl_loss": m["curl_loss"],
+               "alpha": self.agent.alpha, "entropy": m["entropy"], "steps_per_s": sps, "updates_per_s": ups,
+               "wall_s": self.wall()}
+        self.curve.write(row)
+        for episode in result.get("episodes", ()):
+            self.curve_episodes.write({"env_steps": self.step, **{k: episode[k] for k in CURVE_EPISODE_COLUMNS[1:]}})
+        self.say(f"eval @ {self.step}: success {row['success_rate']:.3f}  return {row['episode_return']:.2f}  "
+                 f"spl {row['spl']:.3f}  ({sps:.1f} steps/s, {ups:.1f} updates/s)")
+        return row
+
+    # ---- checkpointing and finishing ------------------------------------------------------
+    def save_checkpoint(self) -> None:
+        state = {
+            "format": CHECKPOINT_FORMAT, "variant": self.variant, "env_id": self.env_id,
+            "env_kwargs": _kwargs_key(self.env_kwargs), "config": self.cfg.to_dict(),
+            "env_steps": self.step, "episodes": self.episodes, "wall_s": self.wall(),
+            "csv_rows": {"curve": self.curve.rows(), "train": self.train_log.rows(),
+                         "curve_episodes": self.curve_episodes.rows()},
+            "recent": [list(x) for x in self.recent],
+            "agent": self.agent.state_dict(), "replay": _to_tensors(self.replay.state_dict()),
+            "rng": _rng_states(self.envs),
+        }
+        atomic_write(self.ckpt_path, lambda f: torch.save(state, f))
+
+    def finish(self, last_row: dict | None) -> dict:
+        """Write actor.pt, then done.json (the run is complete), then drop the checkpoint."""
+        if last_row is None:  # resumed exactly at the end: the last curve row is already written
+            import csv
+
+            with open(self.curve.path) as f:
+                rows = list(csv.DictReader(f))
+            last_row = {k: float(v) for k, v in rows[-1].items()} if rows else {}
+        cfg, agent, key = self.cfg, self.agent, _kwargs_key(self.env_kwargs)
+        meta = {"variant": self.variant, "env_id": self.env_id, "env_kwargs": key,
+                "config": cfg.to_dict(), "env_steps": self.step,
+                "updates": agent.num_updates, "seed": cfg.seed, "torch": str(torch.__version__)}
+        atomic_write(self.out_dir / "actor.pt", lambda f: torch.save(agent.actor_state(meta), f))
+        summary = {"variant": self.variant, "env_id": self.env_id, "env_kwargs": key,
+                   "env_steps": self.step, "updates": agent.num_updates,
+                   "episodes": self.episodes, "wall_s": round(self.wall(), 3), "actor": "actor.pt",
+                   "final_eval": {k: (None if isinstance(v, float) and math.isnan(v) else v)
+                                  for k, v in last_row.items()},
+                   # wall_s is core time only on the machine that ran it: the budget study shows which
+                   "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
+                   "config": cfg.to_dict()}
+        atomic_json(self.done_path, summary)
+        if not cfg.keep_checkpoint and self.ckpt_path.exists():
+            self.ckpt_path.unlink()
+            try:
+                self.ckpt_path.parent.rmdir()
+            except OSError:  # not empty: leave other files alone
+                pass
+        return summary

@@ -39,6 +39,18 @@ def scenario_file(placement, height):
     return f"{RESULTS}/scenarios/{LAYOUT}/{placement}/h{height}.csv"
 
 
+def table1_scenario_files():
+    """The scenario set of every Table 1 cell in every home."""
+    return expand(f"{RESULTS}/scenarios/{{home}}/{{placement}}/h{{height}}.csv",
+                  home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def pathlength_files(variants=None):
+    """`pathlength`'s outputs per variant: its numbers under results/, its table and figure under paper_figs/."""
+    return [path for v in (variants or VARIANTS)
+            for path in (f"{RESULTS}/pathlength/{v}.csv", *(f"{FIGS}/pathlength_{v}.{ext}" for ext in ("md", "png", "pdf")))]
+
+
 def eval_files(variant, homes=None):
     return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
                   seed=SEEDS, home=homes or HOMES, placement=PLACEMENTS, height=HEIGHTS)

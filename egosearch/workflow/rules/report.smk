@@ -111,6 +111,31 @@ rule fig7_oracle:
         "egosearch report fig7 {input} --out-prefix {params.prefix} --planner oracle > {log} 2>&1"
 
 
+rule pathlength:
+    """Success by shortest path length and by detour for one variant, every Table 1 cell pooled and per
+    camera height, beside the reference searchers on the same scenarios."""
+    input:
+        policy=ancient(lambda wc: eval_files(wc.variant)),
+        scenarios=ancient(table1_scenario_files()),
+        bounds=ancient(bound_files()),
+    output:
+        csv=f"{RESULTS}/pathlength/{{variant}}.csv",
+        md=f"{FIGS}/pathlength_{{variant}}.md",
+        png=f"{FIGS}/pathlength_{{variant}}.png",
+        pdf=f"{FIGS}/pathlength_{{variant}}.pdf",
+    log:
+        f"{RESULTS}/logs/report/pathlength_{{variant}}.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/pathlength_{{variant}}.tsv"
+    params:
+        prefix=lambda wc, output: output.md.rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report pathlength {input.policy} --scenarios {input.scenarios} --bounds {input.bounds} "
+        "--out-prefix {params.prefix} --out-csv {output.csv} > {log} 2>&1"
+
+
 rule pictures:
     """The world's pictures: top-down map, placements, first/third-person views."""
     output:
@@ -129,25 +154,30 @@ rule pictures:
 
 
 rule compare:
-    """Does a new variant beat the stored reference? Per cell: difference, 95% CI, p-value."""
+    """Does a new variant beat the stored reference? Per cell: difference, 95% CI, p-value; and the
+    same per shortest-path bin, every cell pooled."""
     input:
         reference=ancient(eval_files(REF)),
         candidate=compare_candidate,
     output:
-        f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
+        cells=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
+        by_length=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_by_length.csv",
     log:
         f"{RESULTS}/logs/report/compare_{config.get('variant') or 'none'}.log",
     conda:
         CONDA_ENV
     shell:
+        # writes {output.by_length} beside {output.cells} (egosearch.report.pathlength.by_length_path)
         "egosearch report compare --reference {input.reference} --candidate {input.candidate} "
-        "--out {output} 2>&1 | tee {log}"
+        "--out {output.cells} 2>&1 | tee {log}"
 
 
 rule provenance:
     """Commit, profile, machine, date, the wall time of every rule and the sha256 of every stored
     result file, next to the results. Every result of `all` is an input, so that the record is
-    rewritten whenever one of them is."""
+    checked whenever one of them is rewritten; update() keeps the old record in place (Snakemake
+    would delete it first), so that the command leaves it byte for byte as it was when no stored
+    file changed (`egosearch report regenerate` rewrites identical files)."""
     input:
         ancient([eval_files(v) for v in VARIANTS]),
         ancient(bound_files()),
@@ -157,8 +187,9 @@ rule provenance:
         rules.fig7.output,
         rules.fig7_oracle.output,
         rules.video.output,
+        pathlength_files(),
     output:
-        provenance_file(),
+        update(provenance_file()),
     log:
         f"{RESULTS}/logs/report/provenance.log",
     params:

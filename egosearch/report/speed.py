@@ -1,0 +1,135 @@
+"""The docs' speed figures, generated from stored benchmark records and training curves.
+
+``egosearch bench env|learner --out results/<profile>/bench/{env,learner}.json`` stores a benchmark's
+result with its command, date, commit, CPU and the machine's load (:func:`egosearch.bench.recorded`);
+:func:`block_speed` renders them, and the env steps per core-second of the stored trainings from
+their ``curve.csv``, so that no speed figure in the docs is typed. CSV and JSON in, Markdown out.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pandas as pd
+
+ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
+"""The issue's one-core targets for the sensor and the env."""
+UPDATES_TARGET = 12.0
+"""The issue's target for SAC+CURL updates/s at Table 2 settings."""
+CORE_S_TARGET = 150.0
+"""The issue's target for env steps per core-second of a whole cpu-profile training."""
+
+LEARNER_KEYS = (
+    ("naive", "CURL's update line by line"),
+    ("table2", "fused Adam, channels-last, uint8 crops on device, shared passes where CURL's order allows; "
+               "same math"),
+    ("table2_shared", "also reuses the critic's encoder pass for CURL and the actor: one optimiser step stale, "
+                      "off by default"),
+    ("table2_1thread", "the same on one thread"),
+    ("cpu_profile", "SAC-DrQ with the privileged critic, batch 64, one thread"),
+)
+
+
+def _bench_command(profile: str, what: str) -> str:
+    return f"egosearch bench {what} --json --out results/{profile}/bench/{what}.json"
+
+
+def _missing(root: Path, path: Path, profile: str, what: str) -> str:
+    return (f"*Not measured yet: `{path.relative_to(root)}` is missing (on an otherwise idle machine: "
+            f"`{_bench_command(profile, what)}`).*")
+
+
+def _measured_on(record: dict) -> str:
+    machine = record.get("machine", {})
+    load = record.get("load_average_before")
+    other = record.get("other_load_cores")
+    busy = ("other processes used " + (f"{other:.2f}" if other is not None else "?") + " cores meanwhile"
+            + (f", load average {load[0]:.2f} before" if load else ""))
+    commit = (record.get("commit") or "unknown")[:7] + (" with local changes" if record.get("commit_dirty") else "")
+    return (f"`{record.get('command', '?')}` on {record.get('date_utc', '?')[:10]}, commit `{commit}`, "
+            f"{machine.get('cpu', '?')} with {machine.get('cores', '?')} cores ({busy}; {record.get('wall_s', '?')} s "
+            "in all)")
+
+
+def _met(value: float, target: float) -> str:
+    return "met" if value >= target else "not met"
+
+
+def _env_lines(root: Path, profile: str) -> list[str]:
+    path = root / "results" / profile / "bench" / "env.json"
+    if not path.exists():
+        return [_missing(root, path, profile, "env")]
+    record = json.loads(path.read_text(encoding="utf-8"))
+    r = record["result"]
+    return [f"Env and sensor, one pinned core, `{r['layout']}` ({r['triangles']:,} triangles): "
+            f"**{r['sensor_frames_per_s']:,.0f} sensor frames/s** ({r['sensor_ms_per_frame']} ms a frame; target "
+            f"1,000: {_met(r['sensor_frames_per_s'], ENV_TARGETS['sensor_frames_per_s'])}) and "
+            f"**{r['env_steps_per_s']:,.0f} env steps/s** ({r['env_ms_per_step']} ms a step, "
+            f"{r['env_resets_included']} resets included; target 700: "
+            f"{_met(r['env_steps_per_s'], ENV_TARGETS['env_steps_per_s'])}). Measured by "
+            + _measured_on(record) + f"; from `{path.relative_to(root)}`."]
+
+
+def _learner_lines(root: Path, profile: str) -> list[str]:
+    path = root / "results" / profile / "bench" / "learner.json"
+    if not path.exists():
+        return [_missing(root, path, profile, "learner")]
+    record = json.loads(path.read_text(encoding="utf-8"))
+    r = record["result"]
+    lines = ["Learner (Table 2 settings: batch 32, 5×84×84, all cores unless stated; updates/s from the median "
+             "update time, the fastest in brackets), measured by " + _measured_on(record) + ":", "",
+             "| key | updates/s |", "|---|---|"]
+    for key, meaning in LEARNER_KEYS:
+        if f"updates_per_s_{key}" in r:
+            lines.append(f"| `updates_per_s_{key}` ({meaning}) | {r[f'updates_per_s_{key}']} "
+                         f"({r.get(f'updates_per_s_{key}_best', '–')}) |")
+    if "replay_gb_100k" in r:
+        lines.append(f"| `replay_gb_100k` | {r['replay_gb_100k']} GB |")
+    lines.append("")
+    table2 = r.get("updates_per_s_table2")
+    if table2 is not None:
+        lines.append(f"Table 2 updates/s against the issue's target of {UPDATES_TARGET:g}: "
+                     f"{_met(table2, UPDATES_TARGET)}.")
+    rate, run = r.get("env_steps_per_core_s_cpu_profile"), r.get("cpu_profile_run", {})
+    if rate is not None:
+        steps = f"{run['env_steps']:,}" if "env_steps" in run else "short"
+        lines.append(f"**`env_steps_per_core_s_cpu_profile` {rate}**: env steps per core-second of a "
+                     f"{steps}-step real training run of the `cpu` profile in `kitchen_living` "
+                     f"(building the envs and writing its checkpoint, env stepping, acting and updates all in; "
+                     f"core-seconds are the process's own CPU time, {run.get('core_s', '?')} s); the issue's target "
+                     f"of {CORE_S_TARGET:g}: {_met(rate, CORE_S_TARGET)}.")
+    return lines + ["", f"From `{path.relative_to(root)}`."]
+
+
+def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
+    """Env steps per core-second of every stored training of ``variants`` (final env steps over the
+    final ``wall_s`` of its curve.csv, times its torch threads)."""
+    rows = []
+    for variant in variants:
+        for curve in sorted((root / "results" / profile / "train" / variant).glob("seed*/curve.csv")):
+            last = pd.read_csv(curve).sort_values("env_steps").iloc[-1]
+            threads = 1
+            done = curve.parent / "done.json"
+            if done.exists():
+                threads = int(json.loads(done.read_text()).get("config", {}).get("num_threads") or 1) or 1
+            if not math.isnan(last.get("wall_s", math.nan)):
+                rows.append((variant, curve.parent.name, int(last.env_steps), float(last.wall_s), threads))
+    if not rows:
+        return []
+    lines = ["Stored trainings (whole runs: start-up weighs less than in the benchmark's short run):", "",
+             "| variant | seed | env steps | wall s | threads | env steps per core-second |",
+             "|---|---|---|---|---|---|"]
+    for variant, seed, steps, wall, threads in rows:
+        lines.append(f"| `{variant}` | {seed.removeprefix('seed')} | {steps:,} | {wall:,.0f} | {threads} | "
+                     f"{steps / (wall * threads):.0f} |")
+    return lines + ["", f"From `results/{profile}/train/<variant>/seed<N>/curve.csv` (last row's `wall_s`)."]
+
+
+def block_speed(root: Path, profile: str) -> str:
+    from egosearch.report.readme import variants_of_all
+
+    sections = [_env_lines(root, profile), _learner_lines(root, profile),
+                _training_lines(root, profile, variants_of_all())]
+    return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"

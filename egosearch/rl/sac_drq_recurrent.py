@@ -1,0 +1,486 @@
+"""Recurrent SAC-DrQ: :mod:`egosearch.rl.sac_drq` with a GRU memory in the actor and in the critic.
+
+NOT the paper's learner, nor the cpu profile's: a lever for the searcher's ceiling. The
+memoryless learners see the last ``frame_history`` depth frames and nothing older, so a search
+cannot know where it has already looked. Here the actor and the critic each carry a GRU state
+over the whole episode.
+
+After Ni et al. 2022 ("Recurrent model-free RL can be a strong baseline for many POMDPs",
+github.com/twni2016/pomdp-baselines): SEPARATE recurrent networks for the actor and the critic
+(their most robust setting; a shared RNN trained by both losses was unstable there), and after
+R2D2 (Kapturowski et al. 2019): replay of contiguous sequences, whose first ``burn_in`` steps
+only warm the hidden state up (no gradient) before the ``sequence_length`` steps that carry the
+losses, with zero initial states (R2D2's "zero start state" plus burn-in).
+
+What it keeps from SAC-DrQ: ONE conv encoder (:class:`PooledConvEncoder`) trained by the critic
+loss only, read detached by the actor; random-shift augmentation (one shift per sequence, so
+that the memory sees a steady camera); pooled uint8 frames in the replay; n-step returns;
+twin Q-heads with a Polyak target (here the target also holds a copy of the critic's GRU);
+the optional privileged critic (the state enters the Q-heads, not the GRU).
+
+Per step, a network's GRU reads [projected conv features, mask, proprio] and its head reads
+[GRU output, projected conv features, mask, proprio] (the current observation stays one layer
+away from the output, as in the memoryless learner, and as pomdp-baselines' recommended
+architecture keeps a branch for the current observation). Unlike Ni et al., the GRUs do not read
+the previous action and reward (the observation's proprio already holds the last head motion);
+feeding them is a further option, not tried here.
+
+Sequences (:func:`sample_sequences`) are windows of ``burn_in + sequence_length`` consecutive
+transitions of one env's ring (:class:`egosearch.rl.replay.MultiReplay` is reused unchanged, so
+checkpoints hold the same replay), plus the last transition's next observation. A window may
+span episode boundaries: the hidden state is zeroed at every episode's first step (``first``),
+exactly as acting zeroes it when an env resets, and an n-step target never bootstraps from an
+observation of another episode (a truncated step whose next observation is not in the window is
+left out of the critic loss: ``loss_mask``).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from typing import Any
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+from egosearch.rl.common import (
+    AgentStateError,
+    Projection,
+    actor_weights,
+    adam,
+    crop_at,
+    gaussian_entropy,
+    load_actor_weights,
+    metric_values,
+    mlp,
+    obs_to_tensors,
+    resolve_device,
+    squashed_sample,
+    weight_init,
+)
+from egosearch.rl.config import LearnerConfig
+from egosearch.rl.replay import MultiReplay, ReplayBuffer
+from egosearch.rl.sac_drq import _ARCH_FIELDS as _DRQ_ARCH_FIELDS
+from egosearch.rl.sac_drq import PooledConvEncoder, _encoder, pool_depth, pooled_side
+
+AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
+ACTOR_FORMAT = "egosearch-sac-drq-recurrent-actor-v1"
+_ARCH_FIELDS = (*_DRQ_ARCH_FIELDS, "recurrent_hidden_dim")
+
+
+def sequences_per_batch(cfg: LearnerConfig) -> int:
+    """Sequences per update: ``batch_size`` counts the steps that carry a loss, as the memoryless
+    learners' batch does, so an update costs about as many conv passes as theirs."""
+    return max(1, cfg.batch_size // cfg.sequence_length)
+
+
+# ---- recurrent cores ------------------------------------------------------------------------
+
+def run_gru(cell: nn.GRUCell, x: torch.Tensor, first: torch.Tensor, h: torch.Tensor | None = None) -> torch.Tensor:
+    """``cell`` over (B, T, D) inputs from state ``h`` (zeros if None), zeroing the state before
+    every step whose ``first`` (B, T) is 1 (an episode's first step). Returns (B, T, H): the state
+    after each step."""
+    b, t = x.shape[:2]
+    if h is None:
+        h = x.new_zeros(b, cell.hidden_size)
+    keep = (1.0 - first).unsqueeze(-1)
+    out = []
+    for i in range(t):
+        h = cell(x[:, i], h * keep[:, i])
+        out.append(h)
+    return torch.stack(out, dim=1)
+
+
+class RecurrentActorHead(nn.Module):
+    """Projection -> GRU over [embedding, mask, proprio] -> MLP on [GRU, embedding, mask, proprio]
+    -> (mu, log_std) with CURL's log-std squashing."""
+
+    def __init__(self, conv_dim: int, arch: dict[str, Any]):
+        super().__init__()
+        latent, extra, hidden = arch["encoder_latent_dim"], arch["extra_dim"], arch["recurrent_hidden_dim"]
+        self.proj = Projection(conv_dim, latent, arch["encoder_tanh"])
+        self.gru = nn.GRUCell(latent + extra, hidden)
+        self.trunk = mlp(hidden + latent + extra, arch["actor_hidden_dim"], 2 * arch["action_dim"],
+                         arch["actor_num_layers"], arch["actor_activation"])
+        self.log_std_min, self.log_std_max = float(arch["actor_log_std_min"]), float(arch["actor_log_std_max"])
+
+    def inputs(self, feats: torch.Tensor, extra: torch.Tensor) -> torch.Tensor:
+        return torch.cat([self.proj(feats), extra], dim=-1)
+
+    def out(self, mem: torch.Tensor, x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        mu, log_std = self.trunk(torch.cat([mem, x], dim=-1)).chunk(2, dim=-1)
+        log_std = torch.tanh(log_std)
+        return mu, self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
+
+    def step(self, feats: torch.Tensor, extra: torch.Tensor, h: torch.Tensor | None):
+        """One acting step: (mu, log_std, new state) for (B, F) features and a (B, H) state."""
+        x = self.inputs(feats, extra)
+        h = self.gru(x, h if h is not None else x.new_zeros(x.shape[0], self.gru.hidden_size))
+        mu, log_std = self.out(h, x)
+        return mu, log_std, h
+
+
+class RecurrentCritic(nn.Module):
+    """Projection -> GRU over [embedding, mask, proprio] -> twin Q-heads on [GRU, embedding, mask,
+    proprio, (privileged state), action]. Its Polyak copy is the target critic, GRU included."""
+
+    def __init__(self, conv_dim: int, cfg: LearnerConfig, extra_dim: int, state_dim: int, action_dim: int):
+        super().__init__()
+        latent, hidden = cfg.encoder_latent_dim, cfg.recurrent_hidden_dim
+        self.proj = Projection(conv_dim, latent, cfg.encoder_tanh)
+        self.gru = nn.GRUCell(latent + extra_dim, hidden)
+        in_dim = hidden + latent + extra_dim + state_dim + action_dim
+        self.q1 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation)
+        self.q2 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation)
+
+    def inputs(self, feats: torch.Tensor, extra: torch.Tensor) -> torch.Tensor:
+        return torch.cat([self.proj(feats), extra], dim=-1)
+
+    def q(self, mem: torch.Tensor, x: torch.Tensor, state: torch.Tensor | None, action: torch.Tensor):
+        parts = [mem, x] + ([state] if state is not None else []) + [action]
+        z = torch.cat(parts, dim=-1)
+        return self.q1(z), self.q2(z)
+
+
+def _sequence_memory(x: torch.Tensor, first: torch.Tensor, gru: nn.GRUCell, burn_in: int) -> torch.Tensor:
+    """GRU states over a whole window; the first ``burn_in`` steps run without autograd, so no
+    gradient reaches them (R2D2's burn-in) and their backward pass costs nothing."""
+    if burn_in <= 0:
+        return run_gru(gru, x, first)
+    with torch.no_grad():
+        warm = run_gru(gru, x[:, :burn_in], first[:, :burn_in])
+    rest = run_gru(gru, x[:, burn_in:], first[:, burn_in:], warm[:, -1])
+    return torch.cat([warm, rest], dim=1)
+
+
+class RecurrentDrqActorNet(nn.Module):
+    """What acting needs: encoder + recurrent actor head. ``forward(depth, extra, h)`` takes the
+    env's uint8 depth (B, K, H, W) and the state (None at an episode's start) and returns
+    (mu, log_std, new state)."""
+
+    recurrent = True
+
+    def __init__(self, arch: dict[str, Any]):
+        super().__init__()
+        self.arch = dict(arch)
+        self.encoder = _encoder(arch)
+        self.head = RecurrentActorHead(self.encoder.out_dim, arch)
+
+    def forward(self, depth: torch.Tensor, extra: torch.Tensor, h: torch.Tensor | None = None):
+        return self.head.step(self.encoder(self.encoder.pool(depth)), extra, h)
+
+
+# ---- sequence replay --------------------------------------------------------------------------
+
+def sample_ring_sequences(buf: ReplayBuffer, starts: np.ndarray, burn_in: int, length: int, n_step: int,
+                          gamma: float) -> dict[str, np.ndarray]:
+    """Windows of ``burn_in + length`` transitions of ring ``buf`` starting at absolute indices
+    ``starts`` (B,), as numpy arrays (see :func:`sample_sequences` for the keys)."""
+    w = burn_in + length
+    idx = np.asarray(starts, np.int64)[:, None] + np.arange(w)[None, :]  # (B, W)
+    b = idx.shape[0]
+    i = idx % buf.capacity
+    fn = buf.frame_numbers(idx.reshape(-1)).reshape(b, w, buf.k + 1)
+    frame_no = np.concatenate([fn[:, :, :-1], fn[:, -1:, 1:]], axis=1)  # (B, W+1, K): obs..., last next_obs
+    depth = buf.frames[frame_no % buf.n_frames]
+    last = i[:, -1]
+    extra = np.concatenate([np.concatenate([buf.mask[i], buf.proprio[i]], -1),
+                            np.concatenate([buf.next_mask[last], buf.next_proprio[last]], -1)[:, None]], axis=1)
+    first = np.zeros((b, w + 1), np.float32)
+    first[:, :w] = buf.t_in_ep[i] == 0
+    term, trunc, reward = buf.terminated[i], buf.truncated[i], buf.reward[i].astype(np.float64)
+    # n-step targets of the positions that carry a loss, all at once: (B, L) arrays
+    pos = burn_in + np.arange(length)
+    ret = np.zeros((b, length))
+    disc = np.ones((b, length))
+    m = np.zeros((b, length), np.int64)
+    not_done = np.ones((b, length), np.float32)
+    loss_mask = np.ones((b, length), np.float32)
+    open_ = np.ones((b, length), bool)
+    for j in range(n_step):
+        q = pos + j
+        qc = np.minimum(q, w - 1)
+        te, tr = term[:, qc], trunc[:, qc]
+        # a truncated step's next observation is in the window only as its last one (o_W):
+        # elsewhere o_{q+1} is the next episode's reset observation, so the return stops before
+        # that step, or, when it is the position's own step, the position carries no critic loss
+        cut = tr & ~te & (q < w - 1)[None, :]
+        if j == 0:
+            loss_mask[cut] = 0.0
+        else:
+            open_ &= ~cut
+        open_ &= (q < w)[None, :]
+        ret += np.where(open_, disc * reward[:, qc], 0.0)
+        disc = np.where(open_, disc * gamma, disc)
+        m += open_
+        not_done[open_ & te] = 0.0
+        open_ &= ~(te | tr)
+    boot = pos[None, :] + m
+    out = {"depth": depth, "extra": extra, "first": first, "action": buf.action[i],
+           "reward": ret.astype(np.float32), "discount": disc.astype(np.float32), "boot": boot,
+           "not_done": not_done, "loss_mask": loss_mask, "index": idx}
+    if buf.state_dim:
+        out["state"] = np.concatenate([buf.state[i], buf.next_state[last][:, None]], axis=1)
+    return out
+
+
+def sample_sequences(replay: MultiReplay, num_sequences: int, burn_in: int, length: int, n_step: int,
+                     gamma: float, device: torch.device | str = "cpu") -> dict[str, torch.Tensor]:
+    """``num_sequences`` windows spread evenly over the env rings (as :meth:`MultiReplay.sample`
+    spreads transitions), each drawn uniformly from its ring's stored windows with the ring's RNG.
+
+    Keys (B sequences, W = burn_in + length windows, T = W + 1 observations):
+    ``depth`` (B, T, K, H, W) uint8, ``extra`` (B, T, mask + proprio), ``first`` (B, T) 1 at an
+    episode's first step, ``action`` (B, W, A), ``state`` (B, T, S) with a privileged critic;
+    for the last ``length`` positions: ``reward`` (n-step sum), ``discount`` (gamma^m), ``boot``
+    (index 0..W of the observation the target bootstraps from), ``not_done``, ``loss_mask``;
+    ``index`` (B, W) absolute transition numbers."""
+    w = burn_in + length
+    n = len(replay.buffers)
+    sizes = [num_sequences // n + (1 if i < num_sequences % n else 0) for i in range(n)]
+    parts = []
+    for buf, size in zip(replay.buffers, sizes):
+        lo, hi = buf._first_valid(), buf.n_added - w  # hi: the last start whose window is stored
+        if size == 0 or hi < lo:
+            continue
+        parts.append(sample_ring_sequences(buf, buf.rng.integers(lo, hi + 1, size=size), burn_in, length,
+                                           n_step, gamma))
+    if not parts:
+        raise ValueError(f"no env ring holds a window of {w} transitions (burn_in + sequence_length) yet")
+    dev = torch.device(device)
+    return {k: torch.from_numpy(np.ascontiguousarray(np.concatenate([p[k] for p in parts]))).to(dev)
+            for k in parts[0]}
+
+
+def shift_sequences(x: torch.Tensor, pad: int) -> torch.Tensor:
+    """DrQ-v2's random shift with ONE offset per sequence: (B, T, C, H, W) float."""
+    if pad <= 0:
+        return x
+    b, t, c, h, w = x.shape
+    oy = torch.randint(0, 2 * pad + 1, (b,), device=x.device).repeat_interleave(t)
+    ox = torch.randint(0, 2 * pad + 1, (b,), device=x.device).repeat_interleave(t)
+    padded = F.pad(x.reshape(b * t, c, h, w), (pad, pad, pad, pad), mode="replicate")
+    return crop_at(padded, oy, ox, h).reshape(b, t, c, h, w)
+
+
+# ---- the agent ------------------------------------------------------------------------------
+
+class SacDrqRecurrentAgent:
+    """Recurrent SAC-DrQ (module docstring). Same driving interface as :class:`SacDrqAgent`, plus
+    ``sample_batch(replay)`` (sequences instead of transitions), ``reset_state(env_index)`` (an
+    env's episode ended) and ``reset_policy_state()`` (an evaluation episode starts)."""
+
+    def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
+                 device: str | torch.device | None = None, state_dim: int = 0):
+        self.cfg = cfg.validate()
+        self.device = resolve_device(cfg.device) if device is None else torch.device(device)
+        self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
+        if cfg.critic_privileged_state and state_dim < 1:
+            raise ValueError("critic_privileged_state needs the env's privileged state (state_dim >= 1)")
+        self.state_dim = int(state_dim) if cfg.critic_privileged_state else 0
+        arch = self.arch()
+        self.encoder: PooledConvEncoder = _encoder(arch)
+        self.critic = RecurrentCritic(self.encoder.out_dim, cfg, arch["extra_dim"], self.state_dim, self.action_dim)
+        self.actor = RecurrentActorHead(self.encoder.out_dim, arch)
+        for net in (self.encoder, self.critic, self.actor):
+            net.apply(weight_init)
+            net.to(self.device)
+        self.critic_target = copy.deepcopy(self.critic)
+        for p in self.critic_target.parameters():
+            p.requires_grad_(False)
+        self.log_alpha = torch.tensor(math.log(cfg.init_temperature), device=self.device, requires_grad=True)
+        self.target_entropy = -float(self.action_dim)
+        self.num_updates = 0
+        self.critic_opt = adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
+                                {"params": self.encoder.parameters(), "lr": cfg.encoder_lr}],
+                               cfg.critic_lr, (cfg.critic_beta1, cfg.critic_beta2))
+        self.actor_opt = adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
+        self.alpha_opt = adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
+        self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
+        # acting states, never checkpointed: train.py cuts every episode at a checkpoint
+        self._h: torch.Tensor | None = None  # (num envs, H) of the training envs
+        self._eval_h: torch.Tensor | None = None  # the single evaluation episode's
+
+    @property
+    def alpha(self) -> float:
+        return float(self.log_alpha.detach().exp())
+
+    @property
+    def replay_image_size(self) -> int:
+        return pooled_side(self.cfg.image_size, self.cfg.obs_downsample)
+
+    def replay_obs(self, obs: dict) -> dict:
+        return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), self.cfg.obs_downsample)}
+
+    # ---- acting --------------------------------------------------------------------------
+    def reset_state(self, env_index: int | None = None) -> None:
+        """Zero the hidden state of training env ``env_index`` (all of them for None)."""
+        if self._h is None:
+            return
+        if env_index is None:
+            self._h = None
+        else:
+            self._h[env_index] = 0.0
+
+    def reset_policy_state(self) -> None:
+        """Zero the evaluation policy's hidden state (:class:`egosearch.rl.train.AgentPolicy`)."""
+        self._eval_h = None
+
+    def _step(self, obs: dict, h: torch.Tensor | None, deterministic: bool):
+        with torch.inference_mode():
+            depth, extra = obs_to_tensors(obs, self.device, self.cfg.image_size)
+            mu, log_std, h = self.actor.step(self.encoder(self.encoder.pool(depth)), extra, h)
+            a = torch.tanh(mu) if deterministic else squashed_sample(mu, log_std, torch.randn_like(mu))[0]
+        return a.float().cpu().numpy(), h
+
+    def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
+        """Actions (B, A) of the first B training envs (a stacked batch), carrying their states."""
+        b = np.asarray(obs["mask"]).reshape(-1, self.mask_dim).shape[0]
+        if self._h is None or self._h.shape[0] < b:
+            grown = torch.zeros(max(b, self.cfg.num_envs), self.cfg.recurrent_hidden_dim, device=self.device)
+            if self._h is not None:
+                grown[: self._h.shape[0]] = self._h
+            self._h = grown
+        a, h = self._step(obs, self._h[:b], deterministic)
+        self._h[:b] = h
+        return a
+
+    def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
+        """One observation of the EVALUATION episode (its own state; see ``reset_policy_state``)."""
+        a, self._eval_h = self._step(obs, self._eval_h, deterministic)
+        return a[0]
+
+    # ---- updating ------------------------------------------------------------------------
+    def sample_batch(self, replay: MultiReplay) -> dict[str, torch.Tensor]:
+        cfg = self.cfg
+        return sample_sequences(replay, sequences_per_batch(cfg), cfg.burn_in, cfg.sequence_length, cfg.n_step,
+                                cfg.gamma, self.device)
+
+    def _features(self, depth: torch.Tensor) -> torch.Tensor:
+        """Conv features (B, T, F) of shifted pooled frames; burn-in frames without autograd."""
+        b, t = depth.shape[:2]
+        burn = self.cfg.burn_in
+
+        def enc(x: torch.Tensor) -> torch.Tensor:
+            return self.encoder(x.reshape(-1, *x.shape[2:])).reshape(x.shape[0], x.shape[1], -1)
+
+        if burn <= 0:
+            return enc(depth)
+        with torch.no_grad():
+            warm = enc(depth[:, :burn])
+        return torch.cat([warm, enc(depth[:, burn:])], dim=1)
+
+    def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
+        cfg = self.cfg
+        self.num_updates += 1
+        burn, length = cfg.burn_in, cfg.sequence_length
+        depth = shift_sequences(batch["depth"].float(), cfg.aug_pad)
+        extra, first = batch["extra"], batch["first"]
+        state = batch.get("state") if self.state_dim else None
+        train = slice(burn, burn + length)
+        boot = batch["boot"]
+        mask = batch["loss_mask"]
+        alpha = self.log_alpha.detach().exp()
+        out: dict[str, torch.Tensor] = {}
+
+        feats = self._features(depth)  # grad only after the burn-in
+        feats_d = feats.detach()
+
+        def at(x: torch.Tensor, index: torch.Tensor) -> torch.Tensor:  # x (B, T, D), index (B, L)
+            return x.gather(1, index.unsqueeze(-1).expand(-1, -1, x.shape[-1]))
+
+        with torch.no_grad():
+            xa = self.actor.inputs(feats_d, extra)
+            mem_a = run_gru(self.actor.gru, xa, first)
+            xa_b = at(xa, boot)
+            mu, log_std = self.actor.out(at(mem_a, boot), xa_b)
+            next_pi, next_log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
+            xt = self.critic_target.inputs(feats_d, extra)
+            mem_t = run_gru(self.critic_target.gru, xt, first)
+            tq1, tq2 = self.critic_target.q(at(mem_t, boot), at(xt, boot),
+                                            at(state, boot) if state is not None else None, next_pi)
+            bootstrap = (batch["not_done"] * batch["discount"]).unsqueeze(-1)
+            target_q = batch["reward"].unsqueeze(-1) + bootstrap * (torch.min(tq1, tq2) - alpha * next_log_pi)
+
+        xc = self.critic.inputs(feats, extra)
+        mem_c = _sequence_memory(xc, first, self.critic.gru, burn)
+        st = state[:, train] if state is not None else None
+        q1, q2 = self.critic.q(mem_c[:, train], xc[:, train], st, batch["action"][:, train])
+        weight = mask.unsqueeze(-1) / mask.sum().clamp(min=1.0)
+        critic_loss = (weight * ((q1 - target_q) ** 2 + (q2 - target_q) ** 2)).sum()
+        self.critic_opt.zero_grad(set_to_none=True)
+        critic_loss.backward()
+        self.critic_opt.step()
+        out["critic_loss"], out["q_mean"] = critic_loss, (q1 * weight).sum()
+
+        if self.num_updates % cfg.actor_update_freq == 0:
+            xa = self.actor.inputs(feats_d, extra)
+            mem = _sequence_memory(xa, first, self.actor.gru, burn)
+            mu, log_std = self.actor.out(mem[:, train], xa[:, train])
+            pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
+            # the critic's memory as it was before its step (not recomputed: a GRU pass saved);
+            # its Q-heads and projection are the stepped ones
+            xc_now = self.critic.inputs(feats_d[:, train], extra[:, train])
+            aq1, aq2 = self.critic.q(mem_c[:, train].detach(), xc_now, st, pi)
+            actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
+            self.actor_opt.zero_grad(set_to_none=True)
+            actor_params = list(self.actor.parameters())
+            for p, g in zip(actor_params, torch.autograd.grad(actor_loss, actor_params)):
+                p.grad = g
+            self.actor_opt.step()
+            alpha_loss = (self.log_alpha.exp() * (-log_pi - self.target_entropy).detach()).mean()
+            self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
+            self.alpha_opt.step()
+            out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
+            out["entropy"] = gaussian_entropy(log_std.reshape(-1, log_std.shape[-1]))
+
+        if self.num_updates % cfg.critic_target_update_freq == 0:
+            with torch.no_grad():
+                torch._foreach_lerp_(list(self.critic_target.parameters()), list(self.critic.parameters()),
+                                     cfg.critic_tau)
+        out["alpha"] = self.log_alpha.detach().exp()
+        return metric_values(out, self.device)
+
+    # ---- persistence -----------------------------------------------------------------------
+    def arch(self) -> dict[str, Any]:
+        arch = {name: getattr(self.cfg, name) for name in _ARCH_FIELDS}
+        arch.update(action_dim=self.action_dim, mask_dim=self.mask_dim, proprio_dim=self.proprio_dim,
+                    extra_dim=self.mask_dim + self.proprio_dim, crop_size=self.cfg.image_size)
+        if self.state_dim:
+            arch["critic_state_dim"] = self.state_dim
+        return arch
+
+    def state_dict(self) -> dict[str, Any]:
+        return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),
+                "critic": self.critic.state_dict(), "critic_target": self.critic_target.state_dict(),
+                "actor": self.actor.state_dict(), "log_alpha": self.log_alpha.detach().clone(),
+                "optimisers": {k: opt.state_dict() for k, opt in self.optimisers.items()},
+                "num_updates": self.num_updates}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        if not isinstance(state, dict) or state.get("format") != AGENT_FORMAT:
+            raise AgentStateError("not a recurrent SAC-DrQ agent state "
+                                  f"(format={state.get('format') if isinstance(state, dict) else None!r})")
+        diff = sorted(k for k, v in self.arch().items() if state["arch"].get(k) != v)
+        if diff:
+            raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
+        for name in ("encoder", "critic", "critic_target", "actor"):
+            getattr(self, name).load_state_dict(state[name])
+        with torch.no_grad():
+            self.log_alpha.copy_(state["log_alpha"])
+        for k, opt in self.optimisers.items():
+            opt.load_state_dict(state["optimisers"][k])
+        self.num_updates = int(state["num_updates"])
+        self._h = self._eval_h = None
+
+    def actor_state(self, metadata: dict[str, Any] | None = None,
+                    storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
+        """Actor-only weights (encoder + recurrent head), float16 like the other actor files."""
+        weights = actor_weights({"encoder": self.encoder, "head": self.actor}, storage_dtype)
+        return {"format": ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights, "metadata": dict(metadata or {})}
+
+
+def load_recurrent_actor_net(state: dict[str, Any], device: str | torch.device = "cpu") -> RecurrentDrqActorNet:
+    return load_actor_weights(RecurrentDrqActorNet(state["arch"]), state, device)

@@ -1,0 +1,72 @@
+# Per-step traces and what they say about how the policies search (`snakemake --cores 2 behaviour
+# searches`, outside `all`): each trained policy reruns its Table 1 evaluation of the trace cells
+# with `--traces`. The runs are deterministic, so the episodes CSV beside each trace repeats the
+# stored evaluation row for row. Names: common.smk.
+
+# The humanoid's camera height of Section 6.3, with targets inside cabinets allowed.
+TRACE_CELLS = [("everywhere", "1.65")]
+# Figure 6's pair: the head moving, and held fixed.
+TRACE_VARIANTS = ["head_on", "head_off"]
+TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
+               for v in TRACE_VARIANTS for s in SEEDS for home in HOMES for placement, height in TRACE_CELLS]
+
+
+rule trace:
+    """One trained policy on one Table 1 cell, every step of every episode recorded."""
+    input:
+        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+    output:
+        trace="results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.npz",
+        episodes="results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output.episodes} --traces {output.trace} > {log} 2>&1"
+
+
+rule behaviour:
+    """Behaviour statistics per variant and head on minus head off, and the paper's behaviour
+    sentences (Section 6.3, Figure 6) with their verdicts."""
+    input:
+        ancient(TRACE_FILES),
+    output:
+        expand(f"{FIGS}/behaviour{{suffix}}", suffix=["_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md"]),
+    log:
+        f"{RESULTS}/logs/report/behaviour.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/behaviour.tsv"
+    params:
+        prefix=lambda wc, output: output[1].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report behaviour {input} --out-prefix {params.prefix} > {log} 2>&1"
+
+
+rule searches:
+    """Chosen searches of seed 0 on the floor plan, and where the camera looks, per trace cell."""
+    input:
+        ancient(TRACE_FILES),
+    output:
+        [f"{FIGS}/searches/{v}_{home}_{placement}_h{height}.png"
+         for v in TRACE_VARIANTS for home in HOMES for placement, height in TRACE_CELLS],
+        [f"{FIGS}/searches/gaze_{home}_{placement}_h{height}.png" for home in HOMES for placement, height in TRACE_CELLS],
+    log:
+        f"{RESULTS}/logs/report/searches.log",
+    params:
+        out_dir=lambda wc, output: str(Path(output[0]).parent),
+        seed=SEEDS[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report searches {input} --seed {params.seed} --out-dir {params.out_dir} > {log} 2>&1"

@@ -1,0 +1,196 @@
+"""Behaviour statistics from hand-built traces: the per-episode formulas, the ratio-of-sums summary with
+its intervals, the claims' verdicts and the README block (no simulator)."""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from egosearch.report.behaviour import (
+    behaviour_episodes,
+    behaviour_report,
+    block_claims,
+    claims_frame,
+    episode_behaviour,
+    revisit_steps,
+    summarise,
+)
+
+
+def _episode(**cols):
+    n = len(cols["x"])
+    base = {"scenario_id": [0] * n, "step": list(range(n)), "y": [0.0] * n, "theta": [0.0] * n,
+            "head_yaw": [0.0] * n, "pitch": [0.0] * n, "visible": [False] * n, "success": [False] * n,
+            "gaze_kind": ["none"] * n, "opening_distance": [5.0] * n}
+    base.update(cols)
+    return pd.DataFrame(base)
+
+
+# Five steps of 0.5 s along +x (theta = 0): step 3 goes back 0.2 m; steps 1, 2 and 5 start within 1 m of
+# an opening; the target is first seen after step 4 and gone again after step 5.
+HAND = _episode(x=[0.0, 0.25, 0.5, 0.3, 0.3, 0.8],
+                opening_distance=[0.5, 0.5, 1.5, 1.5, 0.8, 2.0],
+                visible=[False, False, False, False, True, False],
+                gaze_kind=["none", "shelf", "shelf", "surface", "low_cabinet_interior", "wall"],
+                pitch=[0.0, -0.2, -0.4, 0.0, -0.6, 0.1],
+                head_yaw=[0.0, 0.3, -0.1, -0.1, 0.2, 0.2])
+
+
+def test_one_hand_built_episode():
+    got = episode_behaviour(HAND, step_seconds=0.5)
+    assert got["steps"] == 5 and got["success"] == 0
+    # speeds 0.5, 0.5, 0.4, 0, 1.0 m/s; near at the starts of steps 1, 2, 5
+    assert (got["steps_near"], got["speed_near_sum"]) == (3, pytest.approx(2.0))
+    assert (got["steps_far"], got["speed_far_sum"]) == (2, pytest.approx(0.4))
+    # step 3 is the only backward step; the window is steps 1..4 (first sight after step 4)
+    assert (got["backward_steps"], got["window_steps"], got["backward_in_window"]) == (1, 4, 1)
+    assert (got["other_steps"], got["backward_other"]) == (1, 0)
+    # openings after steps 1, 2 and 4: two looks; one look at a table-like surface
+    assert (got["steps_gaze_opening"], got["opening_looks"]) == (3, 2)
+    assert (got["steps_gaze_surface"], got["surface_looks"]) == (1, 1)
+    assert got["pitch_gaze_opening_sum"] == pytest.approx(-1.2) and got["pitch_gaze_else_sum"] == pytest.approx(0.1)
+    assert got["head_yaw_sweep"] == pytest.approx(1.0) and got["body_turn"] == 0.0
+    assert got["camera_sweep"] == pytest.approx(1.0) and got["turning"] == pytest.approx(1.0)
+    assert (got["seen"], got["first_seen_steps"], got["lost_sight"], got["sight_to_success"]) == (1, 4, 1, 0)
+    # floor squares 0, 0, 1, 0, 0, 1: back into square 0 at step 3, stays at 4, back into 1 at 5
+    assert got["revisit_steps"] == 3
+
+
+def test_a_turn_across_pi_is_its_short_way_and_a_success_counts_from_first_sight():
+    ep = _episode(x=[0.0, 0.0, 0.0], theta=[3.1, -3.1, -3.0], head_yaw=[0.0, -0.1, -0.1],
+                  visible=[True, True, True], success=[False, False, True])
+    got = episode_behaviour(ep, step_seconds=0.15)
+    assert got["body_turn"] == pytest.approx((2 * math.pi - 6.2) + 0.1)
+    # camera heading 3.1 -> -3.2 -> -3.1: 2 pi - 6.3 the short way, then 0.1
+    assert got["camera_sweep"] == pytest.approx(abs(2 * math.pi - 6.3) + 0.1)
+    # seen at the reset: no window before it, nothing lost, success 2 steps after first sight
+    assert (got["first_seen_steps"], got["window_steps"], got["lost_sight"], got["sight_to_success"]) == (0, 0, 0, 2)
+
+
+def test_revisits_count_coming_back_not_staying():
+    # squares A A B A A C
+    assert revisit_steps([0.1, 0.2, 0.7, 0.2, 0.3, 1.2], [0.1] * 6) == 2
+    assert revisit_steps([0.1, 0.2, 0.3], [0.1] * 3) == 0
+
+
+def _episodes(variant, per_scenario, seeds=(0,), cell="kitchen_living/everywhere/h1.65"):
+    """Rows of behaviour_episodes from {scenario_id: {column: value}} (the other columns 0)."""
+    from egosearch.report.behaviour import STATISTICS
+
+    cols = {c for s in STATISTICS for c in (s.num, s.den, *(s.minus or ()))}
+    rows = []
+    for seed in seeds:
+        for sid, values in per_scenario.items():
+            rows.append({"variant": variant, "seed": seed, "cell": cell, "scenario_id": sid, "head": True,
+                         **{c: 0 for c in cols}, "episodes": 1, **values})
+    return pd.DataFrame(rows)
+
+
+def test_a_statistic_is_a_ratio_of_sums_and_a_contrast_pairs_the_scenarios():
+    on = _episodes("head_on", {0: {"success": 1, "steps": 20, "backward_steps": 4},
+                               1: {"success": 1, "steps": 80, "backward_steps": 4},
+                               2: {"success": 0, "steps": 100, "backward_steps": 0}}, seeds=(0, 1))
+    off = _episodes("head_off", {0: {"success": 1, "steps": 50}, 1: {"success": 0, "steps": 100},
+                                 2: {"success": 0, "steps": 100}, 3: {"success": 1, "steps": 10}}, seeds=(0, 1))
+    s = summarise(pd.concat([on, off]), n_resamples=2000).set_index(["variant", "statistic"])
+    assert s.loc[("head_on", "success"), "value"] == pytest.approx(2 / 3)
+    # 8 backward of 200 steps per seed: steps are pooled, not episode shares averaged (that gives 0.0667)
+    assert s.loc[("head_on", "backward_share"), "value"] == pytest.approx(8 / 200)
+    # paired on scenarios 0..2 only: 2/3 - 1/3
+    pair = s.loc[("head_on - head_off", "success")]
+    assert pair["value"] == pytest.approx(1 / 3) and pair["n_scenarios"] == 3
+    for key in (("head_on", "success"), ("head_on", "backward_share"), ("head_on - head_off", "success")):
+        assert s.loc[key, "ci_low"] <= s.loc[key, "value"] <= s.loc[key, "ci_high"]
+    # no step near an opening anywhere: no number, not a zero
+    assert math.isnan(s.loc[("head_on", "speed_near_opening"), "value"])
+
+
+def test_a_scenario_that_repeats_over_seeds_is_one_unit():
+    # the same two scenarios under 1 or 3 seeds with identical outcomes: the interval does not narrow
+    per = {0: {"success": 1}, 1: {"success": 0}}
+    one = summarise(_episodes("head_on", per, seeds=(0,)), n_resamples=4000).set_index("statistic")
+    three = summarise(_episodes("head_on", per, seeds=(0, 1, 2)), n_resamples=4000).set_index("statistic")
+    assert (three.loc["success", "ci_low"], three.loc["success", "ci_high"]) == (
+        one.loc["success", "ci_low"], one.loc["success", "ci_high"]) == (0.0, 1.0)
+
+
+def _summary(rows):
+    return pd.DataFrame([{"variant": v, "statistic": s, "value": x, "ci_low": lo, "ci_high": hi, "n_scenarios": 100,
+                          "n_seeds": 3} for v, s, x, lo, hi in rows])
+
+
+def test_verdicts_follow_the_side_of_the_interval():
+    summary = _summary([
+        ("head_on", "speed_near_minus_elsewhere", -0.2, -0.3, -0.1),      # slower near cabinets: holds
+        ("head_on", "dwell_opening_minus_surface", 0.4, -0.1, 0.9),       # straddles 0
+        ("head_on", "backward_before_sight_minus_other", -0.05, -0.08, -0.02),  # the other side
+        ("head_on", "success", 0.8, 0.7, 0.9),
+    ])
+    got = claims_frame(summary)
+    verdicts, details = list(got["verdict"]), list(got["detail"])
+    assert verdicts == ["holds", "does not hold", "does not hold", "not testable here", "not testable here"]
+    assert "includes 0" in details[1] and "other side" in details[2] and "head_off" in details[3]
+    summary = pd.concat([summary, _summary([("head_on - head_off", "success", 0.15, 0.05, 0.25),
+                                            ("head_on - head_off", "body_turn_per_step", 0.01, -0.02, 0.04)])])
+    got = claims_frame(summary)
+    assert list(got["verdict"])[3:] == ["holds", "does not hold"]
+    assert "+0.20 is inside" in got["detail"][3]
+
+
+def test_an_empty_measure_is_not_testable():
+    got = claims_frame(_summary([("head_on", "speed_near_minus_elsewhere", math.nan, math.nan, math.nan)]))
+    assert got["verdict"][0] == "not testable here" and "no step" in got["detail"][0]
+
+
+def _write_trace(path, episodes, head=True):
+    cols = {k: [] for k in ("scenario_id", "step", "x", "y", "theta", "head_yaw", "pitch", "visible", "success",
+                            "gaze_kind", "opening_distance")}
+    for sid, ep in episodes.items():
+        for k in cols:
+            cols[k] += list(ep[k]) if k != "scenario_id" else [sid] * len(ep)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, **{k: np.asarray(v) for k, v in cols.items()}, step_seconds=np.asarray(0.5),
+                        head=np.asarray(head))
+
+
+def test_trace_files_to_claims_and_the_readme_block(tmp_path):
+    root = tmp_path / "repo"
+    assert "Not yet stored" in block_claims(root, "cpu")
+    traces = root / "results" / "cpu" / "traces"
+    for variant in ("head_on", "head_off"):
+        for seed in (0, 1):
+            _write_trace(traces / variant / f"seed{seed}" / "kitchen_living" / "everywhere" / "h1.65.npz",
+                         {0: HAND, 3: HAND}, head=variant == "head_on")
+    paths = sorted(traces.rglob("*.npz"))
+    eps = behaviour_episodes(paths)
+    assert len(eps) == 8 and set(eps["cell"]) == {"kitchen_living/everywhere/h1.65"}
+    assert set(eps.loc[eps["variant"] == "head_off", "head"]) == {False}
+    written = behaviour_report(paths, root / "paper_figs" / "cpu" / "behaviour", n_resamples=500)
+    assert [p.name for p in written] == ["behaviour_episodes.csv", "behaviour.csv", "behaviour.md",
+                                         "behaviour_claims.csv", "behaviour_claims.md"]
+    block = block_claims(root, "cpu")
+    assert "moves slower" not in block and "move slower around cabinets" in block
+    # identical traces on both sides: the success gain is exactly 0, which is no gain
+    assert "| **does not hold**" in block.split("20% higher")[1].split("\n")[0]
+    with pytest.raises(ValueError, match="a second trace"):
+        behaviour_episodes(paths + paths[:1])
+
+
+def test_the_readme_block_and_the_command(tmp_path, capsys):
+    from egosearch.cli import main
+    from egosearch.report.readme import render_readme
+
+    root = tmp_path / "repo"
+    text = "<!-- egosearch:begin claims -->\nold\n<!-- egosearch:end claims -->\n"
+    assert "Not yet stored: `paper_figs/cpu/behaviour_claims.csv`" in render_readme(text, root, "cpu")
+    paths = []
+    for variant in ("head_on", "head_off"):
+        paths.append(root / "results" / "cpu" / "traces" / variant / "seed0" / "kitchen_living" / "everywhere" /
+                     "h1.65.npz")
+        _write_trace(paths[-1], {0: HAND, 1: HAND})
+    assert main(["report", "behaviour", *map(str, paths), "--out-prefix", f"{root}/paper_figs/cpu/"]) == 0
+    assert "behaviour_claims.md" in capsys.readouterr().out
+    rendered = render_readme(text, root, "cpu")
+    assert "| paper (where) |" in rendered and "From `paper_figs/cpu/behaviour_claims.csv`" in rendered
+    assert main(["report", "behaviour", str(tmp_path / "nothing" / "h1.65.npz"), "--out-prefix", str(tmp_path)]) == 2

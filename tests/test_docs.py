@@ -1,0 +1,160 @@
+"""The docs pages: generated blocks wherever they live, the stored speed records, and a strict mkdocs build."""
+
+import importlib.util
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from egosearch.cli import main
+from egosearch.report.readme import BLOCK, BLOCKS, page_root, pages, update_pages
+
+REPO = Path(__file__).resolve().parent.parent
+needs_mkdocs = pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None,
+                                  reason="mkdocs is not installed (pip install -e '.[dev]')")
+
+
+def _project(root: Path) -> None:
+    """A project whose README and one docs page each hold a block read from the root's paper_figs/."""
+    (root / "paper_figs" / "p").mkdir(parents=True)
+    (root / "paper_figs" / "p" / "table1.md").write_text("| a |\n|---|\n| 0.42 |\n")
+    block = "<!-- egosearch:begin table1 -->\nstale\n<!-- egosearch:end table1 -->\n"
+    (root / "README.md").write_text("# r\n" + block)
+    (root / "docs" / "deep").mkdir(parents=True)
+    (root / "docs" / "deep" / "page.md").write_text("# d\ntext kept\n" + block)
+    # the page's own folder holds stored files too: they must not be taken for the root's
+    (root / "docs" / "deep" / "paper_figs" / "p").mkdir(parents=True)
+    (root / "docs" / "deep" / "paper_figs" / "p" / "table1.md").write_text("| wrong |\n")
+
+
+def test_blocks_in_docs_pages_read_the_project_root(tmp_path, monkeypatch, capsys):
+    _project(tmp_path)
+    page = tmp_path / "docs" / "deep" / "page.md"
+    assert pages(tmp_path)[0] == tmp_path / "README.md" and page in pages(tmp_path)
+    assert page_root(page) == tmp_path.resolve() and page_root(tmp_path / "README.md") == tmp_path.resolve()
+    assert update_pages(tmp_path, "p", check=True) == [tmp_path / "README.md", page]
+    assert "stale" in page.read_text()                      # check mode writes nothing
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "readme", "--profile", "p", "--check"]) == 2
+    assert "README.md, docs/deep/page.md out of date" in capsys.readouterr().err
+    assert main(["report", "readme", "--profile", "p"]) == 0
+    for path in (tmp_path / "README.md", page):
+        assert "| 0.42 |" in path.read_text() and "stale" not in path.read_text() and "wrong" not in path.read_text()
+    assert "text kept" in page.read_text()
+    assert main(["report", "readme", "--profile", "p", "--check"]) == 0
+    # one page alone, as before the docs existed
+    assert main(["report", "readme", "--profile", "p", "--check", "--readme", str(page)]) == 0
+
+
+def test_every_block_lives_in_some_page():
+    """Moving prose between the README and the docs must never drop a generated block."""
+    names = {m["name"] for page in pages(REPO) for m in BLOCK.finditer(page.read_text(encoding="utf-8"))}
+    assert set(BLOCKS) - names == set()
+
+
+def test_the_departures_are_one_link_from_the_readme():
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    assert "docs/learner.md#departures-from-the-paper" in readme
+    learner = (REPO / "docs" / "learner.md").read_text(encoding="utf-8")
+    assert "## Departures from the paper\n" in learner and "<!-- egosearch:begin departures -->" in learner
+
+
+def test_the_readme_keeps_the_commands_ci_runs():
+    """.ci/run runs the README's test command: it must stay in the README, as a command block."""
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    assert "```bash\npython -m pytest -q\n```" in readme and "```bash\nsnakemake --cores 2 all\n```" in readme
+    assert "python3 -m pytest -q" in (REPO / ".ci" / "run").read_text()
+
+
+def _record(result: dict, command: str, other: float = 0.02) -> dict:
+    return {"command": command, "date_utc": "2026-01-02T03:04:05+00:00", "commit": "0123456789abcdef",
+            "commit_dirty": False, "machine": {"cpu": "X CPU", "cores": 2}, "load_average_before": [0.1, 0.2, 0.3],
+            "load_average_after": [0.9, 0.4, 0.3], "other_load_cores": other, "wall_s": 40.0, "result": result}
+
+
+def test_speed_block_comes_from_the_stored_records(tmp_path):
+    from egosearch.report.speed import block_speed
+
+    text = block_speed(tmp_path, "p")
+    assert "`results/p/bench/env.json` is missing" in text and "egosearch bench learner --json --out " \
+        "results/p/bench/learner.json" in text                  # never invented when the file is absent
+    bench = tmp_path / "results" / "p" / "bench"
+    bench.mkdir(parents=True)
+    (bench / "env.json").write_text(json.dumps(_record(
+        {"layout": "kitchen_living", "triangles": 4604, "sensor_frames_per_s": 1234.5, "sensor_ms_per_frame": 0.81,
+         "env_steps_per_s": 650.0, "env_ms_per_step": 1.538, "env_resets_included": 7}, "egosearch bench env")))
+    (bench / "learner.json").write_text(json.dumps(_record(
+        {"updates_per_s_naive": 3.1, "updates_per_s_naive_best": 3.3, "updates_per_s_table2": 4.2,
+         "updates_per_s_table2_best": 4.4, "updates_per_s_cpu_profile": 60.5, "updates_per_s_cpu_profile_best": 62.0,
+         "env_steps_per_core_s_cpu_profile": 151.2, "cpu_profile_run": {"env_steps": 4000, "core_s": 26.5},
+         "replay_gb_100k": 1.156}, "egosearch bench learner", other=1.5)))
+    train = tmp_path / "results" / "p" / "train" / "head_on" / "seed0"
+    train.mkdir(parents=True)
+    (train / "curve.csv").write_text("env_steps,success_rate,wall_s\n0,0.0,1.0\n300000,0.5,2000.0\n")
+    text = block_speed(tmp_path, "p")
+    assert "**1,234 sensor frames/s** (0.81 ms a frame; target 1,000: met)" in text
+    assert "**650 env steps/s** (1.538 ms a step, 7 resets included; target 700: not met)" in text
+    assert "| `updates_per_s_table2` (" in text and "| 4.2 (4.4) |" in text and "| 60.5 (62.0) |" in text
+    assert "target of 12: not met" in text and "**`env_steps_per_core_s_cpu_profile` 151.2**" in text
+    assert "4,000-step" in text and "of 150: met" in text
+    # how busy the machine was is part of every figure
+    assert "other processes used 1.50 cores meanwhile, load average 0.10 before" in text
+    assert "X CPU with 2 cores" in text and "commit `0123456`" in text
+    assert "| `head_on` | 0 | 300,000 | 2,000 | 1 | 150 |" in text
+
+
+def test_bench_out_stores_the_result_with_its_machine_and_load(tmp_path, capsys):
+    out = tmp_path / "bench" / "env.json"
+    assert main(["bench", "env", "--frames", "20", "--steps", "20", "--out", str(out)]) == 0
+    record = json.loads(out.read_text())
+    assert record["command"] == "egosearch bench env --layout kitchen_living --frames 20 --steps 20"
+    assert set(record) >= {"date_utc", "commit", "commit_dirty", "machine", "load_average_before", "other_load_cores"}
+    assert record["machine"]["cores"] >= 1 and len(record["load_average_before"]) == 3
+    assert record["result"]["layout"] == "kitchen_living" and record["result"]["env_steps_per_s"] > 0
+    assert "other processes used" in capsys.readouterr().err
+
+
+def _build(config: Path, site: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(config), "-d", str(site)],
+                          capture_output=True, text=True, timeout=300)
+
+
+@needs_mkdocs
+def test_mkdocs_builds_the_docs_strictly_with_the_stored_figures(tmp_path):
+    run = _build(REPO / "mkdocs.yml", tmp_path / "site")
+    assert run.returncode == 0, run.stderr
+    nav_pages = {p.stem for p in (REPO / "docs").glob("*.md")}
+    for stem in nav_pages - {"index"}:
+        assert (tmp_path / "site" / stem / "index.html").is_file(), stem
+    # the figures the pages show from paper_figs/ are in the site, and the pages point at them
+    results = (tmp_path / "site" / "results" / "index.html").read_text()
+    assert 'src="../paper_figs/cpu/fig6.png"' in results
+    assert (tmp_path / "site" / "paper_figs" / "cpu" / "fig6.png").read_bytes() == \
+        (REPO / "paper_figs" / "cpu" / "fig6.png").read_bytes()
+    assert not (tmp_path / "site" / "hooks.py").exists()
+
+
+@needs_mkdocs
+def test_strict_build_still_fails_on_a_broken_link_or_anchor(tmp_path):
+    """The hook publishes linked repository files; it must not hide a link to nothing."""
+    shutil.copy(REPO / "mkdocs.yml", tmp_path / "mkdocs.yml")
+    text = (tmp_path / "mkdocs.yml").read_text()
+    nav = text[text.index("nav:"):text.index("# The pages show")]
+    (tmp_path / "mkdocs.yml").write_text(text.replace(nav, "nav:\n  - Home: index.md\n  - Other: other.md\n"))
+    (tmp_path / "docs").mkdir()
+    shutil.copy(REPO / "docs" / "hooks.py", tmp_path / "docs" / "hooks.py")
+    (tmp_path / "figs").mkdir()
+    (tmp_path / "figs" / "a.png").write_bytes(b"png")
+    (tmp_path / "docs" / "other.md").write_text("# Other\n\n## A part\n")
+    index = tmp_path / "docs" / "index.md"
+    index.write_text("# Home\n\n![a](../figs/a.png) and [a part](other.md#a-part)\n")
+    run = _build(tmp_path / "mkdocs.yml", tmp_path / "site")
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "site" / "figs" / "a.png").read_bytes() == b"png"
+    for broken, named in (("![b](../figs/missing.png)", "missing.png"), ("[c](other.md#no-such-part)", "no-such-part")):
+        index.write_text(f"# Home\n\n{broken}\n")
+        run = _build(tmp_path / "mkdocs.yml", tmp_path / "site")
+        assert run.returncode != 0 and named in run.stderr + run.stdout
