@@ -301,16 +301,21 @@ def _regenerate(profile: str, reference: str | None) -> None:
     reference = reference or config["reference_variant"]
     results, figs = Path("results") / profile, Path("paper_figs") / profile
     check_outputs(dirs={"the figures folder": figs, "the path-length folder": results / "pathlength"})
-    evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv"))
+    # Table 1's homes only, as the DAG's rules: eval/ also holds the generalisation groups
+    homes = set(config["homes"])
+    evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv")
+                   if Path(p).parts[-3] in homes)
     curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv"))
               for v in variants_of_all(config)}
     curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
-    bounds = sorted(str(p) for b in BOUNDS for p in (results / "eval" / b).glob("seed*/*/*/h*.csv"))
+    bounds = sorted(str(p) for b in BOUNDS for p in (results / "eval" / b).glob("seed*/*/*/h*.csv")
+                    if Path(p).parts[-3] in homes)
     # Figure 6's random level: the cells of the scheme the reference is evaluated in while training (as in the DAG).
-    train_placement = load_variant(reference).train_env["placement"]
-    fig6_random = [p for p in bounds if Path(p).parts[-2] == train_placement and Path(p).parts[-5] == "random"]
+    train_env = load_variant(reference).train_env
+    fig6_random = [p for p in bounds if Path(p).parts[-5] == "random"
+                   and (Path(p).parts[-3], Path(p).parts[-2]) == (train_env["layout"], train_env["placement"])]
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
     read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle]
@@ -325,16 +330,13 @@ def _regenerate(profile: str, reference: str | None) -> None:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:
         report.cmd_fig7(fullbody_oracle, figs / "fig7_oracle", planner="oracle")
-    # Table 1's homes only, as the DAG's pathlength rule: eval/ also holds the generalisation groups
-    homes = set(config["homes"])
     scenarios = sorted(str(p) for home in homes for p in (results / "scenarios" / home).glob("*/h*.csv"))
-    home_bounds = [p for p in bounds if Path(p).parts[-3] in homes]
     for variant in variants_of_all(config):
         variant_evals = sorted(str(p) for p in (results / "eval" / variant).glob("seed*/*/*/h*.csv")
                                if Path(p).parts[-3] in homes)
         if variant_evals and scenarios:
             report.cmd_pathlength(variant_evals, scenarios, _success_radius(), figs / f"pathlength_{variant}",
-                                  out_csv=results / "pathlength" / f"{variant}.csv", bounds=home_bounds)
+                                  out_csv=results / "pathlength" / f"{variant}.csv", bounds=bounds)
     learner = config["profiles"][profile]["learner"]
     learner_cfg = load_config(learner)
     report.cmd_table2(table2_rows(learner_cfg), figs / "table2", departure_rows(learner_cfg))

@@ -65,8 +65,10 @@ def test_the_departures_are_one_link_from_the_readme():
 def test_the_readme_keeps_the_commands_ci_runs():
     """.ci/run runs the README's test command: it must stay in the README, as a command block."""
     readme = (REPO / "README.md").read_text(encoding="utf-8")
-    assert "```bash\npython -m pytest -q\n```" in readme and "```bash\nsnakemake --cores 2 all\n```" in readme
-    assert "python3 -m pytest -q" in (REPO / ".ci" / "run").read_text()
+    ci = [line for line in (REPO / ".ci" / "run").read_text().splitlines() if "-m pytest" in line]
+    assert len(ci) == 1 and ci[0].startswith("python3 -m pytest"), ci
+    assert "```bash\npython " + ci[0].removeprefix("python3 ") + "\n```" in readme
+    assert "```bash\nsnakemake --cores 2 all\n```" in readme
 
 
 def _record(result: dict, command: str, other: float = 0.02) -> dict:

@@ -2,6 +2,7 @@
 
 import json
 import shutil
+import subprocess
 from pathlib import Path
 
 import pandas as pd
@@ -15,6 +16,20 @@ STORED_RUN = [REPO / "results" / "cpu" / "provenance.json", REPO / "results" / "
 needs_stored_run = pytest.mark.skipif(
     not all(p.exists() for p in STORED_RUN),
     reason="the stored run of the current cpu profile is not committed yet (see the README's Results status)")
+
+
+def copy_stored_cpu_results(dest: Path) -> None:
+    """The committed files of results/cpu (git's list): a working copy also holds runs in progress,
+    whose files the provenance does not list yet."""
+    listed = subprocess.run(["git", "ls-files", "-z", "results/cpu"], cwd=REPO, capture_output=True, text=True)
+    names = [n for n in listed.stdout.split("\0") if n] if listed.returncode == 0 else []
+    if not names:   # not a git checkout: everything but what a running training keeps
+        shutil.copytree(REPO / "results" / "cpu", dest, ignore=shutil.ignore_patterns("ckpt", "partial", "*.pt"))
+        return
+    for name in names:
+        target = dest / Path(name).relative_to("results/cpu")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(REPO / name, target)
 
 
 def _stored_results(root: Path) -> None:
@@ -151,9 +166,15 @@ def test_the_repository_readme_and_docs_match_the_stored_cpu_results():
 @needs_stored_run
 def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, monkeypatch):
     """`egosearch report regenerate` from the stored CSVs gives the numbers the DAG stored."""
-    # Only the CSVs regenerate reads: a training still running keeps a large checkpoint here.
-    shutil.copytree(REPO / "results" / "cpu", tmp_path / "results" / "cpu",
-                    ignore=shutil.ignore_patterns("ckpt", "*.pt", "logs", "benchmarks"))
+    results = tmp_path / "results" / "cpu"
+    copy_stored_cpu_results(results)
+    # A generalisation group's evaluations sit beside Table 1's homes in eval/: Table 1, Figure 6 and
+    # the path-length tables must not read them (nor ask the provenance about them).
+    for who in ("head_on", "random"):
+        cell = sorted((results / "eval" / who / "seed0" / "kitchen_living").rglob("h1.05.csv"))[0]
+        group = results / "eval" / who / "seed0" / "generated_heldout" / cell.parent.name / cell.name
+        group.parent.mkdir(parents=True)
+        group.write_text(cell.read_text())
     monkeypatch.chdir(tmp_path)
     assert main(["report", "regenerate", "--profile", "cpu"]) == 0
     stored, again = REPO / "paper_figs" / "cpu", tmp_path / "paper_figs" / "cpu"
@@ -166,8 +187,7 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
 @needs_stored_run
 def test_regenerate_twice_gives_byte_identical_files(tmp_path, monkeypatch):
     """A second regenerate rewrites every output with the same bytes (PDFs included: no date stamped)."""
-    shutil.copytree(REPO / "results" / "cpu", tmp_path / "results" / "cpu",
-                    ignore=shutil.ignore_patterns("ckpt", "partial", "*.pt", "logs", "benchmarks"))
+    copy_stored_cpu_results(tmp_path / "results" / "cpu")
     monkeypatch.chdir(tmp_path)
     figs = tmp_path / "paper_figs" / "cpu"
     assert main(["report", "regenerate", "--profile", "cpu"]) == 0
@@ -186,7 +206,7 @@ def test_regenerate_refuses_a_stored_csv_edited_after_its_provenance(tmp_path, m
     from egosearch.report.provenance import write_provenance
 
     results = tmp_path / "results" / "cpu"
-    shutil.copytree(REPO / "results" / "cpu", results, ignore=shutil.ignore_patterns("ckpt", "partial", "*.pt"))
+    copy_stored_cpu_results(results)
     monkeypatch.chdir(tmp_path)
     write_provenance("cpu", results, results / "provenance.json")
     assert main(["report", "verify", "--profile", "cpu"]) == 0

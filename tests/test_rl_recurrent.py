@@ -276,12 +276,14 @@ def test_recurrent_learner_beats_random_on_the_fake_env(tmp_path):
     from egosearch.policies import RandomPolicy
     from egosearch.rl.train import default_evaluator
 
-    # test_rl_train's sac_drq learning run, with sequences: 8 of 8 steps (+ 4 burn-in) per update
+    # test_rl_train's sac_drq learning run, with sequences: 8 of 8 steps (+ 4 burn-in) per update.
+    # Twice its env steps: at 1200 steps seeds 0-2 reached only 0.2-0.55 (the batch holds 8
+    # sequences, not 64 independent transitions); at 2400 all three reached 1.0.
     cfg = load_config("smoke", {**REC, "obs_downsample": 2, "aug_pad": 2, "num_envs": 4, "n_step": 3,
                                 "batch_size": 64, "sequence_length": 8, "burn_in": 4, "recurrent_hidden_dim": 32,
                                 "update_every": 2, "actor_update_freq": 1, "critic_target_update_freq": 1,
-                                "total_env_steps": 1200, "init_steps": 200, "eval_every": 1200,
-                                "checkpoint_every": 1200, "log_every": 100, "eval_episodes": 5, "seed": 0})
+                                "total_env_steps": 2400, "init_steps": 200, "eval_every": 2400,
+                                "checkpoint_every": 2400, "log_every": 100, "eval_episodes": 5, "seed": 0})
     train(FAKE_ENV_ID, cfg, tmp_path, progress=False)
     evaluate = default_evaluator(FAKE_ENV_ID, {}, episodes=20)
     trained = evaluate(ActorPolicy(tmp_path / "actor.pt"))

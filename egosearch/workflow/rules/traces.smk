@@ -3,12 +3,16 @@
 # with `--traces`. The runs are deterministic, so the episodes CSV beside each trace repeats the
 # stored evaluation row for row. Names: common.smk.
 
-# The humanoid's camera height of Section 6.3, with targets inside cabinets allowed.
-TRACE_CELLS = [("everywhere", "1.65")]
+# Every Table 1 cell: the behaviour statistics pool them, with the cell and scenario as the unit.
+TRACE_CELLS = [(placement, height) for placement in PLACEMENTS for height in HEIGHTS]
+# The pictures: the humanoid's camera height of Section 6.3, with targets inside cabinets allowed.
+SEARCH_CELLS = [("everywhere", HEIGHTS[-1])]
 # Figure 6's pair: the head moving, and held fixed.
 TRACE_VARIANTS = ["head_on", "head_off"]
 TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
                for v in TRACE_VARIANTS for s in SEEDS for home in HOMES for placement, height in TRACE_CELLS]
+SEARCH_TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
+                      for v in TRACE_VARIANTS for s in SEEDS for home in HOMES for placement, height in SEARCH_CELLS]
 
 
 rule trace:
@@ -56,11 +60,11 @@ rule behaviour:
 rule searches:
     """Chosen searches of seed 0 on the floor plan, and where the camera looks, per trace cell."""
     input:
-        ancient(TRACE_FILES),
+        ancient(SEARCH_TRACE_FILES),
     output:
         [f"{FIGS}/searches/{v}_{home}_{placement}_h{height}.png"
-         for v in TRACE_VARIANTS for home in HOMES for placement, height in TRACE_CELLS],
-        [f"{FIGS}/searches/gaze_{home}_{placement}_h{height}.png" for home in HOMES for placement, height in TRACE_CELLS],
+         for v in TRACE_VARIANTS for home in HOMES for placement, height in SEARCH_CELLS],
+        [f"{FIGS}/searches/gaze_{home}_{placement}_h{height}.png" for home in HOMES for placement, height in SEARCH_CELLS],
     log:
         f"{RESULTS}/logs/report/searches.log",
     params:
