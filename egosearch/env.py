@@ -50,7 +50,14 @@ from gymnasium import spaces
 
 from egosearch.agent import AgentSpec, AgentState, check_height
 from egosearch.floormap import FloorMap
-from egosearch.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario, check_placement, navgrid_for
+from egosearch.scenarios import (
+    MAX_STEPS,
+    SUCCESS_DISTANCE,
+    Scenario,
+    check_placement,
+    navgrid_for,
+    shortest_path_region,
+)
 from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
@@ -91,25 +98,34 @@ def space_dims(head: bool = True, target_memory: bool = False, floor_map: bool =
     return {"action": replace(AgentSpec(), head=bool(head)).action_dim, "mask": mask, "proprio": PROPRIO_DIM}
 
 
-DISTANCE_REWARDS = ("distance", "progress")
+DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """How r_d is read: ``distance`` is the paper's text (minus the distance while the target is
 seen); ``progress`` is Savva et al.'s form, which the paper cites (the decrease of that distance
-since the last step, while seen): an ablation, never the default."""
+since the last step, while seen); ``geodesic`` is habitat-lab's ``DistanceToGoalReward``: the
+decrease since the last step of the geodesic distance to the poses from which the target counts as
+found (``scenarios.shortest_path_region``), at every step, seen or not, and with it the collision
+term without its floor (the paper's r_c stops growing at 30 collisions, so pushing on costs
+nothing). ``progress`` and ``geodesic`` are training-only ablations, never the default."""
 
 
 def reward_terms(success: bool, visible: bool, distance: float, n_collisions: int,
-                 previous_distance: float | None = None, distance_reward: str = "distance") -> dict[str, float]:
+                 previous_distance: float | None = None, distance_reward: str = "distance",
+                 geodesic_decrease: float = 0.0) -> dict[str, float]:
     """The four terms of paper eq. 2 and their weighted sum. ``previous_distance`` (None when
-    the target was not seen at the last step) only matters for ``distance_reward="progress"``."""
-    if distance_reward == "progress":
+    the target was not seen at the last step) only matters for ``distance_reward="progress"``,
+    ``geodesic_decrease`` (m the body came closer along the floor this step) for ``"geodesic"``."""
+    if distance_reward == "geodesic":
+        r_d = geodesic_decrease
+    elif distance_reward == "progress":
         r_d = previous_distance - distance if visible and previous_distance is not None else 0.0
     else:
         r_d = -distance if visible else 0.0
+    floor = -math.inf if distance_reward == "geodesic" else COLLISION_PENALTY_FLOOR
     terms = {
         "r_s": SUCCESS_REWARD if success else 0.0,
         "r_d": r_d,
         "r_l": LIVE_PENALTY,
-        "r_c": float(np.clip(COLLISION_PENALTY_PER_HIT * n_collisions, COLLISION_PENALTY_FLOOR, 0.0)),
+        "r_c": float(max(COLLISION_PENALTY_PER_HIT * n_collisions, floor)),
     }
     terms["reward"] = float(sum(w * terms[k] for w, k in zip(REWARD_WEIGHTS, ("r_s", "r_d", "r_l", "r_c"))))
     return terms
@@ -151,7 +167,7 @@ class SearchEnv(gymnasium.Env):
             height_noise: per-step height noise; default on exactly when ``height`` is None.
             max_steps: T_max.
             objects: target object names to draw from in training (default: all).
-            distance_reward: ``distance`` (paper) or ``progress`` (an ablation): see
+            distance_reward: ``distance`` (paper), ``progress`` or ``geodesic`` (ablations): see
                 :data:`DISTANCE_REWARDS`.
             train_heights: (low, high) range (m) of the per-episode camera height in training;
                 default the paper's ``AgentSpec.train_height_range`` [1.0, 1.8].
@@ -245,7 +261,20 @@ class SearchEnv(gymnasium.Env):
         self._remember(depth, mask)
         self._frames[:] = depth
         self._seen_distance = target_distance(self.state, self.target, spec.body_radius) if mask.any() else None
+        if self.distance_reward == "geodesic":
+            grid = navgrid_for(self.layout)
+            goal = shortest_path_region(self.layout, self.target, self.base_height)
+            if not (goal & grid.reachable).any():
+                # a training target this camera height cannot see from near it (a high shelf):
+                # shape toward its surroundings instead, so the episode still has a gradient
+                goal = grid.touch_region(self.target.center[:2], SUCCESS_DISTANCE)
+            self._geodesic_field = grid.distances_to(goal, reachable=True)
+            self._geodesic = self._geodesic_to_goal()
         return self._observation(mask), self._info(mask.any(), False)
+
+    def _geodesic_to_goal(self) -> float:
+        """ℓ from the body to where the target counts as found (inf off the reachable floor)."""
+        return navgrid_for(self.layout).lower_bound_length(self._geodesic_field, self.state.x, self.state.y)
 
     def _random_start(self, rng, start_radius: float | None = None) -> tuple[float, float, float]:
         """A collision-free start in the home's main free region; with ``start_radius`` (a training
@@ -290,7 +319,14 @@ class SearchEnv(gymnasium.Env):
         visible = bool(mask.any())
         distance = target_distance(s, self.target, spec.body_radius)
         success = visible and distance <= SUCCESS_DISTANCE
-        terms = reward_terms(success, visible, distance, self.collisions, self._seen_distance, self.distance_reward)
+        decrease = 0.0
+        if self.distance_reward == "geodesic":
+            geodesic = self._geodesic_to_goal()
+            # a cell the grid cannot reach (a body pressed into furniture) gives no shaping either way
+            decrease = self._geodesic - geodesic if math.isfinite(geodesic) and math.isfinite(self._geodesic) else 0.0
+            self._geodesic = geodesic
+        terms = reward_terms(success, visible, distance, self.collisions, self._seen_distance, self.distance_reward,
+                             decrease)
         self._seen_distance = distance if visible else None
         truncated = not success and self.steps >= self.max_steps
         info = self._info(visible, success, distance)

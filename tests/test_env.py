@@ -137,3 +137,31 @@ def test_training_heights_of_the_cpu_profile_reach_the_lowest_evaluation_camera(
     env.close()
     with pytest.raises(ValueError, match="train_heights"):
         gymnasium.make("EgoSearch-v0", train_heights=(1.5, 1.0))
+
+
+def test_geodesic_shaping_telescopes_to_the_change_of_the_shortest_path():
+    """With ``distance_reward="geodesic"`` the r_d of an episode sums to ℓ at the start minus ℓ at
+    the end (potential-based shaping), and r_c is the unclipped collision count."""
+    from egosearch.env import COLLISION_PENALTY_PER_HIT, SearchEnv
+
+    env = SearchEnv(layout="kitchen_living", distance_reward="geodesic")
+    env.reset(seed=0)
+    start = env._geodesic_to_goal()
+    rng = np.random.default_rng(0)
+    total, infos = 0.0, []
+    for _ in range(60):
+        _, _, terminated, truncated, info = env.step(rng.uniform(-1, 1, env.action_space.shape))
+        total += info["r_d"]
+        infos.append(info)
+        if terminated or truncated:
+            break
+    end = env._geodesic_to_goal()
+    assert np.isfinite(start) and np.isfinite(end) and start > 0.5
+    assert total == pytest.approx(start - end, abs=1e-9)
+    assert any(i["r_d"] != 0.0 for i in infos if not i["visible"])      # shaped while the target is unseen
+    assert infos[-1]["r_c"] == pytest.approx(COLLISION_PENALTY_PER_HIT * env.collisions)
+    # seed 3 draws a shelf target that no pose near it sees at its camera height: the shaping
+    # then leads to the target's surroundings, never to an infinite distance
+    env.reset(seed=3)
+    assert np.isfinite(env._geodesic_to_goal())
+    env.close()

@@ -52,3 +52,15 @@ def test_progress_reward_ablation_hand_worked():
     assert reward_terms(False, False, 1.5, 0, 2.0, "progress")["r_d"] == 0.0
     # The paper's form ignores the previous distance.
     assert reward_terms(False, True, 1.5, 0, 2.0)["r_d"] == -1.5
+
+
+def test_geodesic_reward_ablation_hand_worked():
+    # 0.2 m closer along the floor while the target is unseen, 100 collisions so far:
+    # r_d = +0.2 and r_c = -10 (no floor at -3), so 0.2 - 0.1 + 0.1 * -10.
+    t = reward_terms(success=False, visible=False, distance=4.0, n_collisions=100, distance_reward="geodesic",
+                     geodesic_decrease=0.2)
+    assert t["r_d"] == pytest.approx(0.2) and t["r_c"] == pytest.approx(-10.0)
+    assert t["reward"] == pytest.approx(0.2 - 0.1 - 1.0)
+    # Moving away costs what coming closer earns; the Euclidean distance plays no part.
+    away = reward_terms(False, True, 0.5, 0, 2.0, "geodesic", geodesic_decrease=-0.15)
+    assert away["r_d"] == pytest.approx(-0.15)

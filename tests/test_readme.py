@@ -103,9 +103,25 @@ def test_compare_block_lists_every_stored_comparison(tmp_path):
     text = "<!-- egosearch:begin compare -->\n<!-- egosearch:end compare -->"
     assert "No stored comparison yet" in render_readme(text, tmp_path, "p2")
     out = render_readme(text, tmp_path, "p")
-    assert "`my_new_variant` vs `head_on`" in out
+    assert "`my_new_variant` vs `head_on` (difference" in out     # no homes column: no homes named
     assert "| 1.05 | everywhere | success | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.0001 | 0.001 * |" in out
     assert "| 1.05 | everywhere | spl | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.03 | 0.06 |" in out
+    pd.DataFrame([{**row, "homes": "bedroom_bath"}]).to_csv(folder / "my_new_variant_vs_head_on.csv", index=False)
+    assert "`my_new_variant` vs `head_on` in bedroom_bath (difference" in render_readme(text, tmp_path, "p")
+
+
+def test_generalise_block_says_when_it_shows_the_one_seed_screen(tmp_path):
+    text = "<!-- egosearch:begin generalise -->\n<!-- egosearch:end generalise -->"
+    assert "`paper_figs/p/generalise.md` is missing (run `snakemake --cores 2 generalise`)" in render_readme(
+        text, tmp_path, "p")
+    figs = tmp_path / "paper_figs" / "p"
+    figs.mkdir(parents=True)
+    (figs / "generalise_seed0.md").write_text("| variant | x |\n|---|---|\n| head_on | 0.42 |\n")
+    out = render_readme(text, tmp_path, "p")
+    assert "One seed per policy (seed 0)" in out and "| head_on | 0.42 |" in out
+    (figs / "generalise.md").write_text("| variant | x |\n|---|---|\n| head_on | 0.51 |\n")
+    out = render_readme(text, tmp_path, "p")
+    assert "One seed" not in out and "| head_on | 0.51 |" in out and "`paper_figs/p/generalise.png`" in out
 
 
 def _write_reading_inputs(root: Path) -> None:
@@ -172,7 +188,7 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
     # the path-length tables must not read them (nor ask the provenance about them).
     for who in ("head_on", "random"):
         cell = sorted((results / "eval" / who / "seed0" / "kitchen_living").rglob("h1.05.csv"))[0]
-        group = results / "eval" / who / "seed0" / "generated_heldout" / cell.parent.name / cell.name
+        group = results / "eval" / who / "seed0" / "some_generated_group" / cell.parent.name / cell.name
         group.parent.mkdir(parents=True)
         group.write_text(cell.read_text())
     monkeypatch.chdir(tmp_path)
@@ -182,6 +198,9 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
     assert [n for n in names if not (stored / n).exists()] == []
     for name in names:
         assert (again / name).read_text() == (stored / name).read_text(), name
+    from egosearch.report.readme import table1_contrast  # the reading's paired contrasts too
+
+    assert table1_contrast(tmp_path, "cpu")((1.05, "everywhere"), (0.45, "everywhere"))["n_shared"] > 0
 
 
 @needs_stored_run

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import os
+import textwrap
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -210,10 +211,10 @@ def _figure(df: pd.DataFrame, path: Path, pct: str) -> None:
         ax.bar(xs, ys, width, yerr=[np.nan_to_num(lo), np.nan_to_num(hi)], capsize=3, label=label)
     ax.axhline(1.0, color="0.3", ls="--", lw=1)
     ax.axhline(0.0, color="0.3", ls=":", lw=1)
-    ax.set_xticks(range(len(groups)), [GROUP_LABELS.get(g, g).replace(" (", "\n(") for g in groups], fontsize=8)
+    ax.set_xticks(range(len(groups)), [textwrap.fill(GROUP_LABELS.get(g, g), 16) for g in groups], fontsize=8)
     ax.set_ylabel("normalised score\n(policy − random) / (oracle − random)", fontsize=8)
     ax.set_title(f"Evaluated in (columns) vs trained on (bars); {pct} two-level bootstrap", fontsize=9)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=len(variants), frameon=False)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.25), ncol=min(2, len(variants)), frameon=False)
     fig.tight_layout()
-    fig.savefig(path)
+    fig.savefig(path, bbox_inches="tight")   # the legend sits below the axes
     plt.close(fig)

@@ -150,7 +150,8 @@ def block_compare(root: Path, profile: str) -> str:
     for path in paths:
         candidate, reference = path.stem.split("_vs_", 1)
         df = pd.read_csv(path)
-        lines = [f"`{candidate}` vs `{reference}` (difference = {candidate} - {reference}; from "
+        where = f" in {', '.join(sorted(set(df['homes'])))}" if "homes" in df.columns else ""
+        lines = [f"`{candidate}` vs `{reference}`{where} (difference = {candidate} - {reference}; from "
                  f"`{path.relative_to(root)}`):", "",
                  "| height | placement | metric | reference | candidate | difference (95% CI) | p (one cell) "
                  "| p (Holm) |",
@@ -199,6 +200,26 @@ def block_departures(root: Path, profile: str) -> str:
     return "\n".join(lines[start:]).rstrip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+GENERALISE_SCREEN = "generalise_seed0"
+"""The generalisation table of one seed per policy, stored before `snakemake generalise`'s three."""
+
+
+def block_generalise(root: Path, profile: str) -> str:
+    """The generalisation table (`snakemake generalise`), or its stored one-seed screen, said so."""
+    figs = root / "paper_figs" / profile
+    full, screen = figs / "generalise.md", figs / f"{GENERALISE_SCREEN}.md"
+    if full.exists():
+        text, source = full.read_text(encoding="utf-8"), full
+    elif screen.exists():
+        text = ("*One seed per policy (seed 0), run with the `generalise` rule's command: the three-seed "
+                "`snakemake --cores 2 generalise` is not stored yet.*\n\n" + screen.read_text(encoding="utf-8"))
+        source = screen
+    else:
+        return _missing(root, full).replace("snakemake --cores 2 all", "snakemake --cores 2 generalise")
+    return (text.rstrip("\n") + f"\n\nFrom `{source.relative_to(root)}`, drawn in "
+            f"`{source.with_suffix('.png').relative_to(root)}`.\n")
+
+
 def block_budget(root: Path, profile: str) -> str:
     """The budget study's table: success at its cell, env steps and core-hours per learner setting."""
     path = root / "paper_figs" / profile / "budget.csv"
@@ -236,15 +257,20 @@ def _contrast_text(res: dict | None, intervals: tuple) -> str:
 
 
 def table1_contrast(root: Path, profile: str, variant: str = "head_on") -> Callable[[tuple, tuple], dict | None]:
-    """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every home it
-    was evaluated in and every seed, each episode joined to its scenario's draw (home, start, target)."""
+    """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every Table 1
+    home it was evaluated in (not the generalisation groups) and every seed, each episode joined to
+    its scenario's draw (home, start, target)."""
     from egosearch.report.stats import cell_contrast
+
+    homes = set(workflow_config()["homes"])
 
     def cell(height: float, placement: str) -> pd.DataFrame | None:
         frames = []
         runs = root / "results" / profile / "eval" / variant
         for path in sorted(runs.glob(f"seed*/*/{placement}/h{height:g}.csv")):
             home, seed = path.parent.parent.name, int(path.parent.parent.parent.name.removeprefix("seed"))
+            if home not in homes:
+                continue
             scen = root / "results" / profile / "scenarios" / home / placement / path.name
             if not scen.exists():
                 return None
@@ -383,6 +409,7 @@ def _block_claims(root: Path, profile: str) -> str:
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
+    "generalise": block_generalise,
     "table1": block_table1,
     "fig6": block_fig6,
     "fig7": block_fig7,

@@ -36,7 +36,7 @@ CURRICULUM_END_RADIUS = 12.0
 """Radius (m) the curriculum reaches at its end: more than any home's extent."""
 ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent")
 """Learners :mod:`egosearch.rl.train` can run (see ``LearnerConfig.algorithm``)."""
-DISTANCE_REWARDS = ("distance", "progress")
+DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.env.DISTANCE_REWARDS``; a test keeps them equal)."""
 
 _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
@@ -201,9 +201,13 @@ class LearnerConfig:
     train_distance_reward: str = "distance"
     """Paper eq. 2 text: "distance" = r_d is minus the distance to the target while it is seen.
     "progress" = the decrease of that distance since the last step while seen (Savva et al.
-    2019's form, which the paper cites; potential-based shaping as in habitat-lab). TRAINING
-    ONLY: evaluation always scores the paper's task (success, SPL), whatever the training
-    reward. A variant's ``train_env: distance_reward`` takes precedence."""
+    2019's form, which the paper cites; potential-based shaping as in habitat-lab). "geodesic" =
+    the decrease of the geodesic distance to where the target counts as found, at every step,
+    seen or not (habitat-lab's DistanceToGoalReward), with the collision term unclipped (the
+    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``head_on_geodesic``
+    lever, no profile's default. TRAINING ONLY: evaluation always scores the paper's task
+    (success, SPL), whatever the training reward. A variant's ``train_env: distance_reward``
+    takes precedence."""
     curriculum_steps: int = 0
     """Paper: 0 (no curriculum). Otherwise a start-distance curriculum after the reverse
     curriculum of Florensa et al. 2017, simplified: training episodes start within a radius of
