@@ -218,12 +218,13 @@ SEARCHERS = {"oracle": OraclePolicy, "random": lambda env: RandomPolicy(5, seed=
              "follower": Follower}
 
 
-def _check_sets(pick) -> dict[str, int]:
+def _check_sets(pick, sets=None) -> dict[str, int]:
     """Run every searcher on ``pick(scenarios)`` of each stored set; every success must respect ℓ."""
-    assert STORED_SETS, "no stored scenario sets under results/*/scenarios"
+    sets = STORED_SETS if sets is None else sets
+    assert sets, "no stored scenario sets under results/*/scenarios"
     successes = dict.fromkeys(SEARCHERS, 0)
     broken = []
-    for path in STORED_SETS:
+    for path in sets:
         chosen = pick(read_scenarios(path))
         env = SearchEnv(chosen[0].layout, chosen[0].placement, head=True, height=chosen[0].height)
         try:
@@ -257,8 +258,11 @@ def test_ell_bounds_every_success_on_the_shortest_stored_scenarios():
 
 @pytest.mark.slow
 def test_ell_bounds_every_success_on_every_stored_scenario():
-    successes = _check_sets(lambda scs: scs)
-    assert successes["oracle"] >= 0.9 * sum(len(read_scenarios(p)) for p in STORED_SETS), successes
+    # Table 1's sets whole; the generalisation groups' sets (800 more scenarios over 40 homes) are
+    # checked on their shortest scenarios by the test above
+    sets = [p for p in STORED_SETS if p.parts[-3] in ("kitchen_living", "bedroom_bath")]
+    successes = _check_sets(lambda scs: scs, sets)
+    assert successes["oracle"] >= 0.9 * sum(len(read_scenarios(p)) for p in sets), successes
     assert all(successes.values()), successes
 
 
