@@ -26,6 +26,7 @@ include: "egosearch/workflow/rules/report.smk"
 include: "egosearch/workflow/rules/budget.smk"
 include: "egosearch/workflow/rules/generalise.smk"
 include: "egosearch/workflow/rules/traces.smk"
+include: "egosearch/workflow/rules/fresh.smk"
 
 
 rule all:

@@ -120,17 +120,9 @@ def _cmd_train(args) -> None:
         overrides["num_threads"] = args.threads
     cfg = load_config(args.profile, overrides)
     env = variant.train_env
-    # The training curve (Figure 6) is read in both paper homes for a policy trained in either or both of
-    # them; a policy trained in generated homes is read in its split's first home.
-    from egosearch.scene.layouts import LAYOUT_NAMES
+    from egosearch.home_pool import curve_homes
 
-    if env["layout"] == "generated":
-        curve_homes = [f"home{env['home_seeds'][0]}"]
-    elif env["layout"] in (*LAYOUT_NAMES, "paper_homes"):
-        curve_homes = list(LAYOUT_NAMES)
-    else:
-        curve_homes = [env["layout"]]
-    evaluator = scenario_evaluator(variant.env_id, curve_homes, env["placement"], n=cfg.eval_episodes)
+    evaluator = scenario_evaluator(variant.env_id, curve_homes(env), env["placement"], n=cfg.eval_episodes)
     try:
         summary = train(variant.env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
                         variant=variant.name)
@@ -215,6 +207,11 @@ def _cmd_report(args) -> None:
         trained_on = dict(item.partition("=")[::2] for item in args.trained_on)
         for path in generalise_report(args.files, args.bounds, args.out_prefix, trained_on, args.generated):
             print(f"wrote {path}")
+    elif args.what == "fresh":
+        from egosearch.report.fresh import fresh_report
+
+        for path in fresh_report(args.stored, args.fresh, args.out_prefix, args.variant, args.fresh_seed):
+            print(f"wrote {path}")
     elif args.what == "pathlength":
         report.cmd_pathlength(args.files, args.scenarios, _success_radius(), args.out_prefix, out_csv=args.out_csv,
                               bounds=args.bounds or [])
@@ -287,6 +284,7 @@ def _regenerate(profile: str, reference: str | None) -> None:
     the files `snakemake all` would."""
     from pathlib import Path
 
+    from egosearch.home_pool import curve_homes
     from egosearch.outputs import check_outputs
     from egosearch.report import cli as report
     from egosearch.report.provenance import check_stored
@@ -312,10 +310,10 @@ def _regenerate(profile: str, reference: str | None) -> None:
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
     bounds = sorted(str(p) for b in BOUNDS for p in (results / "eval" / b).glob("seed*/*/*/h*.csv")
                     if Path(p).parts[-3] in homes)
-    # Figure 6's random level: the cells of the scheme the reference is evaluated in while training (as in the DAG).
+    # Figure 6's random level: the cells the reference is evaluated in while training (as in the DAG).
     train_env = load_variant(reference).train_env
-    fig6_random = [p for p in bounds if Path(p).parts[-5] == "random"
-                   and (Path(p).parts[-3], Path(p).parts[-2]) == (train_env["layout"], train_env["placement"])]
+    fig6_random = [p for p in bounds if Path(p).parts[-5] == "random" and Path(p).parts[-2] == train_env["placement"]
+                   and Path(p).parts[-3] in curve_homes(train_env)]
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
     read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle]
@@ -507,6 +505,15 @@ def _report_parsers(sub) -> None:
     r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
                    help="what each variant trained in, for the labels")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))
+
+    r = reports.add_parser("fresh", help="the reference on its stored scenario sets against fresh sets of the same "
+                                         "cells: is a gain tuned to the stored sets?")
+    r.add_argument("--stored", nargs="+", required=True, help="evaluation CSVs on the stored sets: .../{variant}/"
+                                                              "seed{seed}/{home}/{placement}/h{height}.csv")
+    r.add_argument("--fresh", nargs="+", required=True, help="the same actors' evaluation CSVs on the fresh sets")
+    r.add_argument("--variant", default="head_on", help="the variant, for the caption (default: head_on)")
+    r.add_argument("--fresh-seed", type=int, help="the fresh sets' scenario seed, for the caption")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv and .md"))
 
     traces = "trace files of `egosearch evaluate --traces`: .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
     r = reports.add_parser("behaviour", help="how the policies search, from per-step traces, and the paper's "

@@ -27,6 +27,19 @@ PAPER_HOMES = "paper_homes"
 """``train_env: layout`` of a variant that trains in both of the paper's homes (an episode in each at random)."""
 
 
+def curve_homes(train_env: dict) -> list[str]:
+    """The homes a variant's training curve (Figure 6) is read in: both paper homes for a policy trained in
+    either or both of them; a policy trained in generated homes is read in its split's first home."""
+    from egosearch.scene.layouts import LAYOUT_NAMES
+
+    layout = train_env["layout"]
+    if layout == GENERATED:
+        return [f"home{train_env['home_seeds'][0]}"]
+    if layout in (*LAYOUT_NAMES, PAPER_HOMES):
+        return list(LAYOUT_NAMES)
+    return [layout]
+
+
 def check_home_split(home_seeds) -> range:
     """``[first, stop)`` -> the split as a range; ValueError (one line) when it is empty or overlaps the
     held-out homes."""

@@ -69,6 +69,9 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     except jsonschema.ValidationError as err:
         where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
         raise ConfigError(f"config {where}: {err.message}") from None
+    if config.get("fresh_scenario_seed") == config["scenario_seed"]:
+        raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
+                          "scenario_seed; the fresh-set check needs sets never stored")
 
 
 def workflow_variants(config: dict, compare: bool = False, directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from egosearch.home_pool import HELDOUT_HOME_SEEDS, HomePoolEnv, check_home_split
+from egosearch.home_pool import HELDOUT_HOME_SEEDS, HomePoolEnv, check_home_split, curve_homes
 from egosearch.report.generalise import generalise_frame, generalise_report
 
 EPISODE = ["scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions", "episode_return"]
@@ -91,3 +91,11 @@ def test_a_bound_that_missed_scenarios_is_one_line(tmp_path):
               _write(tmp_path / "eval/oracle/seed0/kitchen_living/everywhere/h1.05.csv", [1, 1, 1])]
     with pytest.raises(ValueError, match="random searcher did not run 1 of the policy's scenarios"):
         generalise_frame(files, bounds)
+
+
+def test_the_training_curve_is_read_in_both_paper_homes_unless_trained_in_generated_ones():
+    both = ["kitchen_living", "bedroom_bath"]
+    assert sorted(curve_homes({"layout": "paper_homes"})) == sorted(both)
+    assert sorted(curve_homes({"layout": "kitchen_living"})) == sorted(both)
+    assert curve_homes({"layout": "generated", "home_seeds": [1000, 2000]}) == ["home1000"]
+    assert curve_homes({"layout": "home5"}) == ["home5"]

@@ -220,6 +220,14 @@ def block_generalise(root: Path, profile: str) -> str:
             f"`{source.with_suffix('.png').relative_to(root)}`.\n")
 
 
+def block_fresh(root: Path, profile: str) -> str:
+    """The fresh-set check (`snakemake fresh`): the reference's actors on sets drawn with another seed."""
+    path = root / "paper_figs" / profile / "fresh.md"
+    if not path.exists():
+        return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 fresh")
+    return path.read_text(encoding="utf-8").rstrip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
 def block_budget(root: Path, profile: str) -> str:
     """The budget study's table: success at its cell, env steps and core-hours per learner setting."""
     path = root / "paper_figs" / profile / "budget.csv"
@@ -410,6 +418,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
     "generalise": block_generalise,
+    "fresh": block_fresh,
     "table1": block_table1,
     "fig6": block_fig6,
     "fig7": block_fig7,

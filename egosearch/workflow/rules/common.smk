@@ -119,11 +119,13 @@ def bound_files(bounds=BOUNDS, placements=None, homes=None):
 
 
 def fig6_random_files():
-    """The random searcher on the Table 1 cells of the placement scheme the reference trains and
-    is evaluated in during training (Figure 6's curves): its level in that figure."""
-    placement = VARIANTS[REF].train_env["placement"]
-    home = VARIANTS[REF].train_env["layout"]
-    return bound_files(["random"], [placement], [home]) if placement in PLACEMENTS and home in HOMES else []
+    """The random searcher on the Table 1 cells the reference is evaluated in during training (Figure 6's
+    curves): its level in that figure."""
+    from egosearch.home_pool import curve_homes
+
+    train_env = VARIANTS[REF].train_env
+    homes = [h for h in curve_homes(train_env) if h in HOMES]
+    return bound_files(["random"], [train_env["placement"]], homes) if train_env["placement"] in PLACEMENTS and homes else []
 
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top
@@ -164,3 +166,14 @@ def generalise_files(who, seeds):
     homes = list(GEN_GROUPS) + HOMES
     return expand(f"{RESULTS}/eval/{who}/seed{{seed}}/{{home}}/{{placement}}/h{GEN_HEIGHT}.csv",
                   seed=seeds, home=homes, placement=PLACEMENTS)
+
+
+# The fresh-set check (rules/fresh.smk): the stored sets' cells drawn again with this seed.
+FRESH_SEED = config.get("fresh_scenario_seed", 7)
+
+
+def fresh_files(kind):
+    """The reference's evaluations of every seed and Table 1 cell: on the stored sets, or the fresh."""
+    root = f"{RESULTS}/fresh/eval" if kind == "fresh" else f"{RESULTS}/eval"
+    return expand(f"{root}/{REF}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
+                  seed=SEEDS, home=HOMES, placement=PLACEMENTS, height=HEIGHTS)

@@ -1,0 +1,70 @@
+# The fresh-set check (`snakemake --cores 2 fresh`, outside `all`): the reference's trained actors
+# on scenario sets drawn with `fresh_scenario_seed` in Table 1's homes and cells, read against the
+# stored sets. The sets and evaluations live under results/{profile}/fresh/, apart from Table 1's.
+# (workflow_check refuses a fresh seed equal to the stored sets' seed)
+
+
+rule fresh_scenarios:
+    """A Table 1 cell's scenarios drawn with the fresh seed."""
+    output:
+        "results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/fresh/scenarios/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/fresh/scenarios/{layout}/{placement}/h{height}.tsv"
+    params:
+        n=PROF["scenarios_per_cell"],
+        seed=FRESH_SEED,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch scenarios --layout {wildcards.layout} --placement {wildcards.placement} "
+        "--height {wildcards.height} --n {params.n} --seed {params.seed} --out {output} > {log} 2>&1"
+
+
+rule fresh_evaluate:
+    """One trained policy on one fresh set."""
+    input:
+        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios="results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
+    output:
+        "results/{profile}/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
+rule fresh:
+    """The reference on its stored sets against the fresh sets, per home and cell."""
+    input:
+        stored=ancient(fresh_files("stored")),
+        fresh=fresh_files("fresh"),
+    output:
+        expand(f"{FIGS}/fresh.{{ext}}", ext=["csv", "md"]),
+    log:
+        f"{RESULTS}/logs/report/fresh.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/report/fresh.tsv"
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+        variant=REF,
+        seed=FRESH_SEED,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report fresh --stored {input.stored} --fresh {input.fresh} --variant {params.variant} "
+        "--fresh-seed {params.seed} --out-prefix {params.prefix} > {log} 2>&1"
