@@ -88,6 +88,8 @@ class HomePoolEnv(gymnasium.Env):
         if seed not in self.split:
             raise ValueError(f"home{seed} is outside this env's split [{self.split.start}, {self.split.stop})")
         layout = self.names[seed] if self.names is not None else f"home{seed}"
+        if self.env_id not in gymnasium.registry:
+            import egosearch.envs  # noqa: F401  (registers the EgoSearch ids)
         return gymnasium.make(self.env_id, layout=layout, **self.env_kwargs)
 
     @property

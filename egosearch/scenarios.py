@@ -182,15 +182,29 @@ def target_probe_points(target: Part) -> np.ndarray:
     return np.asarray(pts)
 
 
+def target_surface_points(target: Part, per_edge: int = 5) -> np.ndarray:
+    """Points of a lattice over the whole surface of the target's box (``per_edge`` per edge: 98 for
+    5). The env's sensor may see any sliver of the target, a thin object's edge included, which the
+    inner probes of :func:`target_probe_points` can all miss; ℓ must count such poses."""
+    cx, cy, cz = target.center
+    c, s = math.cos(target.yaw), math.sin(target.yaw)
+    grid = np.linspace(-0.5, 0.5, per_edge)
+    lx, ly, lz = (a.ravel() for a in np.meshgrid(grid, grid, grid, indexing="ij"))
+    on_surface = (np.abs(lx) == 0.5) | (np.abs(ly) == 0.5) | (np.abs(lz) == 0.5)
+    lx, ly, lz = (a[on_surface] * size for a, size in zip((lx, ly, lz), target.size))
+    return np.column_stack([cx + c * lx - s * ly, cy + s * lx + c * ly, cz + lz])
+
+
 #: A pose sees the target when this many probe points are in plain sight: one alone can be a
 #: sliver that the camera's pixels miss.
 MIN_VISIBLE_PROBES = 2
 
 
-def visible_from(layout: str, cameras: np.ndarray, target: Part, min_probes: int = MIN_VISIBLE_PROBES) -> np.ndarray:
-    """For each camera position (N x 3), whether straight lines reach at least ``min_probes``
-    target probe points unblocked by the home."""
-    points = target_probe_points(target)
+def visible_from(layout: str, cameras: np.ndarray, target: Part, min_probes: int = MIN_VISIBLE_PROBES,
+                 points: np.ndarray | None = None) -> np.ndarray:
+    """For each camera position (N x 3), whether straight lines reach at least ``min_probes`` of the
+    target's ``points`` (default: :func:`target_probe_points`) unblocked by the home."""
+    points = target_probe_points(target) if points is None else np.asarray(points, dtype=float)
     origins = np.repeat(cameras, len(points), axis=0)
     ends = np.tile(points, (len(cameras), 1))
     vec = ends - origins
@@ -220,15 +234,15 @@ def success_region(layout: str, target: Part, height: float, distance: float = S
 def shortest_path_region(layout: str, target: Part, height: float, distance: float = SUCCESS_DISTANCE) -> np.ndarray:
     """Grid cells holding at least one pose where the env might declare success: reachable by
     the body (in contact with furniture too), some point of the cell within ``distance``, and
-    any probe point of the target in sight. Wider than :func:`success_region` on purpose:
-    ℓ measured to it must not exceed the path of any success."""
+    any point of the target's surface in sight (:func:`target_surface_points`). Wider than
+    :func:`success_region` on purpose: ℓ measured to it must not exceed the path of any success."""
     grid = navgrid_for(layout)
     near = grid.touch_region(target.center[:2], distance)
     rows, cols = np.nonzero(near)
     if len(rows) == 0:
         return near
     cams = np.column_stack([grid.xs[cols], grid.ys[rows], np.full(len(rows), height)])
-    seen = visible_from(layout, cams, target, min_probes=1)
+    seen = visible_from(layout, cams, target, min_probes=1, points=target_surface_points(target))
     region = np.zeros_like(near)
     region[rows[seen], cols[seen]] = True
     return region

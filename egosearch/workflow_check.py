@@ -76,9 +76,10 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
 
 def workflow_variants(config: dict, compare: bool = False, directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
     """Every variant the run may train, read and checked against the run's learner profile:
-    ``variants``, ``reference_variant``, the profile's ``budget`` variants and, when set (or when
+    ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference and, when set (or when
     ``compare`` is a target), ``variant``."""
-    budget = config["profiles"][config["profile"]].get("budget", {}).get("variants", [])
+    budget_config = config["profiles"][config["profile"]].get("budget", {})
+    budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
     names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
                                + generalise["variants"]))

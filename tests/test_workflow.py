@@ -50,6 +50,21 @@ def test_dry_run_of_generalise_reads_four_groups_of_homes():
     assert "generalise" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout
 
 
+def test_the_budget_study_reads_its_settings_against_its_own_reference():
+    # The cpu settings train in kitchen_living while the reference variant trains in both paper homes:
+    # `budget: reference` names the run they are read against, with the profile's seeds.
+    out = run(["-n", "-p", "-R", "budget", "budget"])
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    assert "--chosen head_on_kitchen_living " in text
+    for seed in (0, 1, 2):
+        assert f"--run head_on_kitchen_living=results/cpu/train/head_on_kitchen_living/seed{seed}/curve.csv" in text
+    assert "--run head_on=" not in text
+    smoke = run(["-n", "-p", "budget", "--config", "profile=smoke"])
+    assert smoke.returncode == 0, smoke.stderr
+    assert "--chosen head_on " in smoke.stdout + smoke.stderr
+
+
 def test_dry_run_of_behaviour_traces_both_variants_outside_all():
     out = run(["-n", "-p", "behaviour", "searches", "--config", "profile=smoke"])
     assert out.returncode == 0, out.stderr

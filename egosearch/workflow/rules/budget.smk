@@ -13,7 +13,7 @@ rule budget:
         f"{RESULTS}/benchmarks/report/budget.tsv"
     params:
         runs=" ".join(f"--run {v}={curve}:{evals}" for v, runs in budget_inputs().items() for curve, evals in runs),
-        chosen=REF,
+        chosen=BUDGET_REF,
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
     conda:
         CONDA_ENV
