@@ -130,10 +130,10 @@ def fig6_random_files():
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top
 # of the profile), so the train and evaluate rules serve it unchanged; the profile's own setting
-# is the reference variant's runs, which `all` makes anyway.
+# is the runs of BUDGET_REF, all seeds.
 BUDGET = PROF.get("budget", {"variants": [], "seeds": [0]})
-# The setting the others are read against: the reference variant unless `budget: reference` names one
-# that trains where the budget settings train.
+# The setting the others are read against: the reference variant (whose runs `all` makes anyway)
+# unless `budget: reference` names one that trains where the budget settings train.
 BUDGET_REF = BUDGET.get("reference", REF)
 BUDGET_CELL = ("no_low_cabinets", "1.05")
 
