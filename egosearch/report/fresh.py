@@ -20,36 +20,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from egosearch.report.data import output_base, parse_eval_path, read_episodes
-from egosearch.report.stats import _two_level_means, scenario_seed_matrix, two_level_ci
+from egosearch.report.data import _sorted_cells, output_base, parse_eval_path, read_episodes
+from egosearch.report.stats import scenario_seed_matrix, shared_seed_difference_ci, two_level_ci
 
 FRESH_COLUMNS = ("home", "height", "placement", "stored", "stored_low", "stored_high", "fresh", "fresh_low",
                  "fresh_high", "difference", "ci_low", "ci_high", "n_stored", "n_fresh", "n_seeds")
 POOLED = "both homes"
-
-
-def shared_seed_difference_ci(stored: np.ndarray, fresh: np.ndarray, confidence: float = 0.95,
-                              n_resamples: int = 10_000, seed: int = 0) -> tuple[float, float]:
-    """Interval of mean(fresh) - mean(stored) for two (scenarios x seeds) matrices whose columns are
-    the same seeds and whose rows are different scenarios: each resample draws each side's rows on
-    their own and one draw of seed columns for both sides."""
-    stored, fresh = np.asarray(stored, float), np.asarray(fresh, float)
-    if stored.ndim != 2 or fresh.ndim != 2 or stored.shape[1] != fresh.shape[1] or not stored.size or not fresh.size:
-        raise ValueError(f"two non-empty matrices with the same seed columns needed, got {stored.shape} and "
-                         f"{fresh.shape}")
-    rng = np.random.default_rng(seed)
-    n_k = stored.shape[1]
-    diffs = np.empty(n_resamples)
-    chunk = max(1, 2_000_000 // max(1, max(stored.shape[0], fresh.shape[0]) * n_k))
-    for start in range(0, n_resamples, chunk):
-        b = min(chunk, n_resamples - start)
-        cols = rng.integers(0, n_k, (b, n_k))
-        diffs[start:start + b] = (_two_level_means(fresh, rng.integers(0, fresh.shape[0], (b, fresh.shape[0])), cols)
-                                  - _two_level_means(stored, rng.integers(0, stored.shape[0], (b, stored.shape[0])),
-                                                     cols))
-    alpha = (1 - confidence) / 2
-    lo, hi = np.quantile(diffs, [alpha, 1 - alpha])
-    return float(lo), float(hi)
 
 
 def _cells(paths: Iterable[PathLike]) -> dict[tuple[str, float, str], list[Path]]:
@@ -76,7 +52,7 @@ def fresh_frame(stored_files: Iterable[PathLike], fresh_files: Iterable[PathLike
         raise ValueError(f"the stored and fresh evaluations cover different cells: {only}")
     rows = []
     homes = sorted({home for home, _, _ in stored})
-    for height, placement in sorted({(h, p) for _, h, p in stored}):
+    for height, placement in _sorted_cells({(h, p) for _, h, p in stored}):
         for home in [*homes, POOLED]:
             pick = homes if home == POOLED else [home]
             if home == POOLED and len(homes) < 2:

@@ -144,6 +144,30 @@ def paired_two_level_ci(ref: np.ndarray, cand: np.ndarray, confidence: float = 0
     return float(lo), float(hi)
 
 
+def shared_seed_difference_ci(stored: np.ndarray, fresh: np.ndarray, confidence: float = 0.95,
+                              n_resamples: int = 10_000, seed: int = 0) -> tuple[float, float]:
+    """Interval of mean(fresh) - mean(stored) for two (scenarios x seeds) matrices whose columns are
+    the same seeds and whose rows are different scenarios: each resample draws each side's rows on
+    their own and one draw of seed columns for both sides."""
+    stored, fresh = np.asarray(stored, float), np.asarray(fresh, float)
+    if stored.ndim != 2 or fresh.ndim != 2 or stored.shape[1] != fresh.shape[1] or not stored.size or not fresh.size:
+        raise ValueError(f"two non-empty matrices with the same seed columns needed, got {stored.shape} and "
+                         f"{fresh.shape}")
+    rng = np.random.default_rng(seed)
+    n_k = stored.shape[1]
+    diffs = np.empty(n_resamples)
+    chunk = max(1, 2_000_000 // max(1, max(stored.shape[0], fresh.shape[0]) * n_k))
+    for start in range(0, n_resamples, chunk):
+        b = min(chunk, n_resamples - start)
+        cols = rng.integers(0, n_k, (b, n_k))
+        diffs[start:start + b] = (_two_level_means(fresh, rng.integers(0, fresh.shape[0], (b, fresh.shape[0])), cols)
+                                  - _two_level_means(stored, rng.integers(0, stored.shape[0], (b, stored.shape[0])),
+                                                     cols))
+    alpha = (1 - confidence) / 2
+    lo, hi = np.quantile(diffs, [alpha, 1 - alpha])
+    return float(lo), float(hi)
+
+
 def detectable_difference(sd_paired: float, n_scenarios: int, alpha: float = 0.05, power: float = 0.8) -> float:
     """Smallest true mean difference a paired two-sided test at level ``alpha`` detects with probability
     ``power`` over ``n_scenarios`` scenarios whose seed-averaged paired differences have standard

@@ -1,11 +1,11 @@
 # The fresh-set check (`snakemake --cores 2 fresh`, outside `all`): the reference's trained actors
 # on scenario sets drawn with `fresh_scenario_seed` in Table 1's homes and cells, read against the
 # stored sets. The sets and evaluations live under results/{profile}/fresh/, apart from Table 1's.
-# (workflow_check refuses a fresh seed equal to the stored sets' seed)
+# (workflow_check refuses a fresh seed equal to the stored sets' seed). The sets and evaluations are
+# the scenarios and evaluate rules' jobs with the fresh seed and paths.
 
 
-rule fresh_scenarios:
-    """A Table 1 cell's scenarios drawn with the fresh seed."""
+use rule scenarios as fresh_scenarios with:
     output:
         "results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
     log:
@@ -15,19 +15,9 @@ rule fresh_scenarios:
     params:
         n=PROF["scenarios_per_cell"],
         seed=FRESH_SEED,
-    threads: 1
-    resources:
-        mem_mb=1000,
-        runtime=10,
-    conda:
-        CONDA_ENV
-    shell:
-        "egosearch scenarios --layout {wildcards.layout} --placement {wildcards.placement} "
-        "--height {wildcards.height} --n {params.n} --seed {params.seed} --out {output} > {log} 2>&1"
 
 
-rule fresh_evaluate:
-    """One trained policy on one fresh set."""
+use rule evaluate as fresh_evaluate with:
     input:
         actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         scenarios="results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
@@ -37,15 +27,6 @@ rule fresh_evaluate:
         "results/{profile}/logs/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
         "results/{profile}/benchmarks/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
-    threads: 1
-    resources:
-        mem_mb=1500,
-        runtime=30,
-    conda:
-        CONDA_ENV
-    shell:
-        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
-        "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
 rule fresh:
