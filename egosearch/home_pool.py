@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import gymnasium
 
+import egosearch.envs  # noqa: F401  (registers the ids this env builds)
+
 HELDOUT_HOME_SEEDS = range(900_000, 900_020)
 """The held-out split: generated homes ``home900000`` ... ``home900019``, evaluated by
 ``snakemake generalise``, never trained in."""
@@ -88,8 +90,6 @@ class HomePoolEnv(gymnasium.Env):
         if seed not in self.split:
             raise ValueError(f"home{seed} is outside this env's split [{self.split.start}, {self.split.stop})")
         layout = self.names[seed] if self.names is not None else f"home{seed}"
-        if self.env_id not in gymnasium.registry:
-            import egosearch.envs  # noqa: F401  (registers the EgoSearch ids)
         return gymnasium.make(self.env_id, layout=layout, **self.env_kwargs)
 
     @property
