@@ -205,7 +205,8 @@ def _cmd_report(args) -> None:
         from egosearch.report.generalise import generalise_report
 
         trained_on = dict(item.partition("=")[::2] for item in args.trained_on)
-        for path in generalise_report(args.files, args.bounds, args.out_prefix, trained_on, args.generated):
+        for path in generalise_report(args.files, args.bounds, args.out_prefix, trained_on, args.generated,
+                                      reference=args.reference):
             print(f"wrote {path}")
     elif args.what == "fresh":
         from egosearch.report.fresh import fresh_report
@@ -502,6 +503,8 @@ def _report_parsers(sub) -> None:
     r.add_argument("--bounds", nargs="+", required=True, help="the random searcher's and the oracle's evaluation "
                                                               "CSVs on the same groups")
     r.add_argument("--generated", help="the variant trained in generated homes (its gap to its training split)")
+    r.add_argument("--reference", help="the variant trained in the paper homes: the generated-homes variant's "
+                                       "score there is read against it")
     r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
                    help="what each variant trained in, for the labels")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))

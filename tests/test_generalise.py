@@ -85,6 +85,28 @@ def test_normalised_score_and_gap_by_hand(tmp_path):
     assert outs[2].stat().st_size > 1000
 
 
+def test_the_generated_variant_is_read_against_the_reference_in_a_paper_home(tmp_path):
+    # bounds 0.1 / 0.9 as above; in kitchen_living the generated-homes variant solves 5 and 3 of 10
+    # (0.4 -> 0.375), the reference 7 and 7 (0.7 -> 0.75): -0.375. No such line in a generated group.
+    root = tmp_path / "eval"
+    files, bounds = [], []
+    for group in ("generated_train", "kitchen_living"):
+        for name, vals in (("random", [1] + [0] * 9), ("oracle", [1] * 9 + [0])):
+            bounds.append(_write(root / name / "seed0" / group / "everywhere" / "h1.05.csv", vals))
+        for variant, solved in (("gen", (5, 3)), ("ref", (7, 7))):
+            for seed, k in enumerate(solved):
+                files.append(_write(root / variant / f"seed{seed}" / group / "everywhere" / "h1.05.csv",
+                                    [1] * k + [0] * (10 - k)))
+    df = generalise_frame(files, bounds, generated="gen", reference="ref", n_resamples=2000)
+    row = df[(df.variant == "gen") & (df.group == "kitchen_living")].iloc[0]
+    assert row.vs_reference == pytest.approx(-0.375)
+    assert row.vs_reference_low <= -0.375 <= row.vs_reference_high <= 0
+    others = df[(df.variant != "gen") | (df.group != "kitchen_living")]
+    assert others["vs_reference"].isna().all()
+    outs = generalise_report(files, bounds, tmp_path / "out" / "g", generated="gen", reference="ref", n_resamples=500)
+    assert "against `ref`" in outs[1].read_text() and "- kitchen_living (paper): -0.37 [" in outs[1].read_text()
+
+
 def test_a_bound_that_missed_scenarios_is_one_line(tmp_path):
     files = [_write(tmp_path / "eval/p/seed0/kitchen_living/everywhere/h1.05.csv", [1, 0, 1])]
     bounds = [_write(tmp_path / "eval/random/seed0/kitchen_living/everywhere/h1.05.csv", [0, 0]),

@@ -46,7 +46,14 @@ def _stored_results(root: Path) -> None:
         "wall_s_all_jobs_summed": 10860.0, "note": "resumed once",
         "jobs": [{"rule": "train", "job": "head_on/seed0", "wall_s": 7200.0},
                  {"rule": "eval", "job": "head_off/seed0/kitchen_living/everywhere/h1.05", "wall_s": 60.0},
-                 {"rule": "train", "job": "my_variant/seed0", "wall_s": 3600.0}]}))
+                 {"rule": "train", "job": "my_variant/seed0", "wall_s": 3600.0},
+                 {"rule": "train", "job": "head_on_generated_homes/seed0", "wall_s": 1800.0},
+                 {"rule": "eval", "job": "head_on/seed0/generated_heldout/everywhere/h1.05", "wall_s": 30.0},
+                 {"rule": "bound", "job": "oracle/seed0/generated_train/everywhere/h1.05", "wall_s": 30.0},
+                 {"rule": "report", "job": "generalise", "wall_s": 12.0},
+                 {"rule": "report", "job": "table1", "wall_s": 12.0},
+                 {"rule": "report", "job": "budget", "wall_s": 12.0},
+                 {"rule": "traces", "job": "head_on/seed0/kitchen_living/everywhere/h1.05", "wall_s": 24.0}]}))
 
 
 README = """# t
@@ -70,9 +77,11 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     # fig6: first, last (with its seed CI) and best evaluation of each variant
     assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | seeds | 0.30 at 4,000 |" in out
     assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | seeds | 0.05 at 0 |" in out
-    assert "commit `0123456`" in out and "3 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
-    # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it
-    assert "summed time / 2, one-thread jobs): 1.01 h; the other 1.00 h are variant comparisons" in out
+    assert "commit `0123456`" in out and "10 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
+    # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it; the
+    # generated-homes variant, the generated groups and the generalise report are `generalise`'s
+    assert "summed time / 2, one-thread jobs): 1.01 h; of `snakemake --cores 2 generalise` after it: 0.26 h" in out
+    assert "the other 1.01 h of jobs are comparisons and studies outside both" in out
     assert "resumed once" in out
     assert "*Not generated yet: `paper_figs/p/fig7.csv` is missing" in out     # never invented when the file is absent
     assert render_readme(out, tmp_path, "p") == out         # idempotent

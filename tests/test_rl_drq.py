@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import PooledConvEncoder, SacDrqAgent, conv_sides, pool_depth, random_shift
@@ -112,6 +113,48 @@ def test_drq_update_moves_the_critic_toward_a_fixed_target():
     assert np.isnan(m["curl_loss"]) and np.isfinite(m["actor_loss"]) and agent.num_updates == 61
 
 
+def _fixed_batch(agent: SacDrqAgent, n: int = 16) -> dict:
+    replay = MultiReplay(1, 64, image_size=agent.replay_image_size, frame_history=5, n_step=1)
+    rng = np.random.default_rng(0)
+    # smooth frames (one depth per column, as a wall seen head on), so that a decoder can learn them
+    ramp = np.linspace(0, 255, 100)
+    for _ in range(40):
+        o = {"depth": np.broadcast_to((ramp * rng.uniform(0.2, 1.0)).astype(np.uint8), (5, 100, 100)).copy(),
+             "mask": np.zeros(30, np.float32), "proprio": np.zeros(4, np.float32)}
+        replay.add(0, agent.replay_obs(o), rng.uniform(-1, 1, 5), 1.0, agent.replay_obs(o), True, False)
+    return replay.sample(n)
+
+
+def test_reconstruction_loss_trains_a_decoder_and_the_encoder_and_resumes():
+    aux = load_config("smoke", {**DRQ, "batch_size": 16, "encoder_aux_loss": "reconstruction"})
+    torch.manual_seed(0)
+    agent = SacDrqAgent(aux, 5)
+    batch = _fixed_batch(agent)
+    torch.manual_seed(1)
+    plain = SacDrqAgent(load_config("smoke", {**DRQ, "batch_size": 16}), 5)
+    for name in ("encoder", "critic", "critic_target", "actor"):
+        getattr(plain, name).load_state_dict(getattr(agent, name).state_dict())
+    torch.manual_seed(2)
+    first = agent.update(batch)
+    torch.manual_seed(2)
+    assert np.isnan(plain.update(batch)["aux_loss"])
+    # the aux loss's gradient reaches the encoder: same weights, batch and noise, other encoder
+    assert not all(torch.equal(a, b) for a, b in zip(agent.encoder.parameters(), plain.encoder.parameters()))
+    losses = [first["aux_loss"]] + [agent.update(batch)["aux_loss"] for _ in range(80)]
+    assert losses[-1] < 0.3 * losses[0], (losses[0], losses[-1])
+    # its decoder and optimiser travel with the agent's state; a state without them is refused
+    state = agent.state_dict()
+    again = SacDrqAgent(aux, 5)
+    again.load_state_dict(state)
+    assert all(torch.equal(a, b) for a, b in zip(again.decoder.parameters(), agent.decoder.parameters()))
+    with pytest.raises(AgentStateError, match="encoder_aux_loss"):
+        again.load_state_dict(plain.state_dict())
+    with pytest.raises(ValueError, match="encoder_aux_loss"):
+        load_config("smoke", {"encoder_aux_loss": "reconstruction"})  # sac_curl has CURL's loss, no decoder
+    with pytest.raises(ValueError, match="encoder_aux_loss"):
+        load_config("smoke", {**DRQ, "encoder_aux_loss": "autoencoder"})
+
+
 def test_drq_training_with_lockstep_envs_resumes_and_writes_a_loadable_actor(tmp_path):
     cfg = load_config("smoke", {**DRQ, "num_envs": 3, "n_step": 3, "update_every": 3, "total_env_steps": 300,
                                 "checkpoint_every": 150, "eval_every": 150, "log_every": 50})
@@ -152,7 +195,8 @@ def test_training_throughput_counts_env_steps_per_core_second():
     assert r["env_steps_per_core_s"] == pytest.approx(120 / r["core_s"], rel=0.01)
 
 
-@pytest.mark.parametrize("overrides", [{}, DRQ], ids=["sac_curl", "sac_drq"])
+@pytest.mark.parametrize("overrides", [{}, DRQ, {**DRQ, "encoder_aux_loss": "reconstruction"}],
+                         ids=["sac_curl", "sac_drq", "sac_drq_reconstruction"])
 def test_killed_and_resumed_run_equals_the_run_that_was_not_stopped(tmp_path, overrides):
     cfg = load_config("smoke", {"device": "cpu", "num_threads": 1, **overrides,
                                 "num_envs": 1 if not overrides else 3, "n_step": 1 if not overrides else 3})

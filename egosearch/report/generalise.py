@@ -11,7 +11,11 @@ its evaluation paths: ``generated_heldout``, ``generated_train``, ``kitchen_livi
   scenarios) and the policy's seeds;
 - for the generated-homes variant, ``gap_to_train``: its normalised score in the group minus the
   one in its own training split, with an interval that resamples each group's scenarios and the
-  seeds once (the same training runs read in both).
+  seeds once (the same training runs read in both);
+- for the generated-homes variant in each paper home, ``vs_reference``: its normalised score minus
+  the reference's, a policy trained in those homes (the issue's aim: within 0.05), paired: one draw
+  of the scenarios for both (they ran the same ones, beside the same bounds), each policy's seeds
+  drawn apart (different training runs).
 """
 
 from __future__ import annotations
@@ -34,7 +38,9 @@ GROUP_LABELS = {"generated_train": "generated homes (training split)",
                 "kitchen_living": "kitchen_living (paper)", "bedroom_bath": "bedroom_bath (paper)"}
 COLUMNS = ("variant", "trained_on", "group", "n_scenarios", "n_seeds", "success", "success_low", "success_high",
            "spl", "spl_low", "spl_high", "random_success", "oracle_success", "normalised", "normalised_low",
-           "normalised_high", "gap_to_train", "gap_low", "gap_high")
+           "normalised_high", "gap_to_train", "gap_low", "gap_high", "vs_reference", "vs_reference_low",
+           "vs_reference_high")
+PAPER_GROUPS = ("kitchen_living", "bedroom_bath")
 
 PathLike = str | os.PathLike
 
@@ -87,7 +93,8 @@ def _interval(x: np.ndarray, confidence: float) -> tuple[float, float]:
 
 def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[PathLike],
                      trained_on: Mapping[str, str] | None = None, generated: str | None = None,
-                     confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> pd.DataFrame:
+                     confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
+                     reference: str | None = None) -> pd.DataFrame:
     """One row per (variant, group) with :data:`COLUMNS` (see the module docstring)."""
     policies = _by_variant_group(policy_files)
     bounds = _by_variant_group(bound_files)
@@ -123,7 +130,8 @@ def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[Pat
                          "random_success": float(mean_r), "oracle_success": float(mean_o),
                          "normalised": float(_normalised(np.array(mean_p), np.array(mean_r), np.array(mean_o))),
                          **dict(zip(("normalised_low", "normalised_high"), _interval(norm_b, confidence))),
-                         "gap_to_train": math.nan, "gap_low": math.nan, "gap_high": math.nan})
+                         "gap_to_train": math.nan, "gap_low": math.nan, "gap_high": math.nan,
+                         "vs_reference": math.nan, "vs_reference_low": math.nan, "vs_reference_high": math.nan})
     if generated is not None and (generated, "generated_train") in boots:
         train_m, train_b, _ = boots[(generated, "generated_train")]
         for row in rows:
@@ -140,6 +148,20 @@ def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[Pat
             train_row = next(r for r in rows if r["variant"] == generated and r["group"] == "generated_train")
             row["gap_to_train"] = row["normalised"] - train_row["normalised"]
             row["gap_low"], row["gap_high"] = _interval(gap, confidence)
+    if generated is not None and reference is not None:
+        for row in rows:
+            group = row["group"]
+            if row["variant"] != generated or group not in PAPER_GROUPS or (reference, group) not in boots:
+                continue
+            gen_m, b, _ = boots[(generated, row["group"])]
+            ref_m = boots[(reference, row["group"])][0]
+            scenarios = _draws(n_resamples, gen_m.shape[0], rng)
+            gen_b = _boot_group(gen_m, b["random"], b["oracle"], scenarios, _draws(n_resamples, gen_m.shape[1], rng))
+            ref_b = _boot_group(ref_m, b["random"], b["oracle"], scenarios, _draws(n_resamples, ref_m.shape[1], rng))
+            ref_row = next(r for r in rows if r["variant"] == reference and r["group"] == row["group"])
+            row["vs_reference"] = row["normalised"] - ref_row["normalised"]
+            row["vs_reference_low"], row["vs_reference_high"] = _interval(
+                _normalised(*gen_b) - _normalised(*ref_b), confidence)
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
 
@@ -153,9 +175,10 @@ def _fmt(x: float, lo: float | None = None, hi: float | None = None) -> str:
 
 def generalise_report(policy_files: Iterable[PathLike], bound_files: Iterable[PathLike], out_prefix: PathLike,
                       trained_on: Mapping[str, str] | None = None, generated: str | None = None,
-                      confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> list[Path]:
+                      confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
+                      reference: str | None = None) -> list[Path]:
     """Write ``{prefix}.csv``, ``.md`` and ``.png``; return their paths."""
-    df = generalise_frame(policy_files, bound_files, trained_on, generated, confidence, n_resamples, seed)
+    df = generalise_frame(policy_files, bound_files, trained_on, generated, confidence, n_resamples, seed, reference)
     base = output_base(out_prefix, "generalise")
     csv, md_path, png = _with(base, ".csv"), _with(base, ".md"), _with(base, ".png")
     df.to_csv(csv, index=False, float_format="%.6g")
@@ -181,6 +204,12 @@ def generalise_report(policy_files: Iterable[PathLike], bound_files: Iterable[Pa
         md += ["", f"`{generated}`: its normalised score in each group minus the one in its own training split:", ""]
         md += [f"- {GROUP_LABELS.get(r.group, r.group)}: {r.gap_to_train:+.2f} [{r.gap_low:+.2f}, {r.gap_high:+.2f}]"
                for r in gaps.itertuples(index=False)]
+    versus = df[np.isfinite(df["vs_reference"])]
+    if len(versus):
+        md += ["", f"`{generated}` against `{reference}`, which trained in the paper homes: normalised score of "
+               f"`{generated}` minus `{reference}`'s (paired: the same scenarios; each policy's seeds apart):", ""]
+        md += [f"- {GROUP_LABELS.get(r.group, r.group)}: {r.vs_reference:+.2f} "
+               f"[{r.vs_reference_low:+.2f}, {r.vs_reference_high:+.2f}]" for r in versus.itertuples(index=False)]
     md += ["", f"Brackets: {pct} two-level bootstrap (scenarios, then seeds); the two placement schemes pooled. "
            f"From `{csv.name}`.", ""]
     md_path.write_text("\n".join(md), encoding="utf-8")

@@ -88,8 +88,30 @@ def variants_of_all(config: dict | None = None) -> list[str]:
     return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
 
 
-def _job_of_all(job: dict, variants: set[str]) -> bool:
-    return job["rule"] not in ("train", "eval") or job["job"].split("/", 1)[0] in variants
+GENERATED_GROUPS = ("generated_train", "generated_heldout")
+"""The generalisation benchmark's groups of generated homes (rules/common.smk's layouts)."""
+REPORTS_OUTSIDE_ALL = {"budget": "other", "fresh": "other", "behaviour": "other", "searches": "other",
+                       "generalise": "generalise"}
+
+
+def job_study(job: dict, config: dict | None = None) -> str:
+    """Which command a recorded job belongs to: "all", "generalise", or "other" (comparisons,
+    the budget study, the fresh-set check, the traces)."""
+    config = config or workflow_config()
+    of_all = set(variants_of_all(config))
+    generalise_only = set(config.get("generalise", {}).get("variants", [])) - of_all
+    rule, parts = job["rule"], job["job"].split("/")
+    if rule in ("fresh", "traces"):
+        return "other"
+    if rule == "report":
+        return REPORTS_OUTSIDE_ALL.get(parts[0], "all")
+    if any(part in GENERATED_GROUPS for part in parts):
+        return "generalise"
+    if rule in ("train", "eval"):
+        if parts[0] in of_all:
+            return "all"
+        return "generalise" if parts[0] in generalise_only else "other"
+    return "all"
 
 
 def block_provenance(root: Path, profile: str) -> str:
@@ -100,9 +122,10 @@ def block_provenance(root: Path, profile: str) -> str:
     machine = record.get("machine", {})
     per_rule = record.get("wall_s_per_rule_summed", {})
     cores = int(machine.get("cores") or 1)
-    variants = set(variants_of_all())
-    of_all = sum(job["wall_s"] for job in record["jobs"] if _job_of_all(job, variants))
-    others = record["wall_s_all_jobs_summed"] - of_all
+    config = workflow_config()
+    summed = {"all": 0.0, "generalise": 0.0, "other": 0.0}
+    for job in record["jobs"]:
+        summed[job_study(job, config)] += job["wall_s"]
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
              f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}, "
              f"{machine.get('cores', '?')} cores, torch {machine.get('torch', '?')}.",
@@ -112,8 +135,11 @@ def block_provenance(root: Path, profile: str) -> str:
              # time over N is what `snakemake --cores N all` takes from a fresh clone, give or take
              # the tail where fewer than N jobs are ready.
              f"- Estimated wall time of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed "
-             f"time / {cores}, one-thread jobs): {of_all / cores / 3600:.2f} h"
-             + (f"; the other {others / 3600:.2f} h are variant comparisons." if others > 0 else ".")]
+             f"time / {cores}, one-thread jobs): {summed['all'] / cores / 3600:.2f} h"
+             + (f"; of `snakemake --cores {cores} generalise` after it: {summed['generalise'] / cores / 3600:.2f} h"
+                if summed["generalise"] > 0 else "")
+             + (f"; the other {summed['other'] / 3600:.2f} h of jobs are comparisons and studies outside both "
+                "(compare, budget, fresh, the traces)." if summed["other"] > 0 else ".")]
     if record.get("note"):
         lines.append(f"- Note kept in the record: {record['note']}")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"

@@ -9,6 +9,8 @@
 - :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, the same interface with a DrQ-v2-style update;
 - :mod:`egosearch.rl.sac_drq_recurrent`: ``SacDrqRecurrentAgent``, SAC-DrQ with a GRU in the actor
   and another in the critic, trained on replayed sequences with burn-in (not the paper's algorithm);
+- :mod:`egosearch.rl.ppo`: ``PpoAgent``, PPO on SAC-DrQ's actor with a separate value network, trained
+  on each env's latest rollout (on-policy; not the paper's algorithm);
 - :mod:`egosearch.rl.replay`: ``ReplayBuffer`` storing each depth frame once, ``MultiReplay``
   (one ring per env, n-step returns), ``replay_gb``;
 - :mod:`egosearch.rl.train`: ``train(env_id, cfg, out_dir, env_kwargs, evaluate_fn)``

@@ -101,14 +101,16 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
     """Env steps per core-second of a short REAL training run of ``profile`` (head-on,
     kitchen_living, everywhere): env stepping, acting and updates all in, its own evaluations
     left out. Core-seconds are this process's CPU time (user + system), so the figure holds on
-    a busy machine too. Warm-up is cut to a tenth of the run so that updates weigh as in a long run."""
+    a busy machine too. Warm-up is cut to a tenth of the run so that updates weigh as in a long run
+    (unless ``overrides`` set ``init_steps``: PPO has no warm-up)."""
     import tempfile
 
     from egosearch.rl.train import train
 
-    cfg = load_config(profile, {**(overrides or {}), "total_env_steps": env_steps,
-                                "init_steps": max(1, env_steps // 10), "eval_every": env_steps,
-                                "checkpoint_every": env_steps, "log_every": env_steps})
+    overrides = overrides or {}
+    cfg = load_config(profile, {**overrides, "total_env_steps": env_steps,
+                                "init_steps": overrides.get("init_steps", max(1, env_steps // 10)),
+                                "eval_every": env_steps, "checkpoint_every": env_steps, "log_every": env_steps})
     with tempfile.TemporaryDirectory() as out:
         cpu0, wall0 = time.process_time(), time.perf_counter()
         train("EgoSearch-v0", cfg, out, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},

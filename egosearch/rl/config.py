@@ -34,10 +34,12 @@ CURRICULUM_START_RADIUS = 1.0
 """Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
 CURRICULUM_END_RADIUS = 12.0
 """Radius (m) the curriculum reaches at its end: more than any home's extent."""
-ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent")
+ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent", "ppo")
 """Learners :mod:`egosearch.rl.train` can run (see ``LearnerConfig.algorithm``)."""
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.env.DISTANCE_REWARDS``; a test keeps them equal)."""
+ENCODER_AUX_LOSSES = ("none", "reconstruction")
+"""Auxiliary losses on the "sac_drq" encoder (see ``LearnerConfig.encoder_aux_loss``)."""
 
 _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
                       "tanh": "Tanh"}
@@ -179,7 +181,10 @@ class LearnerConfig:
     critic, trained on replayed sequences with burn-in (:mod:`egosearch.rl.sac_drq_recurrent`;
     Ni et al. 2022, Kapturowski et al. 2019): a recurrent policy, which CHANGES THE ALGORITHM
     further (the paper's policy sees only the last ``frame_history`` frames); no profile uses it,
-    a variant sets it. Every "sac_drq" field applies to it as well."""
+    a variant sets it. Every "sac_drq" field applies to it as well.
+    "ppo" = ours, PPO (Schulman et al. 2017) on SAC-DrQ's actor, with a separate value network
+    (:mod:`egosearch.rl.ppo`): an on-policy learner, which CHANGES THE ALGORITHM (the paper's is
+    SAC + CURL); no profile uses it, a variant sets it (see the "ppo_*" fields)."""
     num_envs: int = 1
     """Ours (CURL: 1): environments stepped in lockstep in one process, their actions computed
     in one batched forward pass (acting cost per env step falls ~N-fold). Each env has its own
@@ -217,14 +222,28 @@ class LearnerConfig:
     uses the stored scenarios."""
 
     critic_privileged_state: bool = False
-    """Paper: False (the critic sees what the actor sees). True ("sac_drq" and "sac_drq_recurrent"
-    only): an asymmetric
+    """Paper: False (the critic sees what the actor sees). True ("sac_drq", "sac_drq_recurrent"
+    and "ppo" only; for "ppo" the value network reads it): an asymmetric
     actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
     and the target's positions, the target in the body's frame, its distance: see
     ``egosearch.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
     (history + state, not state alone). The actor, and so every policy and actor file, sees only
     the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
     ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""
+
+    encoder_aux_loss: str = "none"
+    """Paper: "none" for "sac_drq" (the paper's encoder has CURL's contrastive loss beside the
+    critic's; "sac_drq" drops it, so only the critic trains its encoder). "reconstruction"
+    ("sac_drq" only): SAC-AE's auxiliary loss (Yarats et al. 2019, *Improving sample efficiency in
+    model-free reinforcement learning from images*): a decoder rebuilds the newest depth frame,
+    pooled and shifted as the encoder saw it, from the conv features, and its squared error trains
+    the encoder beside the critic's loss, so the features the actor reads keep the free space a
+    critic with the privileged state may not need. A loss the paper's learner does not have: it
+    CHANGES THE ALGORITHM; the ``head_on_encoder_aux`` lever, no profile's default. TRAINING ONLY:
+    the decoder is not part of the actor file."""
+    encoder_aux_weight: float = 1.0
+    """SAC-AE (Yarats et al. 2019): 1 on pixels in [-0.5, 0.5]: the weight of
+    ``encoder_aux_loss`` against the critic's loss; read only when that loss is on."""
 
     recurrent_hidden_dim: int = 128
     """Ni et al. 2022 (a separate GRU for the actor and for the critic; 128 units is ours),
@@ -242,6 +261,43 @@ class LearnerConfig:
     "sac_drq_recurrent" only; the paper has none: steps before each replayed sequence that only
     warm its hidden state up from zero (no gradient, no loss). Part of a recurrent learner, which
     CHANGES THE ALGORITHM."""
+
+    # "ppo" only: PPO is a CHANGE OF ALGORITHM (the paper's learner is SAC + CURL) and no profile uses it.
+    # A rollout is the last ``update_every`` env steps (``update_every / num_envs`` per env); an update
+    # is ``ppo_epochs`` passes over it in ``ppo_minibatches`` minibatches (each an Adam step of the actor,
+    # at ``actor_lr``, and of the value network, at ``critic_lr``).
+    ppo_epochs: int = 4
+    """habitat-baselines' PointNav PPO configs (``ppo_epoch`` 2 to 4 across its versions; Schulman
+    et al. 2017: 3 to 10), "ppo"
+    only; the paper's learner is SAC + CURL: passes over each rollout per update."""
+    ppo_minibatches: int = 2
+    """habitat-baselines' PointNav PPO configs (``num_mini_batch`` 2 to 4 across its versions), "ppo"
+    only: minibatches each
+    rollout is cut into per pass (a random split each pass)."""
+    ppo_clip: float = 0.2
+    """Schulman et al. 2017 (PPO's epsilon 0.2; habitat-baselines' ``clip_param`` 0.1 to 0.2), "ppo" only: the
+    probability ratio is clipped to [1 - this, 1 + this] in the surrogate loss."""
+    gae_lambda: float = 0.95
+    """Schulman et al. 2016 (GAE; habitat-baselines' ``tau`` 0.95), "ppo" only: lambda of the
+    advantages, which bootstrap from the value of the next observation at a truncation and at the
+    rollout's end, never at a termination."""
+    value_coef: float = 0.5
+    """habitat-baselines' ``value_loss_coef`` 0.5, "ppo" only: weight of the value network's loss
+    0.5 (V - R)^2 (the value network shares no weights with the actor, so it only scales its
+    gradient before the norm clipping)."""
+    entropy_coef: float = 0.01
+    """habitat-baselines' ``entropy_coef`` 0.01, "ppo" only: weight of the entropy bonus (a
+    one-sample estimate of the tanh-squashed policy's entropy). train.csv's ``alpha`` column
+    shows it, the role SAC's temperature plays."""
+    max_grad_norm: float = 0.5
+    """habitat-baselines' ``max_grad_norm`` 0.5 (Andrychowicz et al. 2021, "What matters in
+    on-policy RL": 0.5), "ppo" only: the gradient norm of the actor and, separately, of the value
+    network is clipped to this before each step."""
+    ppo_init_std: float = 0.5
+    """Andrychowicz et al. 2021 (a smaller initial action std than 1 learned better; last policy
+    layer scaled by 0.01), "ppo" only: the actor starts with this std of the Gaussian before the
+    tanh, whatever the observation. SAC's actor starts near std e^-4 and its temperature widens it;
+    PPO has no such force, so it must start wide."""
 
     train_height_min: float = 1.0
     """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
@@ -345,6 +401,12 @@ class LearnerConfig:
             bad("critic_privileged_state", "False for algorithm sac_curl (only the sac_drq learners have a "
                 "privileged critic; "
                 "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
+        if self.encoder_aux_loss not in ENCODER_AUX_LOSSES:
+            bad("encoder_aux_loss", ", ".join(ENCODER_AUX_LOSSES))
+        if self.encoder_aux_loss != "none" and self.algorithm != "sac_drq":
+            bad("encoder_aux_loss", f"none for algorithm {self.algorithm} (only sac_drq has a decoder)")
+        if self.encoder_aux_weight < 0:
+            bad("encoder_aux_weight", ">= 0")
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
         # Updates fall on the multiples of update_every from the last warm-up step on (train._Run.update):
@@ -353,7 +415,7 @@ class LearnerConfig:
         if self.total_env_steps < first_update:
             bad("total_env_steps", f">= {first_update}, the env step of the first update (after init_steps="
                 f"{self.init_steps} random steps, an update every {self.update_every} steps): fewer train no update")
-        if self.algorithm in ("sac_drq", "sac_drq_recurrent"):
+        if self.algorithm in ("sac_drq", "sac_drq_recurrent", "ppo"):
             side = self.image_size // self.obs_downsample
             for i in range(self.encoder_num_layers):
                 side = (side - 3) // (2 if i < self.encoder_stride2_layers else 1) + 1
@@ -372,6 +434,8 @@ class LearnerConfig:
         if self.algorithm == "sac_drq_recurrent" and self.init_steps // self.num_envs < window:
             # each env ring must hold a whole window when the first update samples one
             bad("init_steps", f">= num_envs * (burn_in + sequence_length) = {self.num_envs * window}")
+        if self.algorithm == "ppo":
+            self._validate_ppo(bad)
         if not 0.3 <= self.train_height_min <= 1.8:
             bad("train_height_min", "[0.3, 1.8] m (training heights are drawn from [this, 1.8] m)")
         if not 0.0 < self.gamma <= 1.0:
@@ -399,6 +463,38 @@ class LearnerConfig:
                 or self.device == "mps"):
             bad("device", "auto, cpu, cuda, cuda:N or mps")
         return self
+
+    def _validate_ppo(self, bad: Callable[[str, str], None]) -> None:
+        """The rules of an on-policy update on the rollout the loop leaves in the replay."""
+        for name in ("ppo_epochs", "ppo_minibatches"):
+            if getattr(self, name) < 1:
+                bad(name, "an integer >= 1")
+        if self.n_step != 1:
+            bad("n_step", "1 for algorithm ppo (GAE takes one-step transitions)")
+        if self.init_steps != 0:
+            bad("init_steps", "0 for algorithm ppo (a warm-up's random actions would be trained on as the policy's)")
+        if self.updates_per_step != 1:
+            bad("updates_per_step", "1 for algorithm ppo (a second update would take the updated policy's "
+                "probabilities for the behaviour's; passes over a rollout are ppo_epochs)")
+        if self.update_every % self.num_envs:
+            bad("update_every", f"a multiple of num_envs={self.num_envs} for algorithm ppo (the rollout: "
+                "the same number of steps of every env)")
+        if self.update_every < self.ppo_minibatches:
+            bad("ppo_minibatches", f"1..update_every={self.update_every} (the rollout's transitions)")
+        if self.replay_capacity < 2 * self.update_every:
+            bad("replay_capacity", f">= 2 * update_every = {2 * self.update_every} for algorithm ppo (each env "
+                "ring keeps two rollouts, so that a rollout's frames are never overwritten)")
+        for name in ("ppo_clip", "max_grad_norm", "ppo_init_std"):
+            if getattr(self, name) <= 0:
+                bad(name, "> 0")
+        if not self.actor_log_std_min < math.log(self.ppo_init_std) < self.actor_log_std_max:
+            bad("ppo_init_std", f"(e^{self.actor_log_std_min}, e^{self.actor_log_std_max}) "
+                "(actor_log_std_min, actor_log_std_max)")
+        if not 0.0 <= self.gae_lambda <= 1.0:
+            bad("gae_lambda", "[0, 1]")
+        for name in ("value_coef", "entropy_coef"):
+            if getattr(self, name) < 0:
+                bad(name, ">= 0")
 
     def start_radius(self, env_steps: int) -> float | None:
         """The curriculum's start radius (m) at ``env_steps``; None once it is over (or off)."""

@@ -229,6 +229,17 @@ class ReplayBuffer:
             batch["state"], batch["next_state"] = put(self.state[i]), put(self.next_state[i])
         return batch
 
+    def latest(self, count: int) -> dict[str, torch.Tensor]:
+        """The newest ``count`` transitions, oldest first (an on-policy learner's rollout): as
+        :meth:`sample` gives them, plus ``truncated`` (B, 1). ``ValueError`` unless all are stored."""
+        first = self.n_added - int(count)
+        if count < 1 or first < self._first_valid():
+            raise ValueError(f"cannot take the latest {count} transitions: {len(self)} are stored")
+        batch = self.sample(count, indices=np.arange(first, self.n_added))
+        i = batch["index"].numpy() % self.capacity
+        batch["truncated"] = torch.from_numpy(self.truncated[i].astype(np.float32)[:, None]).to(self.device)
+        return batch
+
     # ---- checkpoints ----------------------------------------------------------------------
     _SCALARS = ("capacity", "image_size", "k", "mask_dim", "proprio_dim", "action_dim",
                 "n_frames", "n_added", "frames_written", "episode_start", "t", "in_episode")
@@ -369,6 +380,11 @@ class MultiReplay:
     def sample_at(self, env_index: int, indices) -> dict[str, torch.Tensor]:
         """The n-step transitions starting at absolute ``indices`` of ring ``env_index``."""
         return self._sample_n_step(self.buffers[env_index], 0, indices)
+
+    def latest(self, env_index: int, count: int) -> dict[str, torch.Tensor]:
+        """Ring ``env_index``'s newest ``count`` one-step transitions, oldest first, whatever
+        ``n_step`` (see :meth:`ReplayBuffer.latest`)."""
+        return self.buffers[env_index].latest(count)
 
     def _sample_n_step(self, buf: ReplayBuffer, batch_size: int,
                        indices: np.ndarray | None = None) -> dict[str, torch.Tensor]:

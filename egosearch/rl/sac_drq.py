@@ -22,6 +22,8 @@ one update several times cheaper:
 - n-step returns (``n_step``; DrQ-v2 uses 3) come from the replay (:class:`MultiReplay`);
 - ``critic_privileged_state`` (off unless a config sets it): the Q-heads also read the env's
   hidden ``state`` vector (asymmetric actor-critic); the actor never does.
+- ``encoder_aux_loss`` ("none" unless a config sets it): "reconstruction" adds SAC-AE's decoder
+  of the newest frame, whose loss trains the encoder beside the critic's (a lever, not a default).
 
 ``act`` / ``act_batch`` / ``update`` / ``state_dict`` / ``actor_state`` match
 :class:`egosearch.rl.sac_curl.SacCurlAgent`, so :mod:`egosearch.rl.train` drives either.
@@ -150,6 +152,20 @@ class DrqCritic(nn.Module):
         return self.q1(x), self.q2(x)
 
 
+class FrameDecoder(nn.Module):
+    """SAC-AE's auxiliary (``encoder_aux_loss: reconstruction``): conv features -> the newest pooled
+    depth frame, in the encoder's input scale [-0.5, 0.5]. Fully connected, because the pooled
+    frames are small (25 x 25 at the cpu profile)."""
+
+    def __init__(self, conv_dim: int, hidden_dim: int, side: int):
+        super().__init__()
+        self.side = int(side)
+        self.net = nn.Sequential(nn.Linear(conv_dim, hidden_dim), nn.ReLU(), nn.Linear(hidden_dim, side * side))
+
+    def forward(self, h: torch.Tensor) -> torch.Tensor:
+        return self.net(h).view(-1, self.side, self.side)
+
+
 _ARCH_FIELDS = ("frame_history", "image_size", "obs_downsample", "encoder_num_layers", "encoder_num_filters",
                 "encoder_stride2_layers", "encoder_latent_dim", "encoder_activation", "encoder_tanh",
                 "actor_hidden_dim", "actor_num_layers", "actor_activation", "actor_log_std_min",
@@ -206,6 +222,14 @@ class SacDrqAgent:
         self.actor_opt = adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
         self.alpha_opt = adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
         self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
+        self.decoder: FrameDecoder | None = None
+        if cfg.encoder_aux_loss == "reconstruction":
+            self.decoder = FrameDecoder(self.encoder.out_dim, cfg.encoder_latent_dim, self.replay_image_size)
+            self.decoder.apply(weight_init)
+            self.decoder.to(self.device)
+            # its own optimiser, so that agent states without a decoder keep their format
+            self.optimisers["decoder"] = adam(self.decoder.parameters(), cfg.critic_lr,
+                                              (cfg.critic_beta1, cfg.critic_beta2))
 
     @property
     def alpha(self) -> float:
@@ -261,9 +285,18 @@ class SacDrqAgent:
         h = self.encoder(obs)
         q1, q2 = self.critic(h, critic_extra, batch["action"])
         critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
+        loss = critic_loss
+        if self.decoder is not None:
+            # the newest frame as the encoder saw it (pooled, shifted), in its input scale
+            aux_loss = F.mse_loss(self.decoder(h), obs[:, -1] / 255.0 - 0.5)
+            loss = critic_loss + cfg.encoder_aux_weight * aux_loss
+            self.optimisers["decoder"].zero_grad(set_to_none=True)
+            out["aux_loss"] = aux_loss
         self.critic_opt.zero_grad(set_to_none=True)
-        critic_loss.backward()
+        loss.backward()
         self.critic_opt.step()
+        if self.decoder is not None:
+            self.optimisers["decoder"].step()
         out["critic_loss"], out["q_mean"] = critic_loss, q1.mean()
 
         if self.num_updates % cfg.actor_update_freq == 0:
@@ -304,7 +337,8 @@ class SacDrqAgent:
                 "critic": self.critic.state_dict(), "critic_target": self.critic_target.state_dict(),
                 "actor": self.actor.state_dict(), "log_alpha": self.log_alpha.detach().clone(),
                 "optimisers": {k: opt.state_dict() for k, opt in self.optimisers.items()},
-                "num_updates": self.num_updates}
+                "num_updates": self.num_updates,
+                **({"decoder": self.decoder.state_dict()} if self.decoder is not None else {})}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         if not isinstance(state, dict) or state.get("format") != AGENT_FORMAT:
@@ -313,7 +347,10 @@ class SacDrqAgent:
         diff = sorted(k for k, v in self.arch().items() if state["arch"].get(k) != v)
         if diff:
             raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
-        for name in ("encoder", "critic", "critic_target", "actor"):
+        if (self.decoder is None) != ("decoder" not in state):
+            raise AgentStateError("agent state has a different encoder_aux_loss (a decoder in one of them only)")
+        parts = ("encoder", "critic", "critic_target", "actor") + (("decoder",) if self.decoder is not None else ())
+        for name in parts:
             getattr(self, name).load_state_dict(state[name])
         with torch.no_grad():
             self.log_alpha.copy_(state["log_alpha"])

@@ -54,9 +54,10 @@ CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_l
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
 CURVE_EPISODE_COLUMNS = ("env_steps", "home", "height", "scenario_id", "success", "shortest_path", "path_length")
 TRAIN_COLUMNS = ("env_steps", "episodes", "updates", "train_return", "train_success", "critic_loss",
-                 "actor_loss", "alpha_loss", "curl_loss", "alpha", "entropy", "q_mean", "steps_per_s",
+                 "actor_loss", "alpha_loss", "curl_loss", "aux_loss", "alpha", "entropy", "q_mean", "steps_per_s",
                  "updates_per_s", "wall_s")
-_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recurrent": "recurrent SAC-DrQ"}
+_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recurrent": "recurrent SAC-DrQ",
+                    "ppo": "PPO"}
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
@@ -414,8 +415,8 @@ def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: st
     if saved.get("env_kwargs") != _kwargs_key(env_kwargs):
         raise CheckpointError(f"{what} {path} was written with env_kwargs {saved.get('env_kwargs')}, "
                               f"not {_kwargs_key(env_kwargs)}; use another out_dir")
-    # runs saved before the recurrent learner's fields existed ran without them, i.e. as their defaults
-    theirs = {**_RECURRENT_DEFAULTS, **saved.get("config", {})}
+    # runs saved before these fields existed ran without them, i.e. as their defaults
+    theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
     mine = cfg.to_dict()
     diff = sorted(k for k in set(mine) | set(theirs) if k not in RESUMABLE_FIELDS and mine.get(k) != theirs.get(k))
     if diff:
@@ -424,8 +425,11 @@ def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: st
                               f"{' ...' if len(diff) > 4 else ''}; use another out_dir")
 
 
-_RECURRENT_DEFAULTS = {f: LearnerConfig.__dataclass_fields__[f].default
-                       for f in ("recurrent_hidden_dim", "sequence_length", "burn_in")}
+_DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
+                             for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
+                                       "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
+                                       "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std")}
+"""Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults."""
 
 
 def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
@@ -567,6 +571,10 @@ def make_agent(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: 
                state_dim: int = 0):
     """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state);
     ``state_dim``: size of the env's privileged state (``critic_privileged_state``)."""
+    if cfg.algorithm == "ppo":
+        from egosearch.rl.ppo import PpoAgent
+
+        return PpoAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
     if cfg.algorithm == "sac_drq_recurrent":
         from egosearch.rl.sac_drq_recurrent import SacDrqRecurrentAgent
 
