@@ -50,15 +50,14 @@ from egosearch.rl.common import (
     gaussian_entropy,
     metric_values,
     mlp,
-    obs_to_tensors,
     resolve_device,
     squashed_sample,
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.sac_drq import _ARCH_FIELDS, _encoder, pool_depth, pooled_side
 from egosearch.rl.sac_drq import ACTOR_FORMAT as DRQ_ACTOR_FORMAT
+from egosearch.rl.sac_drq import _encoder, act_with, drq_arch, pool_depth, pooled_side
 
 AGENT_FORMAT = "egosearch-ppo-agent-v1"
 ACTION_LIMIT = 1.0 - 1e-6
@@ -167,11 +166,7 @@ class PpoAgent:
     # ---- acting --------------------------------------------------------------------------
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         """Actions (B, A) in [-1, 1] for a stacked batch of observations (one forward pass)."""
-        with torch.inference_mode():
-            depth, extra = obs_to_tensors(obs, self.device, self.cfg.image_size)
-            mu, log_std = self.actor(self.encoder(self.encoder.pool(depth)), extra)
-            a = torch.tanh(mu) if deterministic else squashed_sample(mu, log_std, torch.randn_like(mu))[0]
-        return a.float().cpu().numpy()
+        return act_with(self.encoder, self.actor, obs, self.device, self.cfg.image_size, deterministic)
 
     def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         return self.act_batch(obs, deterministic)[0]
@@ -253,12 +248,7 @@ class PpoAgent:
     # ---- persistence -----------------------------------------------------------------------
     def arch(self) -> dict[str, Any]:
         """SAC-DrQ's arch dict: the actor file is read by :func:`egosearch.rl.sac_drq.load_drq_actor_net`."""
-        arch = {name: getattr(self.cfg, name) for name in _ARCH_FIELDS}
-        arch.update(action_dim=self.action_dim, mask_dim=self.mask_dim, proprio_dim=self.proprio_dim,
-                    extra_dim=self.mask_dim + self.proprio_dim, crop_size=self.cfg.image_size)
-        if self.state_dim:
-            arch["critic_state_dim"] = self.state_dim
-        return arch
+        return drq_arch(self.cfg, self.action_dim, self.mask_dim, self.proprio_dim, self.state_dim)
 
     def state_dict(self) -> dict[str, Any]:
         return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),

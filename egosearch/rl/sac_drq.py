@@ -172,6 +172,29 @@ _ARCH_FIELDS = ("frame_history", "image_size", "obs_downsample", "encoder_num_la
                 "actor_log_std_max", "critic_hidden_dim", "critic_num_layers", "critic_activation")
 
 
+def drq_arch(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, state_dim: int,
+             fields: tuple[str, ...] = _ARCH_FIELDS) -> dict[str, Any]:
+    """The arch dict of an agent with SAC-DrQ's actor: what its actor file records, and what a
+    resumed agent state must match."""
+    arch = {name: getattr(cfg, name) for name in fields}
+    arch.update(action_dim=action_dim, mask_dim=mask_dim, proprio_dim=proprio_dim,
+                extra_dim=mask_dim + proprio_dim, crop_size=cfg.image_size)
+    if state_dim:  # only then: actor files of critics without it keep their arch
+        arch["critic_state_dim"] = state_dim
+    return arch
+
+
+def act_with(encoder: PooledConvEncoder, actor: ActorHead, obs: dict, device: torch.device, image_size: int,
+             deterministic: bool) -> np.ndarray:
+    """Actions (B, A) in [-1, 1] of SAC-DrQ's actor for a stacked batch (one forward pass); acting sees
+    the whole, unshifted image."""
+    with torch.inference_mode():
+        depth, extra = obs_to_tensors(obs, device, image_size)
+        mu, log_std = actor(encoder(encoder.pool(depth)), extra)
+        a = torch.tanh(mu) if deterministic else squashed_sample(mu, log_std, torch.randn_like(mu))[0]
+    return a.float().cpu().numpy()
+
+
 def _encoder(arch: dict[str, Any]) -> PooledConvEncoder:
     return PooledConvEncoder(arch["frame_history"], arch["image_size"], arch["obs_downsample"],
                              arch["encoder_num_layers"], arch["encoder_num_filters"],
@@ -246,11 +269,7 @@ class SacDrqAgent:
     # ---- acting --------------------------------------------------------------------------
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         """Actions (B, A) in [-1, 1] for a stacked batch of observations (one forward pass)."""
-        with torch.inference_mode():
-            depth, extra = obs_to_tensors(obs, self.device, self.cfg.image_size)  # no crop: the whole image
-            mu, log_std = self.actor(self.encoder(self.encoder.pool(depth)), extra)
-            a = torch.tanh(mu) if deterministic else squashed_sample(mu, log_std, torch.randn_like(mu))[0]
-        return a.float().cpu().numpy()
+        return act_with(self.encoder, self.actor, obs, self.device, self.cfg.image_size, deterministic)
 
     def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         return self.act_batch(obs, deterministic)[0]
@@ -325,12 +344,7 @@ class SacDrqAgent:
 
     # ---- persistence -----------------------------------------------------------------------
     def arch(self) -> dict[str, Any]:
-        arch = {name: getattr(self.cfg, name) for name in _ARCH_FIELDS}
-        arch.update(action_dim=self.action_dim, mask_dim=self.mask_dim, proprio_dim=self.proprio_dim,
-                    extra_dim=self.mask_dim + self.proprio_dim, crop_size=self.cfg.image_size)
-        if self.state_dim:  # only then: actor files of critics without it keep their arch
-            arch["critic_state_dim"] = self.state_dim
-        return arch
+        return drq_arch(self.cfg, self.action_dim, self.mask_dim, self.proprio_dim, self.state_dim)
 
     def state_dict(self) -> dict[str, Any]:
         return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),

@@ -63,7 +63,7 @@ from egosearch.rl.common import (
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import _ARCH_FIELDS as _DRQ_ARCH_FIELDS
-from egosearch.rl.sac_drq import PooledConvEncoder, _encoder, pool_depth, pooled_side
+from egosearch.rl.sac_drq import PooledConvEncoder, _encoder, drq_arch, pool_depth, pooled_side
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-drq-recurrent-actor-v1"
@@ -445,12 +445,7 @@ class SacDrqRecurrentAgent:
 
     # ---- persistence -----------------------------------------------------------------------
     def arch(self) -> dict[str, Any]:
-        arch = {name: getattr(self.cfg, name) for name in _ARCH_FIELDS}
-        arch.update(action_dim=self.action_dim, mask_dim=self.mask_dim, proprio_dim=self.proprio_dim,
-                    extra_dim=self.mask_dim + self.proprio_dim, crop_size=self.cfg.image_size)
-        if self.state_dim:
-            arch["critic_state_dim"] = self.state_dim
-        return arch
+        return drq_arch(self.cfg, self.action_dim, self.mask_dim, self.proprio_dim, self.state_dim, _ARCH_FIELDS)
 
     def state_dict(self) -> dict[str, Any]:
         return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),
