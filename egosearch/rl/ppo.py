@@ -57,7 +57,7 @@ from egosearch.rl.common import (
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import ACTOR_FORMAT as DRQ_ACTOR_FORMAT
-from egosearch.rl.sac_drq import _encoder, act_with, drq_arch, pool_depth, pooled_side
+from egosearch.rl.sac_drq import PooledReplay, _encoder, act_with, drq_arch
 
 AGENT_FORMAT = "egosearch-ppo-agent-v1"
 ACTION_LIMIT = 1.0 - 1e-6
@@ -112,7 +112,7 @@ class ValueNet(nn.Module):
         return self.head(torch.cat([self.proj(self.encoder(pooled)), extra], dim=-1)).squeeze(-1)
 
 
-class PpoAgent:
+class PpoAgent(PooledReplay):
     """PPO with SAC-DrQ's actor and a separate value network (module docstring). Driven by
     :mod:`egosearch.rl.train` like the SAC learners; ``sample_batch`` picks its rollout."""
 
@@ -154,14 +154,6 @@ class PpoAgent:
     def alpha(self) -> float:
         """The entropy bonus's weight: SAC's temperature's counterpart in the logs."""
         return float(self.cfg.entropy_coef)
-
-    @property
-    def replay_image_size(self) -> int:
-        return pooled_side(self.cfg.image_size, self.cfg.obs_downsample)
-
-    def replay_obs(self, obs: dict) -> dict:
-        """The observation as the replay stores it: depth frames pooled by ``obs_downsample``."""
-        return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), self.cfg.obs_downsample)}
 
     # ---- acting --------------------------------------------------------------------------
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:

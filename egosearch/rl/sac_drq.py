@@ -214,7 +214,22 @@ class DrqActorNet(nn.Module):
         return self.head(self.encoder(self.encoder.pool(depth)), extra)
 
 
-class SacDrqAgent:
+class PooledReplay:
+    """What the trainer asks of a learner whose replay holds depth pooled by ``obs_downsample``:
+    the stored frames' side and the observation as stored. Shared by SAC-DrQ, its recurrent form
+    and PPO."""
+
+    cfg: LearnerConfig
+
+    @property
+    def replay_image_size(self) -> int:
+        return pooled_side(self.cfg.image_size, self.cfg.obs_downsample)
+
+    def replay_obs(self, obs: dict) -> dict:
+        return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), self.cfg.obs_downsample)}
+
+
+class SacDrqAgent(PooledReplay):
     """SAC with the DrQ-v2-style update (module docstring). ``update`` takes a batch with an
     optional ``discount`` (B, 1) column (gamma^n of n-step returns; default gamma)."""
 
@@ -257,14 +272,6 @@ class SacDrqAgent:
     @property
     def alpha(self) -> float:
         return float(self.log_alpha.detach().exp())
-
-    @property
-    def replay_image_size(self) -> int:
-        return pooled_side(self.cfg.image_size, self.cfg.obs_downsample)
-
-    def replay_obs(self, obs: dict) -> dict:
-        """The observation as the replay stores it: depth frames pooled by ``obs_downsample``."""
-        return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), self.cfg.obs_downsample)}
 
     # ---- acting --------------------------------------------------------------------------
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:

@@ -63,7 +63,7 @@ from egosearch.rl.common import (
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import _ARCH_FIELDS as _DRQ_ARCH_FIELDS
-from egosearch.rl.sac_drq import PooledConvEncoder, _encoder, drq_arch, pool_depth, pooled_side
+from egosearch.rl.sac_drq import PooledConvEncoder, PooledReplay, _encoder, drq_arch
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-drq-recurrent-actor-v1"
@@ -267,7 +267,7 @@ def shift_sequences(x: torch.Tensor, pad: int) -> torch.Tensor:
 
 # ---- the agent ------------------------------------------------------------------------------
 
-class SacDrqRecurrentAgent:
+class SacDrqRecurrentAgent(PooledReplay):
     """Recurrent SAC-DrQ (module docstring). Same driving interface as :class:`SacDrqAgent`, plus
     ``sample_batch(replay)`` (sequences instead of transitions), ``reset_state(env_index)`` (an
     env's episode ended) and ``reset_policy_state()`` (an evaluation episode starts)."""
@@ -306,13 +306,6 @@ class SacDrqRecurrentAgent:
     @property
     def alpha(self) -> float:
         return float(self.log_alpha.detach().exp())
-
-    @property
-    def replay_image_size(self) -> int:
-        return pooled_side(self.cfg.image_size, self.cfg.obs_downsample)
-
-    def replay_obs(self, obs: dict) -> dict:
-        return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), self.cfg.obs_downsample)}
 
     # ---- acting --------------------------------------------------------------------------
     def reset_state(self, env_index: int | None = None) -> None:
