@@ -26,6 +26,17 @@ class AgentStateError(ValueError):
     """A saved agent / actor does not match (format, variant, architecture) or is unreadable."""
 
 
+def check_agent_state(state: Any, fmt: str, kind: str, arch: dict[str, Any]) -> None:
+    """Raise :class:`AgentStateError` unless ``state`` is a ``kind`` agent state (format ``fmt``)
+    of the same architecture ``arch``: what every learner's ``load_state_dict`` checks first."""
+    if not isinstance(state, dict) or state.get("format") != fmt:
+        raise AgentStateError(f"not a {kind} agent state "
+                              f"(format={state.get('format') if isinstance(state, dict) else None!r})")
+    diff = sorted(k for k, v in arch.items() if state["arch"].get(k) != v)
+    if diff:
+        raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
+
+
 def resolve_device(name: str = "auto") -> torch.device:
     """"auto" -> CUDA when available, else CPU."""
     if name == "auto":

@@ -42,11 +42,11 @@ from torch import nn
 from egosearch.rl.common import (
     LOG_2PI,
     ActorHead,
-    AgentStateError,
     Projection,
     actor_head,
     actor_weights,
     adam,
+    check_agent_state,
     gaussian_entropy,
     metric_values,
     mlp,
@@ -249,12 +249,7 @@ class PpoAgent(PooledReplay):
                 "num_updates": self.num_updates}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        if not isinstance(state, dict) or state.get("format") != AGENT_FORMAT:
-            raise AgentStateError("not a PPO agent state "
-                                  f"(format={state.get('format') if isinstance(state, dict) else None!r})")
-        diff = sorted(k for k, v in self.arch().items() if state["arch"].get(k) != v)
-        if diff:
-            raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
+        check_agent_state(state, AGENT_FORMAT, "PPO", self.arch())
         for name in ("encoder", "actor", "value"):
             getattr(self, name).load_state_dict(state[name])
         for k, opt in self.optimisers.items():

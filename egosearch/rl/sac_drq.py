@@ -48,6 +48,7 @@ from egosearch.rl.common import (
     actor_head,
     actor_weights,
     adam,
+    check_agent_state,
     crop_at,
     gaussian_entropy,
     load_actor_weights,
@@ -362,12 +363,7 @@ class SacDrqAgent(PooledReplay):
                 **({"decoder": self.decoder.state_dict()} if self.decoder is not None else {})}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        if not isinstance(state, dict) or state.get("format") != AGENT_FORMAT:
-            raise AgentStateError("not a SAC-DrQ agent state "
-                                  f"(format={state.get('format') if isinstance(state, dict) else None!r})")
-        diff = sorted(k for k, v in self.arch().items() if state["arch"].get(k) != v)
-        if diff:
-            raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
+        check_agent_state(state, AGENT_FORMAT, "SAC-DrQ", self.arch())
         if (self.decoder is None) != ("decoder" not in state):
             raise AgentStateError("agent state has a different encoder_aux_loss (a decoder in one of them only)")
         parts = ("encoder", "critic", "critic_target", "actor") + (("decoder",) if self.decoder is not None else ())

@@ -46,10 +46,10 @@ import torch.nn.functional as F
 from torch import nn
 
 from egosearch.rl.common import (
-    AgentStateError,
     Projection,
     actor_weights,
     adam,
+    check_agent_state,
     crop_at,
     gaussian_entropy,
     load_actor_weights,
@@ -448,12 +448,7 @@ class SacDrqRecurrentAgent(PooledReplay):
                 "num_updates": self.num_updates}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        if not isinstance(state, dict) or state.get("format") != AGENT_FORMAT:
-            raise AgentStateError("not a recurrent SAC-DrQ agent state "
-                                  f"(format={state.get('format') if isinstance(state, dict) else None!r})")
-        diff = sorted(k for k, v in self.arch().items() if state["arch"].get(k) != v)
-        if diff:
-            raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
+        check_agent_state(state, AGENT_FORMAT, "recurrent SAC-DrQ", self.arch())
         for name in ("encoder", "critic", "critic_target", "actor"):
             getattr(self, name).load_state_dict(state[name])
         with torch.no_grad():
