@@ -120,11 +120,13 @@ def _cmd_train(args) -> None:
         overrides["num_threads"] = args.threads
     cfg = load_config(args.profile, overrides)
     env = variant.train_env
+    from egosearch.envs import observed_env_id
     from egosearch.home_pool import curve_homes
 
-    evaluator = scenario_evaluator(variant.env_id, curve_homes(env), env["placement"], n=cfg.eval_episodes)
+    env_id = observed_env_id(variant.env_id, cfg.target_memory)
+    evaluator = scenario_evaluator(env_id, curve_homes(env), env["placement"], n=cfg.eval_episodes)
     try:
-        summary = train(variant.env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
+        summary = train(env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
                         variant=variant.name)
     finally:
         evaluator.close()

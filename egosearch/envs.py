@@ -25,3 +25,11 @@ def env_space_dims(env_id: str) -> dict[str, int]:
     from egosearch.env import space_dims
 
     return space_dims(**ENV_IDS[env_id])
+
+
+def observed_env_id(env_id: str, target_memory: bool) -> str:
+    """The id a policy trains and is evaluated in: ``env_id``, or with ``target_memory`` (a learner
+    config field that changes the observation) its ``*Memory-v0`` form of the same head."""
+    if not target_memory or env_id not in ENV_IDS or ENV_IDS[env_id].get("target_memory"):
+        return env_id
+    return "EgoSearchMemory-v0" if ENV_IDS[env_id]["head"] else "EgoSearchNoHeadMemory-v0"

@@ -239,3 +239,25 @@ def test_learning_beats_random_on_the_fake_env(tmp_path, learner):
     assert trained["success_rate"] >= 0.8, trained
     assert random["success_rate"] <= 0.2, random
     assert trained["episode_return"] > random["episode_return"] + 10
+
+
+def test_target_memory_trains_the_policy_in_the_memory_env_of_its_head(tmp_path):
+    """The config field and a variant naming the *Memory-v0 id are one observation: a head-off run with
+    target_memory acts, and is checked, in EgoSearchNoHeadMemory-v0, whose mask is wider."""
+    from egosearch.envs import ENV_IDS, env_space_dims, observed_env_id
+
+    assert observed_env_id("EgoSearch-v0", True) == "EgoSearchMemory-v0"
+    assert observed_env_id("EgoSearchNoHead-v0", True) == "EgoSearchNoHeadMemory-v0"
+    assert observed_env_id("EgoSearchMap-v0", True) == "EgoSearchMap-v0"  # already remembers
+    assert all(observed_env_id(env_id, False) == env_id for env_id in ENV_IDS)
+
+    cfg = load_config("smoke", {**SMOKE, "target_memory": True, "total_env_steps": 120, "init_steps": 100,
+                                "eval_every": 120, "eval_episodes": 1, "checkpoint_every": 120})
+    train("EgoSearchNoHead-v0", cfg, tmp_path, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},
+          progress=False)
+    actor = ActorPolicy(tmp_path / "actor.pt")
+    assert actor.trained_env_id() == "EgoSearchNoHeadMemory-v0"
+    assert env_space_dims("EgoSearchNoHeadMemory-v0")["mask"] > env_space_dims("EgoSearchNoHead-v0")["mask"]
+    actor.check_env("EgoSearchNoHeadMemory-v0")
+    with pytest.raises(AgentStateError, match="was trained in EgoSearchNoHeadMemory-v0"):
+        actor.check_env("EgoSearchNoHead-v0")

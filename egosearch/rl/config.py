@@ -197,6 +197,13 @@ class LearnerConfig:
     """Ours ("sac_drq" only; the paper: 1): the 100 x 100 depth frames are average-pooled by this
     factor before the encoder (2 -> 50 x 50), as PointNav learners train from 64 x 64 depth
     (Shacklett et al., bps-nav, ICLR 2021). The env, its mask and success test stay at 100 x 100."""
+    target_memory: bool = False
+    """Paper: False (the observation is depth, the target mask and the head's pose). True: the
+    policy trains, and so is evaluated, in the ``*Memory-v0`` env of its variant's id
+    (EgoSearch-v0 -> EgoSearchMemory-v0, EgoSearchNoHead-v0 -> EgoSearchNoHeadMemory-v0), whose
+    observation also carries where the target was last seen, by the searcher's own odometry, and
+    the steps since (``egosearch.env``): the same as naming that id in the variant file. This
+    CHANGES THE OBSERVATION, for the actor and at evaluation too; the paper profile never sets it."""
     encoder_stride2_layers: int = 1
     """CURL: 1 (the first conv has stride 2, the rest stride 1). "sac_drq" only: the first this
     many convs have stride 2 (smaller maps, far fewer FLOPs)."""

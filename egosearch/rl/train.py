@@ -428,7 +428,8 @@ def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: st
 _DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
                              for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
                                        "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
-                                       "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std")}
+                                       "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",
+                                       "target_memory")}
 """Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults."""
 
 
@@ -510,7 +511,10 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     in the checkpoint / actor metadata (default: ``env_id``). ``on_step(env_steps)`` is called
     after every env step (tests use it to interrupt a run).
     """
+    from egosearch.envs import observed_env_id
+
     cfg = cfg.validate()
+    env_id = observed_env_id(env_id, cfg.target_memory)
     env_kwargs = dict(env_kwargs or {})
     out_dir = Path(out_dir)
     variant = variant or env_id
