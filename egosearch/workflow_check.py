@@ -100,6 +100,9 @@ def workflow_variants(config: dict, compare: bool = False, directory: Path = ABL
                                   or variants[generated].train_env["layout"] != "generated"):
         raise ConfigError(f"config generalise/generated_variant: {generated!r} must be one of generalise/variants "
                           "and train in generated homes (train_env: layout: generated)")
+    reference = generalise.get("reference")
+    if reference is not None and reference not in generalise["variants"]:
+        raise ConfigError(f"config generalise/reference: {reference!r} must be one of generalise/variants")
     return variants
 
 

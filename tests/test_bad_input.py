@@ -138,6 +138,16 @@ def test_a_bad_config_is_one_line_naming_the_key(suite, monkeypatch, capsys, ent
     assert stop.value.code == 1 and capsys.readouterr().err == f"egosearch: error: {message.format(allowed=allowed)}\n"
 
 
+def test_a_generalise_reference_outside_its_variants_is_one_line(suite, monkeypatch, capsys):
+    monkeypatch.chdir(suite)
+    base = config()
+    changed = {**base, "generalise": {**base["generalise"], "reference": "head_on_ppo"}}
+    with pytest.raises(SystemExit) as stop:
+        checked_variants(changed, argv=["generalise"], directory=suite / "ablations")
+    assert stop.value.code == 1 and capsys.readouterr().err == (
+        "egosearch: error: config generalise/reference: 'head_on_ppo' must be one of generalise/variants\n")
+
+
 # Snakemake itself, on a few of them: its first line after its own --config notice is the message
 # (a Snakemake run costs seconds, so the rest go through `checked_variants` above).
 def test_snakemake_stops_on_a_variant_typo_before_the_dag(suite):

@@ -44,7 +44,7 @@ rule generalise:
     params:
         prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
         generated=GEN["generated_variant"],
-        reference=REF,
+        reference=GEN.get("reference", REF),
         trained_on=" ".join(f"{name}={v.train_env['layout']}" if v.train_env["layout"] != "generated" else
                             "{}=home{}-home{}".format(name, v.train_env["home_seeds"][0], v.train_env["home_seeds"][1] - 1)
                             for name, v in GEN_VARIANTS.items()),
