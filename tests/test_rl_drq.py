@@ -18,6 +18,7 @@ from egosearch.rl.train import ActorPolicy, train
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
 from test_rl_fake_env import FAKE_ENV_ID, register_fake_envs  # noqa: E402
+from test_rl_train import train_whole_and_resumed  # noqa: E402
 
 register_fake_envs()
 DRQ = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2,
@@ -201,23 +202,4 @@ def test_killed_and_resumed_run_equals_the_run_that_was_not_stopped(tmp_path, ov
     cfg = load_config("smoke", {"device": "cpu", "num_threads": 1, **overrides,
                                 "num_envs": 1 if not overrides else 3, "n_step": 1 if not overrides else 3})
 
-    class Stop(Exception):
-        pass
-
-    def stop_at(step):
-        if step >= 200:
-            raise Stop
-
-    train(FAKE_ENV_ID, cfg, tmp_path / "whole", progress=False)
-    with pytest.raises(Stop):
-        train(FAKE_ENV_ID, cfg, tmp_path / "resumed", progress=False, on_step=stop_at)
-    train(FAKE_ENV_ID, cfg, tmp_path / "resumed", progress=False)
-    a = torch.load(tmp_path / "whole" / "actor.pt", weights_only=True)["state_dict"]
-    b = torch.load(tmp_path / "resumed" / "actor.pt", weights_only=True)["state_dict"]
-    assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
-    timing = {"steps_per_s", "updates_per_s", "wall_s"}
-    for name in ("curve.csv", "train.csv"):
-        rows = [(tmp_path / run / name).read_text().splitlines() for run in ("whole", "resumed")]
-        header = rows[0][0].split(",")
-        keep = [i for i, c in enumerate(header) if c not in timing]
-        assert [[r.split(",")[i] for i in keep] for r in rows[0]] == [[r.split(",")[i] for i in keep] for r in rows[1]]
+    train_whole_and_resumed(cfg, tmp_path, stop_after=200)

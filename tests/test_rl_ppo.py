@@ -16,11 +16,12 @@ from egosearch.rl.config import load_config
 from egosearch.rl.ppo import PpoAgent, clipped_surrogate, gae, squashed_log_prob
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import ACTOR_FORMAT as DRQ_ACTOR_FORMAT
-from egosearch.rl.train import ActorPolicy, train
+from egosearch.rl.train import ActorPolicy
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
 from test_rl_fake_env import FAKE_ENV_ID, register_fake_envs  # noqa: E402
+from test_rl_train import train_whole_and_resumed  # noqa: E402
 
 register_fake_envs()
 PPO = {"device": "cpu", "num_threads": 1, "algorithm": "ppo", "obs_downsample": 4, "encoder_num_layers": 2,
@@ -182,26 +183,11 @@ def test_killed_and_resumed_run_equals_the_run_that_was_not_stopped_and_its_acto
     cfg = load_config("smoke", {**PPO, "total_env_steps": 256, "checkpoint_every": 80, "eval_every": 128,
                                 "log_every": 64, "eval_episodes": 2, "keep_checkpoint": False})
 
-    class Stop(Exception):
-        pass
-
-    def stop_at(step):
-        if step >= 150:
-            raise Stop
-
-    train(FAKE_ENV_ID, cfg, tmp_path / "whole", progress=False)
-    with pytest.raises(Stop):
-        train(FAKE_ENV_ID, cfg, tmp_path / "resumed", progress=False, on_step=stop_at)
-    train(FAKE_ENV_ID, cfg, tmp_path / "resumed", progress=False)
+    # curve.csv's row at 128 averages the losses since the row before, and a resumed run has only those since
+    # its checkpoint at 80 (train.csv's rows, every 64 steps, have no update between 64 and 80)
+    train_whole_and_resumed(cfg, tmp_path, stop_after=150, logs=("train.csv",))
     a = torch.load(tmp_path / "whole" / "actor.pt", weights_only=True)
-    b = torch.load(tmp_path / "resumed" / "actor.pt", weights_only=True)
-    assert a["state_dict"].keys() == b["state_dict"].keys()
-    assert all(torch.equal(a["state_dict"][k], b["state_dict"][k]) for k in a["state_dict"])
     assert a["format"] == DRQ_ACTOR_FORMAT and a["metadata"]["updates"] == 256 // 32 * 4 * 2
-    rows = [(tmp_path / run / "train.csv").read_text().splitlines() for run in ("whole", "resumed")]
-    header = rows[0][0].split(",")
-    keep = [i for i, c in enumerate(header) if c not in {"steps_per_s", "updates_per_s", "wall_s"}]
-    assert [[r.split(",")[i] for i in keep] for r in rows[0]] == [[r.split(",")[i] for i in keep] for r in rows[1]]
 
     policy = ActorPolicy(tmp_path / "whole" / "actor.pt")
     import gymnasium

@@ -23,7 +23,7 @@ from egosearch.rl.train import CHECKPOINT_NAME, ActorPolicy, load_any_actor_net,
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
 from test_rl_fake_env import FAKE_ENV_ID, register_fake_envs  # noqa: E402
-from test_rl_train import Interrupt, check_complete_run, interrupt_at, read_csv  # noqa: E402
+from test_rl_train import check_complete_run, train_whole_and_resumed  # noqa: E402
 
 register_fake_envs()
 REC = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq_recurrent", "obs_downsample": 4,
@@ -251,23 +251,12 @@ def test_actor_file_and_agent_state_round_trip(tmp_path):
 
 def test_smoke_training_with_interrupt_and_resume_equals_the_uninterrupted_run(tmp_path):
     cfg = load_config("smoke", {**REC, "num_envs": 2, "n_step": 3, "seed": 0})
-    whole, parts = tmp_path / "whole", tmp_path / "parts"
-    train(FAKE_ENV_ID, cfg, whole, progress=False)
+    def stopped_at_the_last_checkpoint(parts):
+        assert torch.load(parts / CHECKPOINT_NAME, weights_only=True)["env_steps"] == 150
+
+    whole, parts = train_whole_and_resumed(cfg, tmp_path, stop_after=230, after_stop=stopped_at_the_last_checkpoint)
     check_complete_run(whole, cfg)
-    with pytest.raises(Interrupt):
-        train(FAKE_ENV_ID, cfg, parts, progress=False, on_step=interrupt_at(230))
-    assert torch.load(parts / CHECKPOINT_NAME, weights_only=True)["env_steps"] == 150
-    train(FAKE_ENV_ID, cfg, parts, progress=False)
     check_complete_run(parts, cfg)
-    timing = {"steps_per_s", "updates_per_s", "wall_s"}
-    for name in ("train.csv", "curve.csv"):
-        _, a = read_csv(whole / name)
-        _, b = read_csv(parts / name)
-        assert [{k: v for k, v in r.items() if k not in timing} for r in a] == \
-               [{k: v for k, v in r.items() if k not in timing} for r in b], name
-    wa = torch.load(whole / "actor.pt", weights_only=True)["state_dict"]
-    wb = torch.load(parts / "actor.pt", weights_only=True)["state_dict"]
-    assert all(torch.equal(wa[k], wb[k]) for k in wa)
     assert ActorPolicy(whole / "actor.pt").recurrent
 
 

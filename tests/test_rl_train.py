@@ -54,6 +54,38 @@ def interrupt_at(n: int):
     return hook
 
 
+TIMING_COLUMNS = {"steps_per_s", "updates_per_s", "wall_s"}
+"""The columns of train.csv and curve.csv that a resumed run cannot reproduce."""
+
+
+def train_whole_and_resumed(cfg, root: Path, stop_after: int, after_stop=None,
+                            logs: tuple[str, ...] = ("train.csv", "curve.csv")) -> tuple[Path, Path]:
+    """Train ``cfg`` on the fake env once whole and once stopped after ``stop_after`` env steps and
+    rerun, and check that the two runs are one: the same actor weights to the bit, and the same
+    ``logs`` but for their timing columns. ``after_stop(resumed_dir)`` looks at the stopped run
+    before it resumes. Returns the two run directories."""
+    whole, resumed = root / "whole", root / "resumed"
+
+    def stop(step: int) -> None:
+        if step >= stop_after:
+            raise Interrupt(step)
+
+    train(FAKE_ENV_ID, cfg, whole, progress=False)
+    with pytest.raises(Interrupt):
+        train(FAKE_ENV_ID, cfg, resumed, progress=False, on_step=stop)
+    if after_stop is not None:
+        after_stop(resumed)
+    train(FAKE_ENV_ID, cfg, resumed, progress=False)
+    a = torch.load(whole / "actor.pt", weights_only=True)["state_dict"]
+    b = torch.load(resumed / "actor.pt", weights_only=True)["state_dict"]
+    assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+    for name in logs:
+        rows = [[{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in read_csv(run / name)[1]]
+                for run in (whole, resumed)]
+        assert rows[0] == rows[1], name
+    return whole, resumed
+
+
 def check_complete_run(out: Path, cfg, checkpoint_kept: bool = False) -> dict:
     columns, rows = read_csv(out / "curve.csv")
     assert tuple(columns) == CURVE_COLUMNS
