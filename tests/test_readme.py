@@ -44,7 +44,8 @@ def _stored_results(root: Path) -> None:
         "profile": "p", "commit": "0123456789abcdef", "date_utc": "2026-01-02T03:04:05+00:00",
         "machine": {"cpu": "X", "cores": 2, "torch": "2"}, "wall_s_per_rule_summed": {"train": 10800.0, "eval": 60.0},
         "wall_s_all_jobs_summed": 10860.0, "note": "resumed once",
-        "jobs": [{"rule": "train", "job": "head_on/seed0", "wall_s": 7200.0},
+        # head_on's training shared a core: it ran 3600 s of its 7200 (its CPU time)
+        "jobs": [{"rule": "train", "job": "head_on/seed0", "wall_s": 7200.0, "cpu_s": 3600.0},
                  {"rule": "eval", "job": "head_off/seed0/kitchen_living/everywhere/h1.05", "wall_s": 60.0},
                  {"rule": "train", "job": "my_variant/seed0", "wall_s": 3600.0},
                  {"rule": "train", "job": "head_on_generated_homes/seed0", "wall_s": 1800.0},
@@ -80,7 +81,9 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     assert "commit `0123456`" in out and "10 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
     # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it; the
     # generated-homes variant, the generated groups and the generalise report are `generalise`'s
-    assert "summed time / 2, one-thread jobs): 1.01 h; of `snakemake --cores 2 generalise` after it: 0.26 h" in out
+    # ... each at its CPU time where recorded: head_on's training counts 3600 s, not its 7200 s of wall time
+    assert ("summed time / 2, one-thread jobs, each at its CPU time where recorded): 0.51 h; of `snakemake "
+            "--cores 2 generalise` after it: 0.26 h") in out
     assert "the other 1.01 h of jobs are comparisons and studies outside both" in out
     assert "resumed once" in out
     assert "*Not generated yet: `paper_figs/p/fig7.csv` is missing" in out     # never invented when the file is absent

@@ -203,3 +203,18 @@ def test_verify_and_compare_refuse_a_truncated_or_edited_csv(tmp_path, capsys):
     new = [_eval_csv(results, "new", "everywhere", 1.05, [1, 1, 1, 1], seed) for seed in (0, 1)]
     cmd_compare(ref, new)
     assert any("new/seed0" in p and "not in the sha256 list" in p for p in verify(results)[1])
+
+
+def test_a_jobs_cpu_time_is_recorded_beside_its_wall_time(tmp_path):
+    from egosearch.report.provenance import rule_times
+
+    header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    (tmp_path / "train" / "v").mkdir(parents=True)
+    # a training that shared its core with another job: half of its wall time on the CPU
+    row = "7200.5\t2:00:00\t1500\t2300\t1400\t1450\t0\t10\t50.0\t3600.04\n"
+    (tmp_path / "train" / "v" / "seed0.tsv").write_text(header + row)
+    (tmp_path / "report").mkdir()
+    (tmp_path / "report" / "table1.tsv").write_text("s\th:m:s\n12.0\t0:00:12\n")  # no CPU time recorded
+    assert rule_times(tmp_path) == [
+        {"rule": "report", "job": "table1", "wall_s": 12.0, "max_rss_mb": ""},
+        {"rule": "train", "job": "v/seed0", "wall_s": 7200.5, "max_rss_mb": "1500", "cpu_s": 3600.0}]

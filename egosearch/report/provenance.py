@@ -35,7 +35,8 @@ def _version(package: str) -> str:
 
 
 def rule_times(benchmarks_dir: Path) -> list[dict]:
-    """One row per job: the rule (first folder), the job (rest of the path) and its wall time."""
+    """One row per job: the rule (first folder), the job (rest of the path), its wall time and, where
+    the benchmark recorded it, its CPU time (``cpu_s``)."""
     rows = []
     for path in sorted(Path(benchmarks_dir).rglob("*.tsv")):
         with open(path, newline="") as f:
@@ -43,9 +44,13 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
         if not records:
             continue
         rel = path.relative_to(benchmarks_dir).with_suffix("")
-        rows.append({"rule": rel.parts[0], "job": "/".join(rel.parts[1:]),
-                     "wall_s": round(float(records[-1]["s"]), 1),
-                     "max_rss_mb": records[-1].get("max_rss", "")})
+        row = {"rule": rel.parts[0], "job": "/".join(rel.parts[1:]), "wall_s": round(float(records[-1]["s"]), 1),
+               "max_rss_mb": records[-1].get("max_rss", "")}
+        try:
+            row["cpu_s"] = round(float(records[-1]["cpu_time"]), 1)
+        except (KeyError, TypeError, ValueError):  # older Snakemake, or a job too short to sample
+            pass
+        rows.append(row)
     return rows
 
 
