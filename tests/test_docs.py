@@ -96,6 +96,13 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     train = tmp_path / "results" / "p" / "train" / "head_on" / "seed0"
     train.mkdir(parents=True)
     (train / "curve.csv").write_text("env_steps,success_rate,wall_s\n0,0.0,1.0\n300000,0.5,2000.0\n")
+    # seed 1 shared its core: 3000 s of wall time, 1500 s of CPU time; seed 2 resumed (its job ran 500 s of 2000)
+    benchmarks = tmp_path / "results" / "p" / "benchmarks" / "train" / "head_on"
+    benchmarks.mkdir(parents=True)
+    for seed, wall, job_wall, job_cpu in ((1, 3000.0, 3001.0, 1500.0), (2, 2000.0, 500.0, 480.0)):
+        (train.parent / f"seed{seed}").mkdir()
+        (train.parent / f"seed{seed}" / "curve.csv").write_text(f"env_steps,success_rate,wall_s\n300000,0.5,{wall}\n")
+        (benchmarks / f"seed{seed}.tsv").write_text(f"s\th:m:s\tcpu_time\n{job_wall}\t0:50:00\t{job_cpu}\n")
     text = block_speed(tmp_path, "p")
     assert "**1,234 sensor frames/s** (0.81 ms a frame; target 1,000: met)" in text
     assert "**650 env steps/s** (1.538 ms a step, 7 resets included; target 700: not met)" in text
@@ -105,7 +112,9 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     # how busy the machine was is part of every figure
     assert "other processes used 1.50 cores meanwhile, load average 0.10 before" in text
     assert "X CPU with 2 cores" in text and "commit `0123456`" in text
-    assert "| `head_on` | 0 | 300,000 | 2,000 | 1 | 150 |" in text
+    assert "| `head_on` | 0 | 300,000 | 2,000 | 1 | 150 | – | – |" in text       # no benchmark
+    assert "| `head_on` | 1 | 300,000 | 3,000 | 1 | 100 | 1,500 | 200 |" in text
+    assert "| `head_on` | 2 | 300,000 | 2,000 | 1 | 150 | – | – |" in text       # resumed: its job saw a quarter
 
 
 def test_bench_out_stores_the_result_with_its_machine_and_load(tmp_path, capsys):

@@ -103,9 +103,24 @@ def _learner_lines(root: Path, profile: str) -> list[str]:
     return lines + ["", f"From `{path.relative_to(root)}`."]
 
 
+def _benchmark_cpu_s(path: Path, run_wall_s: float) -> float | None:
+    """The CPU time a training job's benchmark recorded, when that job was the whole run: a resumed
+    run's benchmark covers only its last part (its wall time falls well short of the curve's)."""
+    if not path.exists():
+        return None
+    try:
+        last = pd.read_csv(path, sep="\t").iloc[-1]
+        wall, cpu = float(last["s"]), float(last["cpu_time"])
+    except (KeyError, IndexError, TypeError, ValueError):
+        return None
+    return cpu if cpu > 0 and wall >= 0.9 * run_wall_s else None
+
+
 def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
-    """Env steps per core-second of every stored training of ``variants`` (final env steps over the
-    final ``wall_s`` of its curve.csv, times its torch threads)."""
+    """Env steps per core-second of every stored training of ``variants``: final env steps over the
+    final ``wall_s`` of its curve.csv times its torch threads, and over its job's CPU time where the
+    benchmark recorded the whole run. Wall time counts the time a job waited for a core while more
+    jobs ran than cores; CPU time does not."""
     rows = []
     for variant in variants:
         for curve in sorted((root / "results" / profile / "train" / variant).glob("seed*/curve.csv")):
@@ -115,16 +130,23 @@ def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
             if done.exists():
                 threads = int(json.loads(done.read_text()).get("config", {}).get("num_threads") or 1) or 1
             if not math.isnan(last.get("wall_s", math.nan)):
-                rows.append((variant, curve.parent.name, int(last.env_steps), float(last.wall_s), threads))
+                benchmark = root / "results" / profile / "benchmarks" / "train" / variant / f"{curve.parent.name}.tsv"
+                rows.append((variant, curve.parent.name, int(last.env_steps), float(last.wall_s), threads,
+                             _benchmark_cpu_s(benchmark, float(last.wall_s))))
     if not rows:
         return []
     lines = ["Stored trainings (whole runs: start-up weighs less than in the benchmark's short run):", "",
-             "| variant | seed | env steps | wall s | threads | env steps per core-second |",
-             "|---|---|---|---|---|---|"]
-    for variant, seed, steps, wall, threads in rows:
+             "| variant | seed | env steps | wall s | threads | env steps per core-second | CPU s | "
+             "env steps per CPU-second |",
+             "|---|---|---|---|---|---|---|---|"]
+    for variant, seed, steps, wall, threads, cpu in rows:
         lines.append(f"| `{variant}` | {seed.removeprefix('seed')} | {steps:,} | {wall:,.0f} | {threads} | "
-                     f"{steps / (wall * threads):.0f} |")
-    return lines + ["", f"From `results/{profile}/train/<variant>/seed<N>/curve.csv` (last row's `wall_s`)."]
+                     f"{steps / (wall * threads):.0f} | {'–' if cpu is None else f'{cpu:,.0f}'} | "
+                     f"{'–' if cpu is None else f'{steps / cpu:.0f}'} |")
+    return lines + ["", f"From `results/{profile}/train/<variant>/seed<N>/curve.csv` (last row's `wall_s`) and the "
+                        f"training job's CPU time in `results/{profile}/benchmarks/train/` (– where it does not "
+                        "cover the whole run: a resumed run's covers its last part). A training that shared its "
+                        "core waited part of its wall time; its CPU time is what it cost."]
 
 
 def block_speed(root: Path, profile: str) -> str:
