@@ -134,12 +134,22 @@ def _git(*args: str) -> str | None:
         return None
 
 
+def gpu_fields(gpu: str | None) -> dict:
+    """The GPU part of a machine record: nothing on a machine without one (records stay as they were)."""
+    if gpu is None:
+        return {}
+    import torch
+
+    return {"gpu": gpu, "torch": str(torch.__version__), "cuda": torch.version.cuda,
+            "gpu_memory_gib": round(torch.cuda.get_device_properties(0).total_memory / 2**30, 1)}
+
+
 def recorded(command: str, run: Callable[[], dict]) -> dict:
     """``run()``'s result with what it was measured on: the command, date, commit, CPU and core count,
     and how busy the machine was. A speed figure means little without the load beside it: the load
     average before and after, and ``other_load_cores``, the CPU time other processes used during the
     run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
-    from egosearch.machine import cpu_model
+    from egosearch.machine import cpu_model, gpu_model
 
     load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
     busy0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
@@ -150,9 +160,10 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     return {
         "command": command,
         "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "commit": _git("rev-parse", "HEAD") or "unknown",
+        # a copy of the tree without .git (a device, a cluster node) is told its commit
+        "commit": _git("rev-parse", "HEAD") or os.environ.get("EGOSEARCH_COMMIT") or "unknown",
         "commit_dirty": bool(status) if status is not None else None,
-        "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
+        "machine": {"cpu": cpu_model(), "cores": os.cpu_count(), **gpu_fields(gpu_model())},
         "load_average_before": load_before,
         "load_average_after": [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None,
         "other_load_cores": (round(max(0.0, busy1 - busy0 - own) / wall, 2)

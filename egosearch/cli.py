@@ -114,6 +114,8 @@ def _cmd_train(args) -> None:
     from egosearch.variants import load_variant
 
     check_outputs(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir})
+    if args.max_wall_s is not None and not args.max_wall_s > 0:
+        raise ValueError(f"--max-wall-s must be a positive number of seconds, got {args.max_wall_s}")
     variant = load_variant(args.variant)
     overrides = {**variant.config, "seed": args.seed}
     if args.threads:
@@ -127,10 +129,10 @@ def _cmd_train(args) -> None:
     evaluator = scenario_evaluator(env_id, curve_homes(env), env["placement"], n=cfg.eval_episodes)
     try:
         summary = train(env_id, cfg, args.work_dir or args.out_dir, env_kwargs=env, evaluate_fn=evaluator,
-                        variant=variant.name)
+                        variant=variant.name, max_wall_s=args.max_wall_s)
     finally:
         evaluator.close()
-    if args.work_dir:
+    if args.work_dir and not summary.get("stopped"):
         from egosearch.staging import publish_run
 
         publish_run(args.work_dir, args.out_dir)
@@ -389,13 +391,21 @@ def _cmd_bench(args) -> None:
     from egosearch import bench
     from egosearch.outputs import check_outputs
 
-    check_outputs(files={"--out": args.out})
+    check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
+    if args.what == "gpu" and not args.out_dir:
+        raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
+    if args.what == "gpu" and not args.seconds > 0:
+        raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
 
     def run() -> dict:
         if args.what == "env":
             return bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
         if args.what == "homes":
             return bench.bench_homes()
+        if args.what == "gpu":
+            from egosearch.rl.bench import gpu_check
+
+            return gpu_check(args.seconds, args.out_dir)
         from egosearch.rl.bench import bench_learner
 
         return bench_learner()
@@ -608,6 +618,8 @@ def build_parser() -> argparse.ArgumentParser:
                                                     "rerun with the same folder to resume")
     p.add_argument("--work-dir", help="train (and resume) here, and copy the files to --out-dir only once the run "
                                       "is complete (the DAG does: a killed job never leaves a partial output)")
+    p.add_argument("--max-wall-s", type=float, help="stop after this many seconds with a checkpoint written (inside "
+                                                    "a cluster's time limit); the same command resumes it")
     p.set_defaults(func=_cmd_train)
 
     p = sub.add_parser("variant", help="create a variant file in ablations/ from a template, or check variants")
@@ -637,12 +649,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_fullbody)
 
     p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics), homes (building one) or learner")
-    p.add_argument("what", choices=("env", "homes", "learner"),
+    p.add_argument("what", choices=("env", "homes", "learner", "gpu"),
                    help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
-                        "against a training episode; learner: SAC+CURL updates/s")
+                        "against a training episode; learner: SAC+CURL updates/s; gpu: the learner benchmarks and "
+                        "a paper-profile training of --seconds on this machine's GPU (results/paper/gpu_check)")
     p.add_argument("--layout", default="kitchen_living", help=f"env: the home ({layouts})")
     p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
     p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
+    p.add_argument("--seconds", type=float, default=150.0, help="gpu: the training's wall time (default 150)")
+    p.add_argument("--out-dir", help="gpu: the training's folder (curve.csv, train.csv, config.json, checkpoint)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
                                  "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")

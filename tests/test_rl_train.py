@@ -293,3 +293,17 @@ def test_target_memory_trains_the_policy_in_the_memory_env_of_its_head(tmp_path)
     actor.check_env("EgoSearchNoHeadMemory-v0")
     with pytest.raises(AgentStateError, match="was trained in EgoSearchNoHeadMemory-v0"):
         actor.check_env("EgoSearchNoHead-v0")
+
+
+def test_a_run_stopped_at_its_wall_time_limit_checkpoints_and_resumes(tmp_path):
+    """``max_wall_s``: the run stops at the first env step past the limit with a checkpoint there and
+    no actor; the same call without a limit resumes from that step."""
+    cfg = load_config("smoke", {**SMOKE, "total_env_steps": 200, "eval_every": 100, "checkpoint_every": 100})
+    stopped = train(FAKE_ENV_ID, cfg, tmp_path, progress=False, max_wall_s=1e-9)
+    assert stopped["stopped"] and stopped["env_steps"] == 1 and stopped["updates"] == 0
+    assert (tmp_path / CHECKPOINT_NAME).exists() and not (tmp_path / "actor.pt").exists()
+    assert not (tmp_path / "done.json").exists()
+    seen: list[int] = []
+    done = train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=seen.append)
+    assert seen[0] == 2 and done["env_steps"] == 200 and "stopped" not in done
+

@@ -120,8 +120,10 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
             "env_steps_per_core_s": round(env_steps / cpu, 1), "threads": torch_threads(cfg.num_threads)}
 
 
-def bench_learner(quick: bool = False) -> dict:
-    """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds)."""
+def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
+    """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
+    ``cpu_profile_run=False`` leaves out the cpu profile's training run (a GPU check times a real
+    paper-profile training instead)."""
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
     cpu0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
@@ -133,7 +135,8 @@ def bench_learner(quick: bool = False) -> dict:
     }
     cpu_cfg = load_config("cpu", {})
     runs["cpu_profile"] = time_updates("cpu", threads=torch_threads(cpu_cfg.num_threads), updates=2 * n)
-    throughput = training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
+    throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
+                  if cpu_profile_run else None)
     wall = time.perf_counter() - wall0
     cpu1 = _cpu_seconds_all()
     own = time.process_time() - own0
@@ -142,8 +145,9 @@ def bench_learner(quick: bool = False) -> dict:
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
         result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
     result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
-    result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
-    result["cpu_profile_run"] = throughput
+    if throughput is not None:
+        result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
+        result["cpu_profile_run"] = throughput
     result["replay_gb_100k"] = round(replay_gb(100_000), 3)
     result["torch_threads"] = torch.get_num_threads()
     result["cpu_profile_threads"] = torch_threads(cpu_cfg.num_threads)
@@ -152,4 +156,90 @@ def bench_learner(quick: bool = False) -> dict:
     if cpu0 is not None and cpu1 is not None:
         result["other_load"] = round(max(0.0, (cpu1 - cpu0) - own) / wall, 2) if wall > 0 else None
     result["bench_s"] = round(wall, 1)
+    return result
+
+
+def host_syncs_per_update(profile: str = "paper", updates: int = 6) -> float | None:
+    """Host-device synchronisations per full update (replay sampling excluded), counted with
+    torch's CUDA sync debug mode; None off CUDA. The update's metrics are read back in ONE sync
+    (``metric_values``); anything above 1 is a round trip inside the update."""
+    import warnings
+
+    if not torch.cuda.is_available():
+        return None
+    cfg = load_config(profile, {"device": "cuda"})
+    torch.manual_seed(0)
+    state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+    agent = (SacCurlAgent(cfg, 5, device="cuda") if cfg.algorithm == "sac_curl"
+             else make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim))
+    replay = _filled_replay(5, torch.device("cuda"), size=getattr(agent, "replay_image_size", cfg.image_size),
+                            state_dim=state_dim)
+    batches = [replay.sample(cfg.batch_size) for _ in range(updates + 2)]
+    for batch in batches[:2]:
+        agent.update(batch)
+    torch.cuda.synchronize()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        torch.cuda.set_sync_debug_mode("warn")
+        try:
+            for batch in batches[2:]:
+                agent.update(batch)
+        finally:
+            torch.cuda.set_sync_debug_mode("default")
+    syncs = [w for w in caught if "synchroniz" in str(w.message).lower()]
+    return round(len(syncs) / updates, 2)
+
+
+def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed: int = 0) -> dict:
+    """The paper profile on this machine's accelerator: the learner benchmarks, then a real
+    paper-profile training of ``variant_name`` (its curve evaluations included) for ``seconds`` of
+    wall time, stopped with a checkpoint (``egosearch train --max-wall-s`` resumes it). The run's
+    curve.csv, train.csv and config.json are left in ``out_dir``."""
+    from egosearch.envs import observed_env_id
+    from egosearch.evaluate import scenario_evaluator
+    from egosearch.home_pool import curve_homes
+    from egosearch.rl.train import train
+    from egosearch.variants import load_variant
+
+    result = {"learner": bench_learner(cpu_profile_run=False),
+              "host_syncs_per_update_table2": host_syncs_per_update("paper"),
+              "host_syncs_per_update_cpu_profile": host_syncs_per_update("cpu")}
+    variant = load_variant(variant_name)
+    cfg = load_config("paper", {**variant.config, "seed": seed})
+    env_id = observed_env_id(variant.env_id, cfg.target_memory)
+    evaluator = scenario_evaluator(env_id, curve_homes(variant.train_env), variant.train_env["placement"],
+                                   n=cfg.eval_episodes)
+    eval_s: list[float] = []
+
+    def timed_evaluator(policy) -> dict:
+        t0 = time.perf_counter()
+        row = evaluator(policy)
+        eval_s.append(time.perf_counter() - t0)
+        return row
+
+    wall0 = time.perf_counter()
+    try:
+        summary = train(env_id, cfg, out_dir, env_kwargs=variant.train_env, evaluate_fn=timed_evaluator,
+                        variant=variant.name, progress=False, max_wall_s=seconds)
+    finally:
+        evaluator.close()
+    wall = time.perf_counter() - wall0
+    import csv
+
+    with open(os.path.join(out_dir, "train.csv")) as f:
+        rows = list(csv.DictReader(f))
+    with open(os.path.join(out_dir, "curve.csv")) as f:
+        curve = list(csv.DictReader(f))
+    rates = [(float(r["steps_per_s"]), float(r["updates_per_s"])) for r in rows[1:]]  # the first row holds warm-up
+    result["training"] = {
+        "variant": variant.name, "seed": seed, "env_steps": summary["env_steps"], "updates": summary["updates"],
+        "wall_s": round(wall, 1), "curve_rows": len(curve),
+        "env_steps_per_s_overall": round(summary["env_steps"] / wall, 1),
+        "env_steps_per_s_updating": round(float(np.median([s for s, _ in rates])), 1) if rates else None,
+        "updates_per_s_updating": round(float(np.median([u for _, u in rates])), 1) if rates else None,
+        "train_rows_used": len(rates), "total_env_steps": cfg.total_env_steps,
+        "curve_evaluations": len(eval_s),
+        "curve_evaluation_s_mean": round(float(np.mean(eval_s)), 1) if eval_s else None,
+        "eval_every": cfg.eval_every, "eval_episodes": cfg.eval_episodes,
+    }
     return result

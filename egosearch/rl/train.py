@@ -41,7 +41,7 @@ import gymnasium
 import numpy as np
 import torch
 
-from egosearch.machine import cpu_model
+from egosearch.machine import cpu_model, gpu_model
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
@@ -503,13 +503,19 @@ def _make_env(env_id: str, env_kwargs: dict):
 
 def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwargs: dict | None = None,
           evaluate_fn: Callable[[Any], dict] | None = None, *, variant: str | None = None,
-          progress: bool = True, on_step: Callable[[int], None] | None = None) -> dict:
+          progress: bool = True, on_step: Callable[[int], None] | None = None,
+          max_wall_s: float | None = None) -> dict:
     """Train (or resume, or return at once if ``done.json`` is there) and return the summary.
 
     ``evaluate_fn(policy) -> dict`` with success_rate, spl, episode_return is called every
     ``cfg.eval_every`` env steps (default: :func:`default_evaluator`). ``variant`` names the run
     in the checkpoint / actor metadata (default: ``env_id``). ``on_step(env_steps)`` is called
     after every env step (tests use it to interrupt a run).
+
+    ``max_wall_s``: stop after this many seconds of this call's wall time, at the first env step
+    past it, with a checkpoint written there (a job inside a cluster's time limit, or a device
+    lent for minutes); the summary then has ``"stopped": True`` and no actor is written. The next
+    call resumes from that checkpoint.
     """
     from egosearch.envs import observed_env_id
 
@@ -545,7 +551,8 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     try:
         for _ in range(cfg.num_envs):
             envs.append(_make_env(env_id, train_env_kwargs(cfg, env_kwargs)))
-        return _train(envs, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt)
+        return _train(envs, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt,
+                      max_wall_s)
     finally:
         for env in envs:
             env.close()
@@ -609,7 +616,7 @@ def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
 
 
 def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
-           progress: bool, on_step, ckpt: dict | None) -> dict:
+           progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None) -> dict:
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
     run = _Run(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt)
     own_eval = evaluate_fn is None
@@ -637,6 +644,10 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
                 bar.update(run.step - before)
             if on_step is not None:
                 on_step(run.step)
+            if max_wall_s is not None and run.step < cfg.total_env_steps \
+                    and time.perf_counter() - run.t_start >= max_wall_s:
+                run.save_checkpoint()
+                return run.stopped()
     finally:
         if bar is not None:
             bar.close()
@@ -866,6 +877,18 @@ class _Run:
         }
         atomic_write(self.ckpt_path, lambda f: torch.save(state, f))
 
+    def machine(self) -> dict:
+        """The machine the run used: CPU and cores, and the GPU when it trained on one."""
+        gpu = {"gpu": gpu_model()} if self.device.type == "cuda" else {}
+        return {"cpu": cpu_model(), "cores": os.cpu_count(), **gpu}
+
+    def stopped(self) -> dict:
+        """The summary of a run stopped at its wall-time limit (its checkpoint is written)."""
+        return {"variant": self.variant, "env_id": self.env_id, "env_kwargs": _kwargs_key(self.env_kwargs),
+                "stopped": True, "env_steps": self.step, "updates": self.agent.num_updates,
+                "episodes": self.episodes, "wall_s": round(self.wall(), 3),
+                "machine": self.machine(), "config": self.cfg.to_dict()}
+
     def finish(self, last_row: dict | None) -> dict:
         """Write actor.pt, then done.json (the run is complete), then drop the checkpoint."""
         if last_row is None:  # resumed exactly at the end: the last curve row is already written
@@ -885,7 +908,7 @@ class _Run:
                    "final_eval": {k: (None if isinstance(v, float) and math.isnan(v) else v)
                                   for k, v in last_row.items()},
                    # wall_s is core time only on the machine that ran it: the budget study shows which
-                   "machine": {"cpu": cpu_model(), "cores": os.cpu_count()},
+                   "machine": self.machine(),
                    "config": cfg.to_dict()}
         atomic_json(self.done_path, summary)
         if not cfg.keep_checkpoint and self.ckpt_path.exists():

@@ -1,0 +1,203 @@
+"""The learners on CUDA (the ``gpu`` marker: skipped where CUDA is absent).
+
+The CUDA tests compare one update on CUDA with the same update on the CPU, from the same weights,
+optimiser state and batch. Both draw their random numbers (crop offsets, shifts, the policy's noise)
+from one host generator, so that only the arithmetic differs. TF32 is switched off for them: with
+it, convolutions round their inputs to 10 mantissa bits and the two devices no longer compute the
+same function. Stated tolerance, per tensor: ``|d_cuda - d_cpu| <= 1e-3 |d_cpu| + 1e-7 sqrt(n)``
+for each weight tensor's change ``d`` over the update (Euclidean norms, ``n`` its size), and
+``1e-4`` relative for the update's losses. The measured differences are written to the JSON file
+``$EGOSEARCH_CUDA_REPORT`` names, when it names one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import json
+import math
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+# cuBLAS reads this when it starts: before any test of this process touches CUDA (deterministic GEMMs)
+os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
+
+from egosearch.env import PRIVILEGED_STATE_DIM  # noqa: E402
+from egosearch.rl.bench import _filled_replay  # noqa: E402
+from egosearch.rl.config import load_config  # noqa: E402
+from egosearch.rl.sac_curl import load_actor_net  # noqa: E402
+from egosearch.rl.train import make_agent, train  # noqa: E402
+
+TESTS = Path(__file__).parent
+sys.path.insert(0, str(TESTS))
+from test_rl_fake_env import FAKE_ENV_ID  # noqa: E402
+from test_rl_train import TIMING_COLUMNS, Interrupt, check_complete_run, read_csv  # noqa: E402
+
+needs_cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="CUDA is not available")
+REPORT: dict = {}
+
+
+def _report(key: str, value) -> None:
+    REPORT[key] = value
+    path = os.environ.get("EGOSEARCH_CUDA_REPORT")
+    if path:
+        Path(path).write_text(json.dumps(REPORT, indent=1) + "\n")
+
+
+@contextlib.contextmanager
+def host_random(seed: int):
+    """``torch.randint`` and ``torch.randn_like`` drawn from one CPU generator, then moved to the
+    device asked for: the same numbers on either device (the learners draw nothing else)."""
+    gen = torch.Generator().manual_seed(seed)
+    randint, randn = torch.randint, torch.randn
+
+    def host_randint(low, high, size, *, device=None, **_):
+        return randint(low, high, size, generator=gen).to(device)
+
+    def host_randn_like(x, **_):
+        return randn(x.shape, generator=gen, dtype=x.dtype).to(x.device)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(torch, "randint", host_randint)
+        mp.setattr(torch, "randn_like", host_randn_like)
+        yield
+
+
+@contextlib.contextmanager
+def exact_fp32():
+    saved = torch.backends.cudnn.allow_tf32, torch.backends.cuda.matmul.allow_tf32
+    torch.backends.cudnn.allow_tf32 = torch.backends.cuda.matmul.allow_tf32 = False
+    try:
+        yield
+    finally:
+        torch.backends.cudnn.allow_tf32, torch.backends.cuda.matmul.allow_tf32 = saved
+
+
+def _weights(agent) -> dict[str, torch.Tensor]:
+    state = agent.state_dict()
+    out = {}
+    for part, value in state.items():
+        if isinstance(value, dict) and part != "optimisers" and part != "arch":
+            out.update({f"{part}.{k}": v.detach().float().cpu().clone() for k, v in value.items()
+                        if torch.is_tensor(v) and v.is_floating_point()})
+        elif torch.is_tensor(value) and value.is_floating_point():
+            out[part] = value.detach().float().cpu().clone()
+    return out
+
+
+@pytest.mark.gpu
+@needs_cuda
+@pytest.mark.parametrize("profile", ["paper", "cpu"])
+def test_one_update_on_cuda_matches_the_cpu_update(profile):
+    """``paper``: SAC+CURL at Table 2's sizes; ``cpu``: SAC-DrQ with the privileged critic."""
+    cfg = load_config(profile, {"device": "cpu"})
+    state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+    torch.manual_seed(0)
+    cpu_agent = make_agent(cfg, 5, 30, 4, torch.device("cpu"), state_dim)
+    replay = _filled_replay(5, torch.device("cpu"), n=300, size=getattr(cpu_agent, "replay_image_size", cfg.image_size),
+                            state_dim=state_dim)
+    with host_random(1):  # a few updates first, so that Adam's moments are not at their first step
+        for _ in range(3):
+            cpu_agent.update(replay.sample(cfg.batch_size))
+    state = copy.deepcopy(cpu_agent.state_dict())
+    batch = replay.sample(cfg.batch_size)
+    cuda_agent = make_agent(load_config(profile, {"device": "cuda"}), 5, 30, 4, torch.device("cuda"), state_dim)
+    cuda_agent.load_state_dict(state)
+    before = _weights(cpu_agent)
+    with exact_fp32():
+        with host_random(2):
+            m_cpu = cpu_agent.update(batch)
+        with host_random(2):
+            m_cuda = cuda_agent.update({k: v.to("cuda") if k != "index" else v for k, v in batch.items()})
+    worst_metric, worst_tensor = 0.0, 0.0
+    for key, a in m_cpu.items():
+        b = m_cuda[key]
+        assert math.isnan(a) == math.isnan(b), key
+        if not math.isnan(a):
+            worst_metric = max(worst_metric, abs(a - b) / max(abs(a), 1e-6))
+            assert abs(a - b) <= 1e-4 * max(abs(a), 1e-3), (key, a, b)
+    w_cpu, w_cuda = _weights(cpu_agent), _weights(cuda_agent)
+    assert w_cpu.keys() == w_cuda.keys() == before.keys()
+    moved = 0
+    for name, start in before.items():
+        d_cpu, d_cuda = w_cpu[name] - start, w_cuda[name] - start
+        err, scale = float((d_cuda - d_cpu).norm()), float(d_cpu.norm())
+        moved += scale > 0
+        worst_tensor = max(worst_tensor, err / scale if scale > 0 else 0.0)
+        assert err <= 1e-3 * scale + 1e-7 * math.sqrt(start.numel()), (name, err, scale)
+    assert moved >= len(before) // 2  # the update changed the networks: the comparison compares something
+    _report(f"update_{profile}", {"algorithm": cfg.algorithm, "batch": cfg.batch_size, "tensors": len(before),
+                                  "tensors_moved": moved, "max_relative_metric_difference": worst_metric,
+                                  "max_relative_update_difference": worst_tensor})
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):
+    """A short SAC+CURL training on CUDA, stopped and resumed from its checkpoint; its actor file
+    is then read by a process that sees no GPU (``torch.load(weights_only=True)``)."""
+    cfg = load_config("smoke", {"device": "cuda", "total_env_steps": 300, "checkpoint_every": 150})
+    whole, resumed = tmp_path / "whole", tmp_path / "resumed"
+    torch.use_deterministic_algorithms(True, warn_only=True)
+    try:
+        train(FAKE_ENV_ID, cfg, whole, progress=False)
+
+        def stop(step: int) -> None:
+            if step >= 200:
+                raise Interrupt(step)
+
+        with pytest.raises(Interrupt):
+            train(FAKE_ENV_ID, cfg, resumed, progress=False, on_step=stop)
+        ckpt = torch.load(resumed / "ckpt" / "train_state.ckpt", map_location="cpu", weights_only=True)
+        assert ckpt["env_steps"] == 150 and "cuda" in ckpt["rng"]
+        seen: list[int] = []
+        train(FAKE_ENV_ID, cfg, resumed, progress=False, on_step=seen.append)
+    finally:
+        torch.use_deterministic_algorithms(False)
+    assert seen[0] == 151 and seen[-1] == 300  # resumed at the checkpoint, not started over
+    done = check_complete_run(resumed, cfg)
+    assert done["machine"]["gpu"] == torch.cuda.get_device_name()
+    a = torch.load(whole / "actor.pt", weights_only=True)["state_dict"]
+    b = torch.load(resumed / "actor.pt", weights_only=True)["state_dict"]
+    same_rows = all(
+        [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in read_csv(run / "train.csv")[1]]
+        == [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in read_csv(whole / "train.csv")[1]]
+        for run in (resumed,))
+    _report("resume", {"actor_bitwise_equal": all(torch.equal(a[k], b[k]) for k in a),
+                       "actor_max_abs_difference": max(float((a[k].float() - b[k].float()).abs().max()) for k in a),
+                       "train_csv_equal_but_timing": same_rows})
+    assert all(v.device.type == "cpu" for v in b.values())
+
+    out = os.environ.get("EGOSEARCH_CUDA_ACTOR_OUT")
+    if out:
+        Path(out).write_bytes((resumed / "actor.pt").read_bytes())
+    obs = np.random.default_rng(0)
+    depth = obs.integers(0, 256, (5, 100, 100), dtype=np.uint8)
+    on_cuda = load_actor_net(torch.load(resumed / "actor.pt", weights_only=True), "cuda")
+    with torch.no_grad():
+        mu_cuda = on_cuda(torch.from_numpy(depth[None, :, 8:92, 8:92]).float().cuda(),
+                          torch.zeros(1, 34, device="cuda"))[0]
+    code = textwrap.dedent(f"""
+        import json, numpy as np, torch
+        from egosearch.rl.sac_curl import load_actor_net
+        assert not torch.cuda.is_available()
+        state = torch.load({str(resumed / 'actor.pt')!r}, weights_only=True)
+        net = load_actor_net(state, "cpu")
+        depth = np.random.default_rng(0).integers(0, 256, (5, 100, 100), dtype=np.uint8)
+        with torch.no_grad():
+            mu = net(torch.from_numpy(depth[None, :, 8:92, 8:92]).float(), torch.zeros(1, 34))[0]
+        print(json.dumps(mu[0].tolist()))
+    """)
+    env = {**os.environ, "CUDA_VISIBLE_DEVICES": ""}
+    done_cpu = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert done_cpu.returncode == 0, done_cpu.stderr[-2000:]
+    mu_cpu = np.array(json.loads(done_cpu.stdout.strip().splitlines()[-1]))
+    assert np.allclose(mu_cpu, mu_cuda[0].cpu().numpy(), atol=1e-2)
+
