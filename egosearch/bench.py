@@ -160,8 +160,8 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     return {
         "command": command,
         "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        # a copy of the tree without .git (a device, a cluster node) is told its commit
-        "commit": _git("rev-parse", "HEAD") or os.environ.get("EGOSEARCH_COMMIT") or "unknown",
+        # a copy of the tree (a device, a cluster node) is told its commit: its .git, if any, may be stale
+        "commit": os.environ.get("EGOSEARCH_COMMIT") or _git("rev-parse", "HEAD") or "unknown",
         "commit_dirty": bool(status) if status is not None else None,
         "machine": {"cpu": cpu_model(), "cores": os.cpu_count(), **gpu_fields(gpu_model())},
         "load_average_before": load_before,

@@ -1,4 +1,5 @@
-"""The learners on CUDA (the ``gpu`` marker: skipped where CUDA is absent).
+"""The learners on CUDA (the ``gpu`` marker: skipped where CUDA is absent), and a CUDA-trained actor
+file read on this machine (runs everywhere).
 
 The CUDA tests compare one update on CUDA with the same update on the CPU, from the same weights,
 optimiser state and batch. Both draw their random numbers (crop offsets, shifts, the policy's noise)
@@ -39,6 +40,10 @@ TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
 from test_rl_fake_env import FAKE_ENV_ID  # noqa: E402
 from test_rl_train import TIMING_COLUMNS, Interrupt, check_complete_run, read_csv  # noqa: E402
+
+CUDA_ACTOR = TESTS / "data" / "cuda_actor.pt"
+"""An actor trained on CUDA: ``test_cuda_training_resumes_and_its_actor_loads_without_cuda`` wrote it
+on a GPU machine (``EGOSEARCH_CUDA_ACTOR_OUT``; results/paper/gpu_check/cuda_tests.log is that run)."""
 
 needs_cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="CUDA is not available")
 REPORT: dict = {}
@@ -201,3 +206,15 @@ def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):
     mu_cpu = np.array(json.loads(done_cpu.stdout.strip().splitlines()[-1]))
     assert np.allclose(mu_cpu, mu_cuda[0].cpu().numpy(), atol=1e-2)
 
+
+def test_an_actor_trained_on_cuda_loads_and_acts_on_this_machine():
+    """The stored CUDA-trained actor: ``weights_only=True`` reads it on any machine, its tensors
+    are on the CPU, and it acts."""
+    state = torch.load(CUDA_ACTOR, weights_only=True)
+    assert state["metadata"]["config"]["device"] == "cuda" and state["metadata"]["env_steps"] == 300
+    assert all(v.device.type == "cpu" for v in state["state_dict"].values())
+    net = load_actor_net(state, "cpu")
+    depth = torch.from_numpy(np.random.default_rng(0).integers(0, 256, (1, 5, 84, 84), dtype=np.uint8)).float()
+    with torch.no_grad():
+        mu, log_std = net(depth, torch.zeros(1, 34))
+    assert mu.shape == (1, 5) and torch.isfinite(mu).all() and torch.isfinite(log_std).all()

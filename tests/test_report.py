@@ -639,3 +639,35 @@ def test_figure6_band_resamples_the_curve_episodes_when_every_seed_kept_them(tmp
     assert df.loc[100, "success_rate"] == pytest.approx(mean)
     assert (df.loc[100, "low"], df.loc[100, "high"]) == pytest.approx((lo, hi))
     assert df.loc[0, "ci_unit"] == CI_SEEDS
+
+
+def test_gpu_projection_by_hand(tmp_path):
+    """The paper profile's `all` from a GPU check: trainings one at a time at the measured rate with
+    their curve evaluations, plus the cpu run's other jobs of `all` over the machine's cores, the
+    full-body ones scaled by the paper profile's count of runs (3 motion generators x 3 seeds = 9)."""
+    import json
+
+    from egosearch.report.gpu import GPU_CHECK, block_gpu_projection, projection
+
+    (tmp_path / GPU_CHECK).mkdir(parents=True)
+    run = {"total_env_steps": 1000, "eval_every": 500, "env_steps_per_s_updating": 10.0,
+           "curve_evaluation_s_mean": 20.0, "env_steps": 100}
+    record = {"machine": {"cores": 4, "cpu": "x", "gpu": "G"}, "date_utc": "2026-01-01T00:00:00+00:00",
+              "result": {"training": run}}
+    (tmp_path / GPU_CHECK / "gpu_check.json").write_text(json.dumps(record))
+    (tmp_path / "results" / "cpu").mkdir(parents=True)
+    jobs = [{"rule": "train", "job": "head_on/seed0", "wall_s": 9e9},  # replaced by the GPU's rate
+            {"rule": "eval", "job": "head_on/seed0/kitchen_living/everywhere/h1.05", "wall_s": 720.0, "cpu_s": 360.0},
+            {"rule": "fullbody", "job": "ours-M5/seed0", "wall_s": 80.0},
+            {"rule": "traces", "job": "head_on/seed0/x", "wall_s": 1e6}]  # not part of `all`
+    (tmp_path / "results" / "cpu" / "provenance.json").write_text(json.dumps({"jobs": jobs}))
+    p = projection(tmp_path)
+    # a training: 1000 / 10 = 100 s of steps + 3 evaluations (0, 500, 1000) x 20 s = 160 s; 2 variants x 3 seeds
+    assert p["evaluations"] == 3 and p["trainings"] == 6
+    assert math.isclose(p["train_h"] * 3600, 160.0) and math.isclose(p["trainings_h"] * 3600, 960.0)
+    # other jobs: 360 (CPU time) + 9 x 80 = 1080 core-seconds, over 4 cores = 270 s
+    assert math.isclose(p["other_core_h"] * 3600, 1080.0) and math.isclose(p["other_h"] * 3600, 270.0)
+    assert math.isclose(p["total_h"] * 3600, 1230.0)
+    assert "6 trainings of 1,000 env steps" in block_gpu_projection(tmp_path, "cpu")
+    (tmp_path / GPU_CHECK / "gpu_check.json").unlink()
+    assert projection(tmp_path) is None and "Not measured yet" in block_gpu_projection(tmp_path, "cpu")

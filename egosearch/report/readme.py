@@ -449,6 +449,19 @@ def _block_claims(root: Path, profile: str) -> str:
     return block_claims(root, profile)
 
 
+def _block_gpu(root: Path, profile: str) -> str:
+    """The stored GPU check and the paper profile's projection (:mod:`egosearch.report.gpu`)."""
+    from egosearch.report.gpu import block_gpu
+
+    return block_gpu(root, profile)
+
+
+def _block_gpu_projection(root: Path, profile: str) -> str:
+    from egosearch.report.gpu import block_gpu_projection
+
+    return block_gpu_projection(root, profile)
+
+
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
@@ -464,6 +477,8 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "reading": block_reading,
     "claims": _block_claims,
     "speed": _block_speed,
+    "gpu": _block_gpu,
+    "gpu_projection": _block_gpu_projection,
 }
 
 DOCS = "docs"

@@ -1,0 +1,173 @@
+"""The paper profile on a GPU: the stored GPU check and the projection of the paper profile's ``all``.
+
+``egosearch bench gpu --seconds S --out-dir DIR --out results/paper/gpu_check/gpu_check.json`` on a
+GPU machine stores the learner benchmarks and a paper-profile training of S seconds (its curve.csv
+and train.csv beside it); ``pytest -m gpu tests/test_cuda.py`` there writes ``cuda_tests.log`` and
+``cuda_report.json``. This module renders them, and projects the wall time of
+``snakemake --config profile=paper all`` on one such machine from the measured rates, so that no
+figure of it is typed. JSON and CSV in, Markdown out.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+GPU_CHECK = Path("results") / "paper" / "gpu_check"
+"""Where the GPU check is stored, under the project root."""
+
+
+def _missing(root: Path) -> str:
+    return (f"*Not measured yet: `{GPU_CHECK / 'gpu_check.json'}` is missing (on a GPU machine: "
+            f"`egosearch bench gpu --seconds 300 --out-dir <a folder> --out {GPU_CHECK / 'gpu_check.json'}`).*\n")
+
+
+def _record(root: Path) -> dict | None:
+    path = root / GPU_CHECK / "gpu_check.json"
+    return json.loads(path.read_text(encoding="utf-8")) if path.exists() else None
+
+
+def fullbody_jobs(profile_config: dict) -> int:
+    """Full-body runs per setting of a profile: motion generators x seeds (rules/fullbody.smk)."""
+    fullbody = profile_config["fullbody"]
+    return len(fullbody["motion_generators"]) * len(fullbody["seeds"])
+
+
+def projection(root: Path) -> dict | None:
+    """Hours of ``snakemake --config profile=paper all`` on the GPU check's machine: its trainings one
+    at a time at the measured rate (curve evaluations included), plus the other jobs of ``all``, CPU
+    jobs, from the stored cpu run's recorded costs (the full-body ones scaled to the paper profile's
+    count of runs) spread over the machine's cores. None without a GPU check."""
+    from egosearch.report.readme import job_cost_s, job_study, variants_of_all, workflow_config
+
+    record = _record(root)
+    if record is None:
+        return None
+    run = record["result"]["training"]
+    config = workflow_config()
+    paper = config["profiles"]["paper"]
+    evaluations = run["total_env_steps"] // run["eval_every"] + 1
+    train_s = run["total_env_steps"] / run["env_steps_per_s_updating"] + evaluations * run["curve_evaluation_s_mean"]
+    trainings = len(variants_of_all(config)) * len(paper["seeds"])
+    scale = fullbody_jobs(paper) / fullbody_jobs(config["profiles"]["cpu"])
+    other_s, provenance = 0.0, root / "results" / "cpu" / "provenance.json"
+    if provenance.exists():
+        for job in json.loads(provenance.read_text(encoding="utf-8"))["jobs"]:
+            if job["rule"] != "train" and job_study(job, config) == "all":
+                other_s += job_cost_s(job) * (scale if job["rule"].startswith("fullbody") else 1.0)
+    cores = int(record["machine"]["cores"])
+    return {"train_h": train_s / 3600, "trainings": trainings, "trainings_h": trainings * train_s / 3600,
+            "other_core_h": other_s / 3600, "other_h": other_s / cores / 3600, "cores": cores,
+            "fullbody_scale": scale, "total_h": (trainings * train_s + other_s / cores) / 3600,
+            "evaluations": evaluations}
+
+
+def _machine(record: dict) -> str:
+    m = record["machine"]
+    return (f"{m.get('gpu', 'no GPU')} ({m.get('gpu_memory_gib', '?')} GiB), {m['cpu']} with {m['cores']} cores, "
+            f"torch {m.get('torch', '?')}, CUDA {m.get('cuda', '?')}")
+
+
+def _commit(record: dict) -> str:
+    return record["commit"][:7]
+
+
+def block_gpu_projection(root: Path, profile: str) -> str:
+    """The README's lines: the projected wall time of the paper profile's ``all`` on one GPU."""
+    record, p = _record(root), projection(root)
+    if record is None or p is None:
+        return _missing(root)
+    run = record["result"]["training"]
+    return (f"On one {record['machine'].get('gpu', 'GPU')} ({record['machine']['cores']} CPU cores), "
+            f"`snakemake --cores {p['cores']} --config profile=paper all` is projected at **about "
+            f"{p['total_h']:.0f} h**: {p['trainings']} trainings of {run['total_env_steps']:,} env steps, one at a "
+            f"time, at the measured {run['env_steps_per_s_updating']:.1f} env steps/s ({p['train_h']:.1f} h each), "
+            f"plus about {p['other_h']:.1f} h of CPU jobs. Derived from the stored GPU check "
+            f"(`{GPU_CHECK}/`, {record['date_utc'][:10]}); how, and what `--executor slurm` needs: "
+            "[docs/gpu.md](docs/gpu.md).\n")
+
+
+def _compile_line(root: Path) -> str | None:
+    path = root / GPU_CHECK / "compile_bench.txt"
+    if not path.exists():
+        return None
+    found = [line for line in path.read_text(encoding="utf-8").splitlines() if line.startswith("{")]
+    if not found:
+        return None
+    r = json.loads(found[-1])
+    if "compiled" not in r:
+        return f"- `compile: true` (torch.compile) failed there: {r.get('compiled_error', '?')}."
+    plain, compiled = r["plain"]["median_s"], r["compiled"]["median_s"]
+    verdict = "faster" if compiled < plain else "no faster"
+    return (f"- `compile: true` (torch.compile of the networks, default mode): {1 / compiled:.1f} updates/s "
+            f"against {1 / plain:.1f} without it, median of 40 Table 2 updates each, in one run "
+            f"(`{GPU_CHECK}/compile_bench.txt`): {verdict}.")
+
+
+def _tests_lines(root: Path) -> list[str]:
+    log, report = root / GPU_CHECK / "cuda_tests.log", root / GPU_CHECK / "cuda_report.json"
+    if not log.exists():
+        return []
+    text = log.read_text(encoding="utf-8")
+    results = re.findall(r"^tests/test_cuda\.py::(\S+) (PASSED|FAILED|SKIPPED|ERROR)", text, flags=re.M)
+    summary = re.findall(r"=+ (.+) in [\d.]+s", text)
+    lines = [f"CUDA tests (`pytest -m gpu tests/test_cuda.py` on that machine; `{GPU_CHECK}/cuda_tests.log`): "
+             + (summary[-1] if summary else "no summary line") + "."]
+    lines += [f"- `{name}`: {status.lower()}" for name, status in results]
+    if report.exists():
+        r = json.loads(report.read_text(encoding="utf-8"))
+        for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu profile")):
+            if key in r:
+                u = r[key]
+                lines.append(f"- one update, CUDA against CPU from the same weights, optimiser state and batch, TF32 "
+                             f"off ({label}, {u['tensors']} weight tensors): largest relative difference of a "
+                             f"tensor's change {u['max_relative_update_difference']:.1e} (tolerance 1e-3), of a "
+                             f"loss {u['max_relative_metric_difference']:.1e} (tolerance 1e-4)")
+        if "resume" in r:
+            same = "bit for bit the same" if r["resume"]["actor_bitwise_equal"] else (
+                f"not bit for bit the same (largest difference {r['resume']['actor_max_abs_difference']:.1e})")
+            lines.append(f"- the CUDA training stopped at 200 env steps and resumed from its checkpoint at 150 "
+                         f"(deterministic algorithms on): its actor is {same} as the run never stopped")
+    return lines
+
+
+def block_gpu(root: Path, profile: str) -> str:
+    """docs/gpu.md: the machine, the CUDA tests, the learner's speed there, the training, the projection."""
+    record, p = _record(root), projection(root)
+    if record is None or p is None:
+        return _missing(root)
+    result, run = record["result"], record["result"]["training"]
+    learner = result["learner"]
+    sections = [
+        [f"Machine: {_machine(record)}. Recorded by `{record['command']}` on {record['date_utc'][:16]} UTC, "
+         f"commit `{_commit(record)}` ({record['wall_s']:.0f} s in all; `{GPU_CHECK}/gpu_check.json`)."
+         + (f" {record['commit_note'][0].upper()}{record['commit_note'][1:]}." if record.get("commit_note") else "")],
+        _tests_lines(root),
+        ["Learner on the GPU (updates/s from the median update, the fastest in brackets):", "",
+         "| key | updates/s |", "|---|---|"]
+        + [f"| `updates_per_s_{key}` | {learner[f'updates_per_s_{key}']} ({learner[f'updates_per_s_{key}_best']}) |"
+           for key in ("naive", "table2", "table2_shared", "table2_1thread", "cpu_profile")]
+        + ["", f"- Host-device synchronisations per update (torch's sync debug mode, replay sampling excluded): "
+               f"{result['host_syncs_per_update_table2']} at Table 2, {result['host_syncs_per_update_cpu_profile']} "
+               "for the cpu profile's learner. One is the update's metrics, read back together; where the other "
+               "comes from was not traced there (on the CPU, nothing else in an update reads a tensor back)."]
+        + ([line] if (line := _compile_line(root)) else []),
+        [f"Paper-profile training (`{run['variant']}`, seed {run['seed']}, its envs on the machine's CPU, one env as "
+         f"Table 2): {run['env_steps']:,} env steps and {run['updates']:,} updates in {run['wall_s']:.0f} s, "
+         f"stopped there with a checkpoint (`--max-wall-s`). **{run['env_steps_per_s_updating']:.1f} env steps/s** "
+         f"while updating (one update per env step; the median of {run['train_rows_used']} train.csv rows), "
+         f"{run['env_steps_per_s_overall']:.1f} over the whole run; a curve evaluation ({run['eval_episodes']} "
+         f"episodes) took {run['curve_evaluation_s_mean']:.1f} s. `curve.csv`, `train.csv` and `config.json` are "
+         f"beside the record."],
+        ["Projection of `snakemake --config profile=paper all` on one such machine:", "",
+         f"- {p['trainings']} trainings (the `all` variants x the paper profile's seeds) of "
+         f"{run['total_env_steps']:,} env steps at {run['env_steps_per_s_updating']:.1f} env steps/s, with "
+         f"{p['evaluations']} curve evaluations each: {p['train_h']:.1f} h a training, {p['trainings_h']:.1f} h "
+         "one at a time;",
+         f"- the other jobs of `all` are CPU jobs: {p['other_core_h']:.1f} core-hours by the stored cpu run's "
+         f"recorded costs (`results/cpu/provenance.json`, full-body runs x{p['fullbody_scale']:.0f} for the paper "
+         f"profile's motion generators and seeds), {p['other_h']:.1f} h on {p['cores']} cores;",
+         f"- **about {p['total_h']:.0f} h in all**, an estimate from the measured rates, not a measured run."],
+    ]
+    return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"
