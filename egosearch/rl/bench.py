@@ -23,6 +23,7 @@ Keys:
 
 from __future__ import annotations
 
+import csv
 import os
 import platform
 import time
@@ -224,8 +225,6 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
     finally:
         evaluator.close()
     wall = time.perf_counter() - wall0
-    import csv
-
     with open(os.path.join(out_dir, "train.csv")) as f:
         rows = list(csv.DictReader(f))
     with open(os.path.join(out_dir, "curve.csv")) as f:
