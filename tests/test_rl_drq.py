@@ -48,6 +48,22 @@ def test_conv_sides_and_random_shift():
     assert torch.equal(random_shift(x, 0), x)
 
 
+def test_channels_last_encoder_computes_the_same_features_and_gradients():
+    torch.manual_seed(0)
+    plain = PooledConvEncoder(5, 100, 2, 2, 8, 2, "relu")
+    fast = PooledConvEncoder(5, 100, 2, 2, 8, 2, "relu")
+    fast.load_state_dict(plain.state_dict())
+    fast.use_channels_last()
+    assert fast.convs[0].weight.is_contiguous(memory_format=torch.channels_last)
+    x = torch.randint(0, 256, (4, 5, 50, 50)).float()
+    a, b = plain(x), fast(x)
+    assert a.shape == b.shape == (4, plain.out_dim)
+    torch.testing.assert_close(a, b, rtol=1e-5, atol=1e-6)  # features in (C, H, W) order either way
+    a.square().sum().backward()
+    b.square().sum().backward()
+    torch.testing.assert_close(plain.convs[0].weight.grad, fast.convs[0].weight.grad, rtol=1e-4, atol=1e-5)
+
+
 def _obs(value: int, size: int = 8) -> dict:
     return {"depth": np.full((3, size, size), value, np.uint8), "mask": np.full(30, value, np.float32),
             "proprio": np.zeros(4, np.float32)}

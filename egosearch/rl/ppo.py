@@ -135,6 +135,9 @@ class PpoAgent(PooledReplay):
         self._start_wide(cfg.ppo_init_std)
         for net in (self.encoder, self.actor, self.value):
             net.to(self.device)
+        if cfg.channels_last:
+            self.encoder.use_channels_last()
+            self.value.encoder.use_channels_last()
         self.num_updates = 0
         self.actor_params = [*self.encoder.parameters(), *self.actor.parameters()]
         self.optimisers = {"actor": adam(self.actor_params, cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2)),

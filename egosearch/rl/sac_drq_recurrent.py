@@ -287,6 +287,8 @@ class SacDrqRecurrentAgent(PooledReplay):
         for net in (self.encoder, self.critic, self.actor):
             net.apply(weight_init)
             net.to(self.device)
+        if cfg.channels_last:
+            self.encoder.use_channels_last()
         self.critic_target = copy.deepcopy(self.critic)
         for p in self.critic_target.parameters():
             p.requires_grad_(False)
