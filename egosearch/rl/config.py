@@ -348,8 +348,8 @@ class LearnerConfig:
     still shares every pass that CURL's order allows (see ``SacCurlAgent._update_fast``)."""
     channels_last: bool = True
     """Ours: run the convs in channels-last memory layout (same math, faster oneDNN kernels), in
-    every learner. For SAC-DrQ at 50 px it saved about 8% of a short real training's CPU time on the
-    2-core AMD EPYC (five interleaved pairs of 2,400-step runs, noisy: 45-58 against 51-63 CPU-s)."""
+    every learner. For SAC-DrQ at 50 px the gain on the 2-core CPU is small and noisy (short real
+    trainings, not a stored benchmark); it changes no number a run learns."""
     compile: bool = False
     """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
     ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
