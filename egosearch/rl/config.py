@@ -349,7 +349,7 @@ class LearnerConfig:
     channels_last: bool = True
     """Ours: run the convs in channels-last memory layout (same math, faster oneDNN kernels), in
     every learner. For SAC-DrQ at 50 px the gain on the 2-core CPU is small and noisy (short real
-    trainings, not a stored benchmark); it changes no number a run learns."""
+    trainings, not a stored benchmark); results differ only by float rounding."""
     compile: bool = False
     """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
     ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
