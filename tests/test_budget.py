@@ -47,6 +47,21 @@ def test_budget_pools_seeds_and_counts_core_hours(tmp_path):
     assert [p.suffix for p in outs] == [".csv", ".png", ".pdf"] and all(p.stat().st_size > 0 for p in outs)
 
 
+def test_budget_names_where_each_setting_trained(tmp_path):
+    here = _run(tmp_path, "here", 0, 1000, 5.0, [1])
+    (here[0].parent / "done.json").write_text(
+        '{"env_kwargs": "[(\'layout\', \'kitchen_living\'), (\'placement\', \'everywhere\')]", '
+        '"machine": {"cpu": "X"}}')
+    both = [_run(tmp_path, "both", s, 1000, 5.0, [0]) for s in range(2)]
+    for curve, _ in both:
+        (curve.parent / "done.json").write_text('{"env_kwargs": "[(\'layout\', \'paper_homes\')]"}')
+    unknown = _run(tmp_path, "unknown", 0, 1000, 5.0, [1])
+    df = budget_frame({"here": [here], "both": both, "unknown": [unknown]}).set_index("setting")
+    assert df.loc["here", "trained_in"] == "kitchen_living" and df.loc["here", "machine"] == "X"
+    assert df.loc["both", "trained_in"] == "paper_homes" and df.loc["both", "machine"] == "not recorded"
+    assert df.loc["unknown", "trained_in"] == "not recorded"
+
+
 def test_budget_refuses_runs_of_one_setting_that_end_at_different_steps(tmp_path):
     runs = {"mixed": [_run(tmp_path, "mixed", 0, 1000, 5.0, [1]), _run(tmp_path, "mixed", 1, 2000, 5.0, [0])]}
     with pytest.raises(ValueError, match="different env steps"):

@@ -218,3 +218,24 @@ def test_a_jobs_cpu_time_is_recorded_beside_its_wall_time(tmp_path):
     assert rule_times(tmp_path) == [
         {"rule": "report", "job": "table1", "wall_s": 12.0, "max_rss_mb": ""},
         {"rule": "train", "job": "v/seed0", "wall_s": 7200.5, "max_rss_mb": "1500", "cpu_s": 3600.0}]
+
+
+def test_a_resumed_training_costs_its_whole_run_in_the_estimate(tmp_path):
+    from egosearch.report.provenance import rule_times
+    from egosearch.report.readme import job_cost_s
+
+    benchmarks = tmp_path / "benchmarks"
+    header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
+    for run, bench_row, curve_wall in (("resumed", "2000.0\t0:33:20\t1\t1\t1\t1\t0\t0\t90\t1800.0\n", 5000.0),
+                                       ("whole", "5000.0\t1:23:20\t1\t1\t1\t1\t0\t0\t90\t4500.0\n", 4990.0)):
+        (benchmarks / "train" / "v").mkdir(parents=True, exist_ok=True)
+        (benchmarks / "train" / "v" / f"{run}.tsv").write_text(header + bench_row)
+        (tmp_path / "train" / "v" / run).mkdir(parents=True)
+        # the curve counts wall time from the run's start, across its resume
+        (tmp_path / "train" / "v" / run / "curve.csv").write_text(
+            f"env_steps,success_rate,wall_s\n100000,0.3,{curve_wall / 2}\n200000,0.5,{curve_wall}\n")
+    resumed, whole = rule_times(benchmarks)
+    assert resumed["run_wall_s"] == 5000.0 and "run_wall_s" not in whole
+    # its benchmark timed the last 2,000 s at 0.9 CPU-s per second: the whole run is 5,000 s of that
+    assert job_cost_s(resumed) == 4500.0
+    assert job_cost_s(whole) == 4500.0

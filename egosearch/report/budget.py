@@ -6,12 +6,15 @@ independent; with several seeds, which ran the same scenarios, the two-level boo
 scenarios then seeds), against the env steps it
 trained for and the core-hours its training took (``wall_s`` of the last row of its curve.csv
 times its torch threads: the runs are one-thread jobs, so wall time on a core is core time). Core
-time is the machine's: each row names the CPU its runs trained on (``machine``).
+time is the machine's: each row names the CPU its runs trained on (``machine``), and where they
+trained (``trained_in``: the home layout of their training envs), because a setting read in the
+home it trained in alone has an advantage there that is not the setting's.
 CSV in, files out: no torch, no simulator.
 """
 
 from __future__ import annotations
 
+import ast
 import json
 import math
 import os
@@ -31,18 +34,35 @@ from egosearch.report.stats import scenario_seed_matrix, two_level_ci, wilson_ci
 PathLike = str | os.PathLike
 
 BUDGET_COLUMNS = ("setting", "label", "n_seeds", "env_steps", "core_hours", "core_hours_per_seed", "episodes",
-                  "success_rate", "low", "high", "env_steps_per_core_s", "machine")
+                  "success_rate", "low", "high", "env_steps_per_core_s", "machine", "trained_in")
 NOT_RECORDED = "not recorded"
+
+
+def _done(curve: PathLike) -> dict:
+    try:
+        done = json.loads((Path(curve).parent / "done.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return done if isinstance(done, dict) else {}
 
 
 def run_machine(curve: PathLike) -> str:
     """The CPU that trained the run of ``curve`` (from the ``done.json`` beside it; runs made before
     training recorded it say so), so that core-hours are read against the machine they were spent on."""
-    done = Path(curve).parent / "done.json"
-    try:
-        return json.loads(done.read_text()).get("machine", {}).get("cpu") or NOT_RECORDED
-    except (OSError, ValueError, AttributeError):
-        return NOT_RECORDED
+    machine = _done(curve).get("machine")
+    return (machine.get("cpu") if isinstance(machine, dict) else None) or NOT_RECORDED
+
+
+def run_layout(curve: PathLike) -> str:
+    """The home layout the run of ``curve`` trained in (its ``done.json``'s env kwargs, which it
+    records as the repr of their sorted items)."""
+    kwargs = _done(curve).get("env_kwargs")
+    if isinstance(kwargs, str):
+        try:
+            kwargs = dict(ast.literal_eval(kwargs))
+        except (ValueError, SyntaxError, TypeError):
+            kwargs = None
+    return str(kwargs.get("layout", NOT_RECORDED)) if isinstance(kwargs, dict) else NOT_RECORDED
 
 
 def budget_frame(runs: Mapping[str, Iterable[tuple[PathLike, PathLike]]], threads: int = 1,
@@ -72,7 +92,8 @@ def budget_frame(runs: Mapping[str, Iterable[tuple[PathLike, PathLike]]], thread
                      "core_hours_per_seed": core_s / 3600 / len(pairs), "episodes": n,
                      "success_rate": k / n, "low": low, "high": high,
                      "env_steps_per_core_s": steps[0] * len(pairs) / core_s,
-                     "machine": " + ".join(sorted({run_machine(c) for c, _ in pairs}))})
+                     "machine": " + ".join(sorted({run_machine(c) for c, _ in pairs})),
+                     "trained_in": " + ".join(sorted({run_layout(c) for c, _ in pairs}))})
     return pd.DataFrame(rows, columns=list(BUDGET_COLUMNS))
 
 
@@ -100,7 +121,7 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
         axes = fig.subplots(1, 2, sharey=True)
         for i, row in enumerate(df.itertuples(index=False)):
             colour = OKABE_ITO[i % len(OKABE_ITO)]
-            label = f"{row.label} ({row.n_seeds} seed{'s' if row.n_seeds > 1 else ''})"
+            label = f"{row.label} ({row.n_seeds} seed{'s' if row.n_seeds > 1 else ''}; trained in {row.trained_in})"
             if row.setting == chosen:
                 label += " — chosen"
             for ax, x in zip(axes, (row.env_steps, row.core_hours_per_seed)):
@@ -126,4 +147,4 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
     return [_with(base, ".csv"), *outs]
 
 
-__all__ = ["BUDGET_COLUMNS", "NOT_RECORDED", "budget_figure", "budget_frame", "log_ticks", "run_machine"]
+__all__ = ["BUDGET_COLUMNS", "NOT_RECORDED", "budget_figure", "budget_frame", "log_ticks", "run_layout", "run_machine"]

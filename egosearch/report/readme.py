@@ -117,9 +117,15 @@ def job_study(job: dict, config: dict | None = None) -> str:
 def job_cost_s(job: dict) -> float:
     """What a one-thread job costs a core of its own: its CPU time where the benchmark recorded it,
     else its wall time. A job that ran beside more jobs than cores waited for a core part of its wall
-    time (three trainings on two cores take half as long again each)."""
+    time (three trainings on two cores take half as long again each). A resumed training's benchmark
+    timed only its last part: its cost is scaled to the whole run by wall time (``run_wall_s``),
+    which assumes the earlier part spent its wall time on the CPU in the same proportion."""
     cpu = job.get("cpu_s")
-    return float(cpu) if cpu is not None and 0 < cpu <= job["wall_s"] else float(job["wall_s"])
+    cost = float(cpu) if cpu is not None and 0 < cpu <= job["wall_s"] else float(job["wall_s"])
+    run_wall = job.get("run_wall_s")
+    if run_wall is not None and run_wall > job["wall_s"] > 0:
+        cost *= run_wall / job["wall_s"]
+    return cost
 
 
 def block_provenance(root: Path, profile: str) -> str:
@@ -143,7 +149,8 @@ def block_provenance(root: Path, profile: str) -> str:
              # time over N is what `snakemake --cores N all` takes from a fresh clone, give or take
              # the tail where fewer than N jobs are ready.
              f"- Estimated wall time of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed "
-             f"time / {cores}, one-thread jobs, each at its CPU time where recorded): "
+             f"time / {cores}, one-thread jobs, each at its CPU time where recorded, a resumed training's "
+             "scaled to its whole run): "
              f"{summed['all'] / cores / 3600:.2f} h"
              + (f"; of `snakemake --cores {cores} generalise` after it: {summed['generalise'] / cores / 3600:.2f} h"
                 if summed["generalise"] > 0 else "")
@@ -270,11 +277,12 @@ def block_budget(root: Path, profile: str) -> str:
         return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 budget")
     df = pd.read_csv(path)
     lines = ["| setting | seeds | env steps per run | core-hours per run | env steps per core-second | "
-             "success, 1.05 m excl. low cabinets (95% CI) | trained on |", "|---|---|---|---|---|---|---|"]
+             "success, 1.05 m excl. low cabinets (95% CI) | trained on | trained in |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in df.itertuples(index=False):
         lines.append(f"| `{r.setting}` | {int(r.n_seeds)} | {int(r.env_steps):,} | {_fmt(r.core_hours_per_seed)} | "
                      f"{r.env_steps_per_core_s:.0f} | {_fmt(r.success_rate)} [{_fmt(r.low)}, {_fmt(r.high)}] | "
-                     f"{r.machine} |")
+                     f"{r.machine} | {r.trained_in} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
