@@ -34,6 +34,11 @@ def _version(package: str) -> str:
         return "not installed"
 
 
+WHOLE_RUN_SHARE = 0.9
+"""A training's benchmark timed the whole run when its wall time is at least this share of the wall
+time its ``curve.csv`` counts; below it, the run was resumed and the benchmark timed its last part."""
+
+
 def _curve_wall_s(curve: Path) -> float | None:
     """The wall time a training's ``curve.csv`` counts from its start, across resumes (last row)."""
     try:
@@ -64,7 +69,7 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
             pass
         if row["rule"] == "train":
             run_wall = _curve_wall_s(Path(benchmarks_dir).parent / "train" / row["job"] / "curve.csv")
-            if run_wall is not None and row["wall_s"] < 0.9 * run_wall:
+            if run_wall is not None and row["wall_s"] < WHOLE_RUN_SHARE * run_wall:
                 row["run_wall_s"] = round(run_wall, 1)
         rows.append(row)
     return rows

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from egosearch.report.provenance import WHOLE_RUN_SHARE
+
 ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
 """The issue's one-core targets for the sensor and the env."""
 UPDATES_TARGET = 12.0
@@ -113,7 +115,7 @@ def _benchmark_cpu_s(path: Path, run_wall_s: float) -> float | None:
         wall, cpu = float(last["s"]), float(last["cpu_time"])
     except (KeyError, IndexError, TypeError, ValueError):
         return None
-    return cpu if cpu > 0 and wall >= 0.9 * run_wall_s else None
+    return cpu if cpu > 0 and wall >= WHOLE_RUN_SHARE * run_wall_s else None
 
 
 def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
