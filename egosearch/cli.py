@@ -396,6 +396,8 @@ def _cmd_bench(args) -> None:
         raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
     if args.what == "gpu" and not args.seconds > 0:
         raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
+    if args.baseline_seconds < 0 or args.baseline_seconds > 0 and not args.cuda_graph:
+        raise ValueError(f"--baseline-seconds {args.baseline_seconds}: needs --cuda-graph and a number >= 0")
 
     def run() -> dict:
         if args.what == "env":
@@ -405,12 +407,16 @@ def _cmd_bench(args) -> None:
         if args.what == "gpu":
             from egosearch.rl.bench import gpu_check
 
-            return gpu_check(args.seconds, args.out_dir)
+            return gpu_check(args.seconds, args.out_dir, overrides={"cuda_graph": True} if args.cuda_graph else None,
+                             baseline_seconds=args.baseline_seconds)
         from egosearch.rl.bench import bench_learner
 
         return bench_learner()
 
     options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
+    if args.what == "gpu":
+        options = f" --seconds {args.seconds:g}" + (" --cuda-graph" if args.cuda_graph else "") + (
+            f" --baseline-seconds {args.baseline_seconds:g}" if args.baseline_seconds else "")
     record = bench.recorded(f"egosearch bench {args.what}{options}", run)
     result = record["result"]
     if args.out:
@@ -658,6 +664,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
     p.add_argument("--seconds", type=float, default=150.0, help="gpu: the training's wall time (default 150)")
     p.add_argument("--out-dir", help="gpu: the training's folder (curve.csv, train.csv, config.json, checkpoint)")
+    p.add_argument("--cuda-graph", action="store_true",
+                   help="gpu: train with the update captured as CUDA graphs (learner.cuda_graph=true)")
+    p.add_argument("--baseline-seconds", type=float, default=0.0,
+                   help="gpu, with --cuda-graph: also train this long without it (in <out-dir>/baseline), for the "
+                        "ratio on one machine")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
                                  "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")

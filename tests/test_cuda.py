@@ -143,6 +143,95 @@ def test_one_update_on_cuda_matches_the_cpu_update(profile):
                                   "max_relative_update_difference": worst_tensor})
 
 
+@contextlib.contextmanager
+def fixed_device_random():
+    """``torch.randint`` and ``torch.randn_like`` as fixed functions of the shape, computed on the
+    device: a recorded update replays the same numbers an eager one draws (torch's generator gives
+    a graph other offsets), and nothing is copied from the host inside a capture."""
+
+    def fixed_randint(low, high, size, *, device=None, **_):
+        n = math.prod(size)
+        return ((torch.arange(n, device=device) * 7 + 3) % (high - low) + low).reshape(size)
+
+    def fixed_randn_like(x, **_):
+        return torch.sin(torch.arange(x.numel(), device=x.device, dtype=x.dtype) * 0.37).reshape(x.shape)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(torch, "randint", fixed_randint)
+        mp.setattr(torch, "randn_like", fixed_randn_like)
+        yield
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
+    """``cuda_graph``: ten Table 2 updates (both patterns warmed up, captured and replayed) equal
+    ten eager ones from the same weights and batches, within the CPU-vs-CUDA tolerance; loading a
+    state drops the graphs, and the next update again equals the eager one."""
+    from dataclasses import replace
+
+    from egosearch.rl.sac_curl import SacCurlAgent
+
+    cfg = load_config("paper", {"device": "cuda"})
+    torch.manual_seed(0)
+    eager = SacCurlAgent(cfg, 5, device="cuda")
+    graphed = SacCurlAgent(replace(cfg, cuda_graph=True), 5, device="cuda")
+    assert eager.graphed is None and graphed.graphed is not None
+    graphed.load_state_dict(eager.state_dict())
+    replay = _filled_replay(5, torch.device("cuda"), n=300)
+    batches = [replay.sample(cfg.batch_size) for _ in range(11)]
+    before = _weights(eager)
+    worst_metric = 0.0
+    with exact_fp32(), fixed_device_random():
+        for i, batch in enumerate(batches):
+            if i == 10:  # a checkpoint loaded mid-run: the graphs must not write into stale optimiser state
+                graphed.load_state_dict(eager.state_dict())
+                assert graphed.graphed.graphs == {}
+            m_eager, m_graph = eager.update(batch), graphed.update(batch)
+            for key, a in m_eager.items():
+                b = m_graph[key]
+                assert math.isnan(a) == math.isnan(b), (i, key)
+                if not math.isnan(a):
+                    worst_metric = max(worst_metric, abs(a - b) / max(abs(a), 1e-6))
+                    assert abs(a - b) <= 1e-4 * max(abs(a), 1e-3), (i, key, a, b)
+            if i == 9:
+                assert graphed.graphed.captures == 2  # odd and even updates: two patterns of steps
+    w_eager, w_graph = _weights(eager), _weights(graphed)
+    worst_tensor = 0.0
+    for name, start in before.items():
+        d_eager, d_graph = w_eager[name] - start, w_graph[name] - start
+        err, scale = float((d_graph - d_eager).norm()), float(d_eager.norm())
+        worst_tensor = max(worst_tensor, err / scale if scale > 0 else 0.0)
+        assert err <= 1e-3 * scale + 1e-7 * math.sqrt(start.numel()), (name, err, scale)
+    _report("graph_vs_eager", {"updates": len(batches), "tensors": len(before),
+                               "max_relative_metric_difference": worst_metric,
+                               "max_relative_update_difference": worst_tensor})
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_a_graphed_update_draws_fresh_random_numbers_at_each_replay():
+    """With torch's own generator, a replayed graph must not repeat its crops and noise: each
+    replay moves the CUDA generator's offset on, as an eager update does."""
+    from dataclasses import replace
+
+    from egosearch.rl.sac_curl import SacCurlAgent
+
+    cfg = replace(load_config("paper", {"device": "cuda"}), cuda_graph=True)
+    torch.manual_seed(0)
+    agent = SacCurlAgent(cfg, 5, device="cuda")
+    replay = _filled_replay(5, torch.device("cuda"), n=300)
+    for _ in range(6):
+        agent.update(replay.sample(cfg.batch_size))
+    assert agent.graphed.captures == 2
+    generator = torch.cuda.default_generators[torch.cuda.current_device()]
+    offsets = [generator.get_offset()]
+    for _ in range(4):
+        assert math.isfinite(agent.update(replay.sample(cfg.batch_size))["critic_loss"])
+        offsets.append(generator.get_offset())
+    assert all(a < b for a, b in zip(offsets, offsets[1:])), offsets
+
+
 @pytest.mark.gpu
 @needs_cuda
 def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):

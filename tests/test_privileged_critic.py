@@ -11,6 +11,7 @@ import torch
 
 from egosearch.agent import AgentState
 from egosearch.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
+from egosearch.envs import env_space_dims, observed_env_id
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import SacDrqAgent
@@ -103,6 +104,9 @@ def test_training_with_a_privileged_critic_gives_an_actor_that_acts_without_it(t
     done = train("EgoSearch-v0", cfg, tmp_path, progress=False)
     assert done["updates"] == 240 // 4 - 79 // 4
     policy = ActorPolicy(tmp_path / "actor.pt")
-    obs = {"depth": np.zeros((5, 100, 100), np.uint8), "mask": np.zeros(30, np.float32),
-           "proprio": np.zeros(4, np.float32)}
+    # the cpu profile observes the last-seen target memory, so the actor's mask vector is that env's
+    assert policy.trained_env_id() == observed_env_id("EgoSearch-v0", cfg.target_memory)
+    dims = env_space_dims(policy.trained_env_id())
+    obs = {"depth": np.zeros((5, 100, 100), np.uint8), "mask": np.zeros(dims["mask"], np.float32),
+           "proprio": np.zeros(dims["proprio"], np.float32)}
     assert policy.act(obs).shape == (5,)

@@ -302,7 +302,8 @@ def test_table2_rows_match_the_paper():
     rows = dict(table2_rows(cpu))
     assert rows["Batch-size"] == str(cpu.batch_size) and rows["Replay buffer"] == "100000"
     assert rows["Encoder (CNN) : Number of filters"] == str(cpu.encoder_num_filters)
-    assert rows["Augmentation"] == "Random Shift (±1 px at 25x25)"
+    side = 100 // cpu.obs_downsample
+    assert rows["Augmentation"] == f"Random Shift (±{cpu.aug_pad} px at {side}x{side})"
     assert rows["Encoder (CNN) : τ (polyak averaging)"].startswith("none")
 
 
@@ -328,3 +329,29 @@ def test_bench_timer_runs():
     # the cpu profile's learner has a privileged critic: its update needs the replay's states
     r = time_updates("cpu", threads=1, warmup=1, updates=2)
     assert 0 < r["best_s"] <= r["median_s"] < 10
+
+
+def test_cuda_graph_is_refused_where_it_cannot_apply_and_ignored_on_the_cpu():
+    with pytest.raises(ValueError, match=r"^LearnerConfig\.cuda_graph=True .*only the sac_curl update"):
+        load_config("cpu", {"cuda_graph": True})
+    with pytest.raises(ValueError, match=r"^LearnerConfig\.cuda_graph=True .*compile"):
+        load_config("paper", {"cuda_graph": True, "compile": True})
+    small = {"device": "cpu", "batch_size": 4, "actor_hidden_dim": 16, "critic_hidden_dim": 16,
+             "encoder_num_layers": 1, "encoder_num_filters": 4}
+    agents = []
+    for graph in (False, True):
+        torch.manual_seed(0)
+        agents.append(SacCurlAgent(load_config("paper", {**small, "cuda_graph": graph}), 5))
+    assert agents[1].graphed is None  # a CPU has no graphs to record: the eager update runs
+    assert not any(g.get("capturable") for opt in agents[1].optimisers.values() for g in opt.param_groups)
+    rng = np.random.default_rng(0)
+    batch = {"obs_depth": torch.from_numpy(rng.integers(0, 256, (4, 5, 100, 100), dtype=np.uint8)),
+             "next_obs_depth": torch.from_numpy(rng.integers(0, 256, (4, 5, 100, 100), dtype=np.uint8)),
+             "mask": torch.zeros(4, 30), "next_mask": torch.zeros(4, 30), "proprio": torch.zeros(4, 4),
+             "next_proprio": torch.zeros(4, 4), "action": torch.zeros(4, 5), "reward": torch.ones(4, 1),
+             "not_done": torch.ones(4, 1)}
+    metrics = []
+    for agent in agents:
+        torch.manual_seed(1)
+        metrics.append(agent.update(batch))
+    np.testing.assert_equal(metrics[1], metrics[0])  # NaN where a loss was not computed, in both

@@ -134,6 +134,8 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         "naive": time_updates("paper", impl="reference", warmup=2, updates=max(3, n // 2)),
         "table2_1thread": time_updates("paper", threads=1, updates=max(3, n // 2)),
     }
+    if torch.cuda.is_available():  # the captured update: 4 eager warm-up updates and 2 captures first
+        runs["table2_graph"] = time_updates("paper", {"cuda_graph": True}, warmup=8, updates=n)
     cpu_cfg = load_config("cpu", {})
     runs["cpu_profile"] = time_updates("cpu", threads=torch_threads(cpu_cfg.num_threads), updates=2 * n)
     throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
@@ -146,6 +148,9 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
         result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
     result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
+    if "updates_per_s_table2_graph" in result:
+        result["speedup_graph_vs_table2"] = round(result["updates_per_s_table2_graph"]
+                                                  / result["updates_per_s_table2"], 2)
     if throughput is not None:
         result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
         result["cpu_profile_run"] = throughput
@@ -160,30 +165,31 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     return result
 
 
-def host_syncs_per_update(profile: str = "paper", updates: int = 6) -> float | None:
+def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: dict | None = None) -> float | None:
     """Host-device synchronisations per full update (replay sampling excluded), counted with
     torch's CUDA sync debug mode; None off CUDA. The update's metrics are read back in ONE sync
-    (``metric_values``); anything above 1 is a round trip inside the update."""
+    (``metric_values``); anything above 1 is a round trip inside the update. The first 6 updates
+    are left out (a captured update warms up and records its graphs in them)."""
     import warnings
 
     if not torch.cuda.is_available():
         return None
-    cfg = load_config(profile, {"device": "cuda"})
+    cfg = load_config(profile, {**(overrides or {}), "device": "cuda"})
     torch.manual_seed(0)
     state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
     agent = (SacCurlAgent(cfg, 5, device="cuda") if cfg.algorithm == "sac_curl"
              else make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim))
     replay = _filled_replay(5, torch.device("cuda"), size=getattr(agent, "replay_image_size", cfg.image_size),
                             state_dim=state_dim)
-    batches = [replay.sample(cfg.batch_size) for _ in range(updates + 2)]
-    for batch in batches[:2]:
+    batches = [replay.sample(cfg.batch_size) for _ in range(updates + 6)]
+    for batch in batches[:6]:
         agent.update(batch)
     torch.cuda.synchronize()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         torch.cuda.set_sync_debug_mode("warn")
         try:
-            for batch in batches[2:]:
+            for batch in batches[6:]:
                 agent.update(batch)
         finally:
             torch.cuda.set_sync_debug_mode("default")
@@ -191,22 +197,36 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6) -> float | N
     return round(len(syncs) / updates, 2)
 
 
-def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed: int = 0) -> dict:
+def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed: int = 0,
+              overrides: dict | None = None, baseline_seconds: float = 0.0) -> dict:
     """The paper profile on this machine's accelerator: the learner benchmarks, then a real
     paper-profile training of ``variant_name`` (its curve evaluations included) for ``seconds`` of
     wall time, stopped with a checkpoint (``egosearch train --max-wall-s`` resumes it). The run's
-    curve.csv, train.csv and config.json are left in ``out_dir``."""
+    curve.csv, train.csv and config.json are left in ``out_dir``. ``overrides`` change the
+    training's config (``cuda_graph``, say); with ``baseline_seconds`` the same training without
+    them runs that long in ``out_dir/baseline``, so that both rates come from one machine."""
+    result = {"learner": bench_learner(cpu_profile_run=False),
+              "host_syncs_per_update_table2": host_syncs_per_update("paper"),
+              "host_syncs_per_update_cpu_profile": host_syncs_per_update("cpu")}
+    if torch.cuda.is_available():
+        result["host_syncs_per_update_table2_graph"] = host_syncs_per_update("paper", overrides={"cuda_graph": True})
+    result["training"] = _timed_training(seconds, out_dir, variant_name, seed, overrides or {})
+    if baseline_seconds > 0 and overrides:
+        result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"),
+                                                      variant_name, seed, {})
+    return result
+
+
+def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, overrides: dict) -> dict:
+    """A paper-profile training for ``seconds``, and its rates read back from its CSVs."""
     from egosearch.envs import observed_env_id
     from egosearch.evaluate import scenario_evaluator
     from egosearch.home_pool import curve_homes
     from egosearch.rl.train import train
     from egosearch.variants import load_variant
 
-    result = {"learner": bench_learner(cpu_profile_run=False),
-              "host_syncs_per_update_table2": host_syncs_per_update("paper"),
-              "host_syncs_per_update_cpu_profile": host_syncs_per_update("cpu")}
     variant = load_variant(variant_name)
-    cfg = load_config("paper", {**variant.config, "seed": seed})
+    cfg = load_config("paper", {**variant.config, **overrides, "seed": seed})
     env_id = observed_env_id(variant.env_id, cfg.target_memory)
     evaluator = scenario_evaluator(env_id, curve_homes(variant.train_env), variant.train_env["placement"],
                                    n=cfg.eval_episodes)
@@ -230,8 +250,9 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
     with open(os.path.join(out_dir, "curve.csv")) as f:
         curve = list(csv.DictReader(f))
     rates = [(float(r["steps_per_s"]), float(r["updates_per_s"])) for r in rows[1:]]  # the first row holds warm-up
-    result["training"] = {
-        "variant": variant.name, "seed": seed, "env_steps": summary["env_steps"], "updates": summary["updates"],
+    return {
+        "variant": variant.name, "seed": seed, "overrides": dict(overrides),
+        "env_steps": summary["env_steps"], "updates": summary["updates"],
         "wall_s": round(wall, 1), "curve_rows": len(curve),
         "env_steps_per_s_overall": round(summary["env_steps"] / wall, 1),
         "env_steps_per_s_updating": round(float(np.median([s for s, _ in rates])), 1) if rates else None,
@@ -241,4 +262,3 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
         "curve_evaluation_s_mean": round(float(np.mean(eval_s)), 1) if eval_s else None,
         "eval_every": cfg.eval_every, "eval_episodes": cfg.eval_episodes,
     }
-    return result

@@ -44,12 +44,14 @@ def resolve_device(name: str = "auto") -> torch.device:
     return torch.device(name)
 
 
-def adam(params, lr: float, betas: tuple[float, float]) -> torch.optim.Adam:
-    """Fused Adam where the device and dtype allow it (one kernel for every tensor), else foreach."""
+def adam(params, lr: float, betas: tuple[float, float], capturable: bool = False) -> torch.optim.Adam:
+    """Fused Adam where the device and dtype allow it (one kernel for every tensor), else foreach;
+    ``capturable`` keeps its step counter on the device, so that a CUDA graph can record its step."""
+    params = list(params)
     try:
-        return torch.optim.Adam(params, lr=lr, betas=betas, fused=True)
+        return torch.optim.Adam(params, lr=lr, betas=betas, fused=True, capturable=capturable)
     except (RuntimeError, ValueError):
-        return torch.optim.Adam(params, lr=lr, betas=betas, foreach=True)
+        return torch.optim.Adam(params, lr=lr, betas=betas, foreach=True, capturable=capturable)
 
 
 def activation(name: str) -> nn.Module:

@@ -358,6 +358,13 @@ class LearnerConfig:
     """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
     ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
     kernels near the CPU's peak; see ``egosearch.rl.bench``). May help on a GPU."""
+    cuda_graph: bool = False
+    """Ours: on a GPU, record the SAC+CURL update as CUDA graphs (one per pattern of the update's
+    steps) and replay them, instead of launching its hundreds of small kernels from Python
+    (``egosearch.rl.cuda_graph``). The same math with capturable Adam; the random numbers come
+    from torch's CUDA generator at other offsets than an eager update's. Ignored on the CPU;
+    ``algorithm`` sac_curl only, and not with ``compile``. Off by default; docs/gpu.md gives
+    what it measured on a GPU."""
     keep_checkpoint: bool = False
     """Ours: keep the last checkpoint (agent + optimisers + replay) after training finishes;
     by default it is deleted once actor.pt and done.json are written (replay buffers are large
@@ -414,6 +421,10 @@ class LearnerConfig:
             bad("critic_privileged_state", "False for algorithm sac_curl (only the sac_drq learners have a "
                 "privileged critic; "
                 "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
+        if self.cuda_graph and self.algorithm != "sac_curl":
+            bad("cuda_graph", f"False for algorithm {self.algorithm} (only the sac_curl update is captured)")
+        if self.cuda_graph and self.compile:
+            bad("cuda_graph", "False with compile: true (torch.compile and a captured update do not mix)")
         if self.encoder_aux_loss not in ENCODER_AUX_LOSSES:
             bad("encoder_aux_loss", ", ".join(ENCODER_AUX_LOSSES))
         if self.encoder_aux_loss != "none" and self.algorithm != "sac_drq":
@@ -730,7 +741,8 @@ def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
 
 
 HOUSEKEEPING_FIELDS = frozenset({"eval_every", "eval_episodes", "log_every", "checkpoint_every", "seed", "device",
-                                  "num_threads", "channels_last", "compile", "keep_checkpoint"})
+                                  "num_threads", "channels_last", "compile", "cuda_graph",
+                                  "keep_checkpoint"})
 """Fields that change how a run is watched, saved or placed on the machine, never what it learns."""
 
 

@@ -65,6 +65,7 @@ from egosearch.rl.common import (
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.cuda_graph import GraphedUpdate
 
 AGENT_FORMAT = "egosearch-sac-curl-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-curl-actor-v1"
@@ -183,6 +184,9 @@ class SacCurlAgent:
                                       requires_grad=True)
         self.target_entropy = -float(self.action_dim)
         self.num_updates = 0
+        # a recorded update needs fast-path kernels on a GPU and Adam steps it can record
+        self.graphed = (GraphedUpdate(self._update_fast)
+                        if cfg.cuda_graph and impl == "fast" and self.device.type == "cuda" else None)
         self._build_optimisers()
         self._compiled = False
         if cfg.compile and impl == "fast":
@@ -192,7 +196,7 @@ class SacCurlAgent:
     def _adam(self, params, lr: float, betas: tuple[float, float]) -> torch.optim.Adam:
         if self.impl == "reference":
             return torch.optim.Adam(params, lr=lr, betas=betas, foreach=False)
-        return adam(params, lr, betas)
+        return adam(params, lr, betas, capturable=self.graphed is not None)
 
     def _build_optimisers(self) -> None:
         cfg = self.cfg
@@ -275,6 +279,11 @@ class SacCurlAgent:
         self.num_updates += 1
         if self.impl == "reference":
             out = self._update_reference(batch)
+        elif self.graphed is not None:
+            cfg, step = self.cfg, self.num_updates
+            steps_taken = (step % cfg.curl_update_freq == 0, step % cfg.actor_update_freq == 0,
+                           step % cfg.critic_target_update_freq == 0)
+            out = self.graphed(steps_taken, batch)
         else:
             out = self._update_fast(batch)
         return metric_values(out, self.device)
@@ -533,6 +542,8 @@ class SacCurlAgent:
         for k, opt in self.optimisers.items():
             opt.load_state_dict(state["optimisers"][k])
         self.num_updates = int(state["num_updates"])
+        if self.graphed is not None:  # the graphs point at the optimiser state just replaced
+            self.graphed.reset()
 
     def actor_state(self, metadata: dict[str, Any] | None = None,
                     storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
