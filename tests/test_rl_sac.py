@@ -355,3 +355,11 @@ def test_cuda_graph_is_refused_where_it_cannot_apply_and_ignored_on_the_cpu():
         torch.manual_seed(1)
         metrics.append(agent.update(batch))
     np.testing.assert_equal(metrics[1], metrics[0])  # NaN where a loss was not computed, in both
+    # a checkpoint from a GPU run with graphs (capturable Adam) resumes here without them
+    state = agents[0].state_dict()
+    for opt_state in state["optimisers"].values():
+        for group in opt_state["param_groups"]:
+            group["capturable"] = True
+    agents[1].load_state_dict(state)
+    assert not any(g["capturable"] for opt in agents[1].optimisers.values() for g in opt.param_groups)
+    assert np.isfinite(agents[1].update(batch)["critic_loss"])

@@ -541,6 +541,8 @@ class SacCurlAgent:
             self.log_alpha.copy_(state["log_alpha"])
         for k, opt in self.optimisers.items():
             opt.load_state_dict(state["optimisers"][k])
+            for group in opt.param_groups:  # saved by a run with or without graphs: this agent's choice holds
+                group["capturable"] = self.graphed is not None
         self.num_updates = int(state["num_updates"])
         if self.graphed is not None:  # the graphs point at the optimiser state just replaced
             self.graphed.reset()
