@@ -203,8 +203,9 @@ def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
     with exact_fp32(), fixed_device_random():
         for i in range(16):
             if i == 10:  # a checkpoint loaded mid-run: the graphs must not write into stale optimiser state
+                assert graphed.graphed.captures == 2  # odd and even updates: two patterns of steps
                 graphed.load_state_dict(eager.state_dict())
-                assert graphed.graphed.graphs == {} and graphed.graphed.captures == 2
+                assert graphed.graphed.graphs == {}
             source, target = _agent_tensors(eager), _agent_tensors(graphed)
             assert len(source) == len(target)
             with torch.no_grad():
@@ -225,7 +226,7 @@ def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
                 err, scale = float((d_graph - d_eager).norm()), float(d_eager.norm())
                 worst_tensor = max(worst_tensor, err / scale if scale > 0 else 0.0)
                 assert err <= 1e-3 * scale + 1e-7 * math.sqrt(start.numel()), (i, name, err, scale)
-    assert graphed.graphed.captures == 4  # odd and even updates, twice: two patterns, recorded again after the load
+    assert graphed.graphed.captures == 2 and len(graphed.graphed.graphs) == 2  # recorded again after the load
     _report("graph_vs_eager", {"updates": 16, "tensors": len(before),
                                "max_relative_metric_difference": worst_metric,
                                "max_relative_update_difference": worst_tensor})
