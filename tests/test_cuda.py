@@ -204,7 +204,8 @@ def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
         for i in range(16):
             if i == 10:  # a checkpoint loaded mid-run: the graphs must not write into stale optimiser state
                 assert graphed.graphed.captures == 2  # odd and even updates: two patterns of steps
-                graphed.load_state_dict(eager.state_dict())
+                # a copy: Adam's load_state_dict keeps a state tensor that is already on the right device
+                graphed.load_state_dict(copy.deepcopy(eager.state_dict()))
                 assert graphed.graphed.graphs == {}
             source, target = _agent_tensors(eager), _agent_tensors(graphed)
             assert len(source) == len(target)
