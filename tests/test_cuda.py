@@ -43,7 +43,8 @@ from test_rl_train import TIMING_COLUMNS, Interrupt, check_complete_run, read_cs
 
 CUDA_ACTOR = TESTS / "data" / "cuda_actor.pt"
 """An actor trained on CUDA: ``test_cuda_training_resumes_and_its_actor_loads_without_cuda`` wrote it
-on a GPU machine (``EGOSEARCH_CUDA_ACTOR_OUT``; results/paper/gpu_check/cuda_tests.log is that run)."""
+on a GPU machine (``EGOSEARCH_CUDA_ACTOR_OUT``), in the first GPU check (commit ce339b0); the stored
+results/paper/gpu_check/cuda_tests.log is a later run of the same tests, which kept its actor elsewhere."""
 
 needs_cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="CUDA is not available")
 REPORT: dict = {}

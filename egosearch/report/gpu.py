@@ -82,7 +82,9 @@ def block_gpu_projection(root: Path, profile: str) -> str:
     return (f"On one {record['machine'].get('gpu', 'GPU')} ({record['machine']['cores']} CPU cores), "
             f"`snakemake --cores {p['cores']} --config profile=paper all` is projected at **about "
             f"{p['total_h']:.0f} h**: {p['trainings']} trainings of {run['total_env_steps']:,} env steps, one at a "
-            f"time, at the measured {run['env_steps_per_s_updating']:.1f} env steps/s ({p['train_h']:.1f} h each), "
+            f"time, at the measured {run['env_steps_per_s_updating']:.1f} env steps/s"
+            + f" ({p['train_h']:.1f} h each" + ("; the update recorded as CUDA graphs, as the profile does"
+                                                if run.get("overrides", {}).get("cuda_graph") else "") + "), "
             f"plus about {p['other_h']:.1f} h of CPU jobs. Derived from the stored GPU check "
             f"(`{GPU_CHECK}/`, {record['date_utc'][:10]}); how, and what `--executor slurm` needs: "
             "[docs/gpu.md](docs/gpu.md).\n")
@@ -100,9 +102,9 @@ def _compile_line(root: Path) -> str | None:
         return f"- `compile: true` (torch.compile) failed there: {r.get('compiled_error', '?')}."
     plain, compiled = r["plain"]["median_s"], r["compiled"]["median_s"]
     verdict = "faster" if compiled < plain else "no faster"
-    return (f"- `compile: true` (torch.compile of the networks, default mode): {1 / compiled:.1f} updates/s "
-            f"against {1 / plain:.1f} without it, median of 40 Table 2 updates each, in one run "
-            f"(`{GPU_CHECK}/compile_bench.txt`): {verdict}.")
+    return (f"- `compile: true` (torch.compile of the networks, default mode), measured in an earlier GPU "
+            f"session: {1 / compiled:.1f} updates/s against {1 / plain:.1f} without it, median of 40 Table 2 "
+            f"updates each, in one run (`{GPU_CHECK}/compile_bench.txt`): {verdict}.")
 
 
 def _tests_lines(root: Path) -> list[str]:
@@ -112,7 +114,9 @@ def _tests_lines(root: Path) -> list[str]:
     text = log.read_text(encoding="utf-8")
     results = re.findall(r"^tests/test_cuda\.py::(\S+) (PASSED|FAILED|SKIPPED|ERROR)", text, flags=re.M)
     summary = re.findall(r"=+ (.+) in [\d.]+s", text)
-    lines = [f"CUDA tests (`pytest -m gpu tests/test_cuda.py` on that machine; `{GPU_CHECK}/cuda_tests.log`): "
+    commit = re.search(r"^commit ([0-9a-f]{7})", text, flags=re.M)
+    lines = ["CUDA tests (`pytest -m gpu tests/test_cuda.py` on that machine"
+             + (f", commit `{commit.group(1)}`" if commit else "") + f"; `{GPU_CHECK}/cuda_tests.log`): "
              + (summary[-1] if summary else "no summary line") + "."]
     lines += [f"- `{name}`: {status.lower()}" for name, status in results]
     if report.exists():
@@ -124,12 +128,32 @@ def _tests_lines(root: Path) -> list[str]:
                              f"off ({label}, {u['tensors']} weight tensors): largest relative difference of a "
                              f"tensor's change {u['max_relative_update_difference']:.1e} (tolerance 1e-3), of a "
                              f"loss {u['max_relative_metric_difference']:.1e} (tolerance 1e-4)")
+        if "graph_vs_eager" in r:
+            g = r["graph_vs_eager"]
+            lines.append(f"- the update recorded as CUDA graphs against the eager update, each of {g['updates']} "
+                         f"Table 2 updates from the same state and batch, TF32 off ({g['tensors']} weight tensors; "
+                         "graphs warmed up, recorded, replayed, dropped by a loaded state and recorded again): "
+                         f"largest relative difference of a tensor's change {g['max_relative_update_difference']:.1e} "
+                         f"(tolerance 1e-3), of a loss {g['max_relative_metric_difference']:.1e} (tolerance 1e-4)")
         if "resume" in r:
             same = "bit for bit the same" if r["resume"]["actor_bitwise_equal"] else (
                 f"not bit for bit the same (largest difference {r['resume']['actor_max_abs_difference']:.1e})")
             lines.append(f"- the CUDA training stopped at 200 env steps and resumed from its checkpoint at 150 "
                          f"(deterministic algorithms on): its actor is {same} as the run never stopped")
     return lines
+
+
+def _overrides(run: dict) -> str:
+    overrides = run.get("overrides", {})
+    shown = ", ".join(f"`{k}: {str(v).lower() if isinstance(v, bool) else v}`" for k, v in overrides.items())
+    return f", {shown}" if shown else ""
+
+
+def _baseline_sentence(base: dict, run: dict) -> str:
+    return (f" The same training without{_overrides(run)[1:]}, run next for {base['wall_s']:.0f} s on the same "
+            f"machine (`baseline/`): {base['env_steps_per_s_updating']:.1f} env steps/s while updating (median of "
+            f"{base['train_rows_used']} rows), so "
+            f"{run['env_steps_per_s_updating'] / base['env_steps_per_s_updating']:.1f}x.")
 
 
 def block_gpu(root: Path, profile: str) -> str:
@@ -147,19 +171,28 @@ def block_gpu(root: Path, profile: str) -> str:
         ["Learner on the GPU (updates/s from the median update, the fastest in brackets):", "",
          "| key | updates/s |", "|---|---|"]
         + [f"| `updates_per_s_{key}` | {learner[f'updates_per_s_{key}']} ({learner[f'updates_per_s_{key}_best']}) |"
-           for key in ("naive", "table2", "table2_shared", "table2_1thread", "cpu_profile")]
-        + ["", f"- Host-device synchronisations per update (torch's sync debug mode, replay sampling excluded): "
-               f"{result['host_syncs_per_update_table2']} at Table 2, {result['host_syncs_per_update_cpu_profile']} "
-               "for the cpu profile's learner. One is the update's metrics, read back together; where the other "
-               "comes from was not traced there (on the CPU, nothing else in an update reads a tensor back)."]
+           for key in ("naive", "table2", "table2_shared", "table2_1thread", "table2_graph", "cpu_profile")
+           if f"updates_per_s_{key}" in learner]
+        + ([""] if "speedup_graph_vs_table2" in learner else [])
+        + ([f"- `table2_graph` is the Table 2 update recorded as CUDA graphs and replayed (`cuda_graph`): "
+            f"{learner['speedup_graph_vs_table2']}x the eager update's rate, in the same run."]
+           if "speedup_graph_vs_table2" in learner else [])
+        + [f"- Host-device synchronisations per update (torch's sync debug mode, replay sampling excluded): "
+           f"{result['host_syncs_per_update_table2']} at Table 2"
+           + (f" ({result['host_syncs_per_update_table2_graph']} with the graphs)"
+              if "host_syncs_per_update_table2_graph" in result else "")
+           + f", {result['host_syncs_per_update_cpu_profile']} for the cpu profile's learner. One is the update's "
+           "metrics, read back together; where the other comes from was not traced there (on the CPU, nothing "
+           "else in an update reads a tensor back)."]
         + ([line] if (line := _compile_line(root)) else []),
         [f"Paper-profile training (`{run['variant']}`, seed {run['seed']}, its envs on the machine's CPU, one env as "
-         f"Table 2): {run['env_steps']:,} env steps and {run['updates']:,} updates in {run['wall_s']:.0f} s, "
-         f"stopped there with a checkpoint (`--max-wall-s`). **{run['env_steps_per_s_updating']:.1f} env steps/s** "
-         f"while updating (one update per env step; the median of {run['train_rows_used']} train.csv rows), "
-         f"{run['env_steps_per_s_overall']:.1f} over the whole run; a curve evaluation ({run['eval_episodes']} "
-         f"episodes) took {run['curve_evaluation_s_mean']:.1f} s. `curve.csv`, `train.csv` and `config.json` are "
-         f"beside the record."],
+         f"Table 2{_overrides(run)}): {run['env_steps']:,} env steps and {run['updates']:,} updates in "
+         f"{run['wall_s']:.0f} s, stopped there with a checkpoint (`--max-wall-s`). "
+         f"**{run['env_steps_per_s_updating']:.1f} env steps/s** while updating (one update per env step; the median "
+         f"of {run['train_rows_used']} train.csv rows), {run['env_steps_per_s_overall']:.1f} over the whole run; a "
+         f"curve evaluation ({run['eval_episodes']} episodes) took {run['curve_evaluation_s_mean']:.1f} s. "
+         "`curve.csv`, `train.csv` and `config.json` are beside the record."
+         + (_baseline_sentence(result["training_baseline"], run) if "training_baseline" in result else "")],
         ["Projection of `snakemake --config profile=paper all` on one such machine:", "",
          f"- {p['trainings']} trainings (the `all` variants x the paper profile's seeds) of "
          f"{run['total_env_steps']:,} env steps at {run['env_steps_per_s_updating']:.1f} env steps/s, with "

@@ -184,9 +184,9 @@ class SacCurlAgent:
                                       requires_grad=True)
         self.target_entropy = -float(self.action_dim)
         self.num_updates = 0
-        # a recorded update needs fast-path kernels on a GPU and Adam steps it can record
-        self.graphed = (GraphedUpdate(self._update_fast)
-                        if cfg.cuda_graph and impl == "fast" and self.device.type == "cuda" else None)
+        # a recorded update needs fast-path kernels on a GPU, uncompiled, and Adam steps it can record
+        self.graphed = (GraphedUpdate(self._update_fast) if cfg.cuda_graph and impl == "fast" and not cfg.compile
+                        and self.device.type == "cuda" else None)
         self._build_optimisers()
         self._compiled = False
         if cfg.compile and impl == "fast":

@@ -61,7 +61,7 @@ _ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recur
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
-RESUMABLE_FIELDS = ("device", "num_threads", "compile", "keep_checkpoint")
+RESUMABLE_FIELDS = ("device", "num_threads", "compile", "cuda_graph", "keep_checkpoint")
 """Config fields that may differ between a checkpoint and the run resuming it."""
 
 
