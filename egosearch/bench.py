@@ -149,7 +149,7 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     and how busy the machine was. A speed figure means little without the load beside it: the load
     average before and after, and ``other_load_cores``, the CPU time other processes used during the
     run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
-    from egosearch.machine import cpu_model, gpu_model
+    from egosearch.machine import cpu_model, cpu_vector_unit, gpu_model
 
     load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
     busy0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
@@ -163,7 +163,8 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
         # a copy of the tree (a device, a cluster node) is told its commit: its .git, if any, may be stale
         "commit": os.environ.get("EGOSEARCH_COMMIT") or _git("rev-parse", "HEAD") or "unknown",
         "commit_dirty": bool(status) if status is not None else None,
-        "machine": {"cpu": cpu_model(), "cores": os.cpu_count(), **gpu_fields(gpu_model())},
+        "machine": {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count(),
+                    **gpu_fields(gpu_model())},
         "load_average_before": load_before,
         "load_average_after": [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None,
         "other_load_cores": (round(max(0.0, busy1 - busy0 - own) / wall, 2)

@@ -82,7 +82,8 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it; the
     # generated-homes variant, the generated groups and the generalise report are `generalise`'s
     # ... each at its CPU time where recorded: head_on's training counts 3600 s, not its 7200 s of wall time
-    assert ("summed time / 2, one-thread jobs, each at its CPU time where recorded, a resumed training's scaled to "
+    assert ("summed time / 2, one-thread jobs, each at its CPU time where recorded, on the machine that ran it, "
+            "a resumed training's scaled to "
             "its whole run): 0.51 h; of `snakemake "
             "--cores 2 generalise` after it: 0.26 h") in out
     assert "the other 1.01 h of jobs are comparisons and studies outside both" in out

@@ -307,3 +307,16 @@ def test_a_run_stopped_at_its_wall_time_limit_checkpoints_and_resumes(tmp_path):
     done = train(FAKE_ENV_ID, cfg, tmp_path, progress=False, on_step=seen.append)
     assert seen[0] == 2 and done["env_steps"] == 200 and "stopped" not in done
 
+
+
+def test_the_vector_unit_is_read_from_the_cpu_flags(tmp_path):
+    from egosearch.machine import cpu_vector_unit
+
+    info = tmp_path / "cpuinfo"
+    for flags, unit in (("fpu sse2 avx avx2 avx512f avx512bw", "AVX-512"), ("fpu sse2 avx avx2 fma", "AVX2"),
+                        ("fpu sse2 avx", "AVX"), ("fpu sse2", "no AVX")):
+        info.write_text(f"processor\t: 0\nmodel name\t: AMD EPYC\nflags\t\t: {flags}\n")
+        assert cpu_vector_unit(info) == unit
+    info.write_text("processor\t: 0\n")  # no flags line (not x86, say)
+    assert cpu_vector_unit(info) is None
+    assert cpu_vector_unit(tmp_path / "absent") is None

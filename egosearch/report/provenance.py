@@ -17,7 +17,7 @@ from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-from egosearch.machine import cpu_model
+from egosearch.machine import cpu_model, cpu_vector_unit
 
 
 def _git(*args: str) -> str:
@@ -146,7 +146,8 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
         "commit": _git("rev-parse", "HEAD"),
         "commit_dirty": bool(status) if status != "unknown" else None,
         "date_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
-        "machine": {"cpu": cpu_model(), "cores": os.cpu_count(), "platform": platform.platform(),
+        "machine": {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count(),
+                    "platform": platform.platform(),
                     "python": platform.python_version(), "torch": _version("torch"),
                     "pybullet": _version("pybullet"), "snakemake": _version("snakemake")},
         "wall_s_per_rule_summed": per_rule,

@@ -141,7 +141,8 @@ def block_provenance(root: Path, profile: str) -> str:
     for job in record["jobs"]:
         summed[job_study(job, config)] += job_cost_s(job)
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
-             f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}, "
+             f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}"
+             + (f" ({machine['vector_unit']})" if machine.get("vector_unit") else "") + ", "
              f"{machine.get('cores', '?')} cores, torch {machine.get('torch', '?')}.",
              f"- {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed: "
              + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + ".",
@@ -149,8 +150,8 @@ def block_provenance(root: Path, profile: str) -> str:
              # time over N is what `snakemake --cores N all` takes from a fresh clone, give or take
              # the tail where fewer than N jobs are ready.
              f"- Estimated wall time of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed "
-             f"time / {cores}, one-thread jobs, each at its CPU time where recorded, a resumed training's "
-             "scaled to its whole run): "
+             f"time / {cores}, one-thread jobs, each at its CPU time where recorded, on the machine that ran it, "
+             "a resumed training's scaled to its whole run): "
              f"{summed['all'] / cores / 3600:.2f} h"
              + (f"; of `snakemake --cores {cores} generalise` after it: {summed['generalise'] / cores / 3600:.2f} h"
                 if summed["generalise"] > 0 else "")

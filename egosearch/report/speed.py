@@ -51,7 +51,8 @@ def _measured_on(record: dict) -> str:
             + (f", load average {load[0]:.2f} before" if load else ""))
     commit = (record.get("commit") or "unknown")[:7] + (" with local changes" if record.get("commit_dirty") else "")
     return (f"`{record.get('command', '?')}` on {record.get('date_utc', '?')[:10]}, commit `{commit}`, "
-            f"{machine.get('cpu', '?')} with {machine.get('cores', '?')} cores ({busy}; {record.get('wall_s', '?')} s "
+            f"{machine.get('cpu', '?')}" + (f" ({machine['vector_unit']})" if machine.get("vector_unit") else "")
+            + f" with {machine.get('cores', '?')} cores ({busy}; {record.get('wall_s', '?')} s "
             "in all)")
 
 

@@ -41,7 +41,7 @@ import gymnasium
 import numpy as np
 import torch
 
-from egosearch.machine import cpu_model, gpu_model
+from egosearch.machine import cpu_model, cpu_vector_unit, gpu_model
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
@@ -880,7 +880,7 @@ class _Run:
     def machine(self) -> dict:
         """The machine the run used: CPU and cores, and the GPU when it trained on one."""
         gpu = {"gpu": gpu_model()} if self.device.type == "cuda" else {}
-        return {"cpu": cpu_model(), "cores": os.cpu_count(), **gpu}
+        return {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count(), **gpu}
 
     def stopped(self) -> dict:
         """The summary of a run stopped at its wall-time limit (its checkpoint is written)."""
