@@ -669,5 +669,17 @@ def test_gpu_projection_by_hand(tmp_path):
     assert math.isclose(p["other_core_h"] * 3600, 1080.0) and math.isclose(p["other_h"] * 3600, 270.0)
     assert math.isclose(p["total_h"] * 3600, 1230.0)
     assert "6 trainings of 1,000 env steps" in block_gpu_projection(tmp_path, "cpu")
+    assert "CUDA graphs" not in block_gpu_projection(tmp_path, "cpu")
+    # a graphed training with its eager baseline on the same machine: the projection says which rate it used
+    record["result"]["training"] = {**run, "overrides": {"cuda_graph": True}}
+    (tmp_path / GPU_CHECK / "gpu_check.json").write_text(json.dumps(record))
+    assert "(0.0 h each; the update recorded as CUDA graphs, as the profile does)" in block_gpu_projection(
+        tmp_path, "cpu")
+    from egosearch.report.gpu import _baseline_sentence
+
+    base = {"wall_s": 60.4, "env_steps_per_s_updating": 4.0, "train_rows_used": 3}
+    assert _baseline_sentence(base, record["result"]["training"]) == (
+        " The same training without `cuda_graph: true`, run next for 60 s on the same machine (`baseline/`): "
+        "4.0 env steps/s while updating (median of 3 rows), so 2.5x.")
     (tmp_path / GPU_CHECK / "gpu_check.json").unlink()
     assert projection(tmp_path) is None and "Not measured yet" in block_gpu_projection(tmp_path, "cpu")

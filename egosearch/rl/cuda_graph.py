@@ -29,7 +29,7 @@ import torch
 
 
 class GraphedUpdate:
-    """``update(key, batch)`` runs ``fn(batch) -> dict[str, Tensor]`` eagerly for the first
+    """``graphed(key, batch)`` runs ``fn(batch) -> dict[str, Tensor]`` eagerly for the first
     ``warmup`` calls of each ``key``, then as that key's captured CUDA graph."""
 
     def __init__(self, fn: Callable[[dict[str, torch.Tensor]], dict[str, torch.Tensor]], warmup: int = 2):
