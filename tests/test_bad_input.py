@@ -251,6 +251,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
          "egosearch bench: error: bench gpu needs --out-dir (the paper-profile training's folder)"),
         (["bench", "gpu", "--seconds", "-1", "--out-dir", str(tmp_path / "run")],
          "egosearch bench: error: --seconds must be a positive number, got -1.0"),
+        (["bench", "gpu", "--out-dir", str(tmp_path / "run"), "--baseline-seconds", "-5"],
+         "egosearch bench: error: --baseline-seconds must be a number >= 0, got -5.0"),
         (["scenarios", "--height", "7", "--out", str(tmp_path / "s.csv")],
          "egosearch scenarios: error: height=7.0 is outside the sensible range [0.3, 2.0] m"),
         (["scenarios", "--n", "0", "--out", str(tmp_path / "s.csv")],

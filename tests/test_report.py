@@ -679,7 +679,10 @@ def test_gpu_projection_by_hand(tmp_path):
 
     base = {"wall_s": 60.4, "env_steps_per_s_updating": 4.0, "train_rows_used": 3}
     assert _baseline_sentence(base, record["result"]["training"]) == (
-        " The same training without `cuda_graph: true`, run next for 60 s on the same machine (`baseline/`): "
-        "4.0 env steps/s while updating (median of 3 rows), so 2.5x.")
+        " The same training with the update launched eagerly (`cuda_graph: false`), run next for 60 s on the same "
+        "machine (`baseline/`): 4.0 env steps/s while updating (median of 3 rows), so 2.5x.")
+    record["result"]["training"] = {**run, "cuda_graph": True}  # what a record says since the profile graphs
+    (tmp_path / GPU_CHECK / "gpu_check.json").write_text(json.dumps(record))
+    assert "as the profile does" in block_gpu_projection(tmp_path, "cpu")
     (tmp_path / GPU_CHECK / "gpu_check.json").unlink()
     assert projection(tmp_path) is None and "Not measured yet" in block_gpu_projection(tmp_path, "cpu")

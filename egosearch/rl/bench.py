@@ -203,17 +203,18 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
     paper-profile training of ``variant_name`` (its curve evaluations included) for ``seconds`` of
     wall time, stopped with a checkpoint (``egosearch train --max-wall-s`` resumes it). The run's
     curve.csv, train.csv and config.json are left in ``out_dir``. ``overrides`` change the
-    training's config (``cuda_graph``, say); with ``baseline_seconds`` the same training without
-    them runs that long in ``out_dir/baseline``, so that both rates come from one machine."""
+    training's config; with ``baseline_seconds`` the same training with the update launched eagerly
+    (``cuda_graph`` false) runs that long in ``out_dir/baseline``, so that both rates come from one
+    machine."""
     result = {"learner": bench_learner(cpu_profile_run=False),
               "host_syncs_per_update_table2": host_syncs_per_update("paper"),
               "host_syncs_per_update_cpu_profile": host_syncs_per_update("cpu")}
     if torch.cuda.is_available():
         result["host_syncs_per_update_table2_graph"] = host_syncs_per_update("paper", overrides={"cuda_graph": True})
     result["training"] = _timed_training(seconds, out_dir, variant_name, seed, overrides or {})
-    if baseline_seconds > 0 and overrides:
+    if baseline_seconds > 0:
         result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"),
-                                                      variant_name, seed, {})
+                                                      variant_name, seed, {**(overrides or {}), "cuda_graph": False})
     return result
 
 
@@ -251,7 +252,7 @@ def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, 
         curve = list(csv.DictReader(f))
     rates = [(float(r["steps_per_s"]), float(r["updates_per_s"])) for r in rows[1:]]  # the first row holds warm-up
     return {
-        "variant": variant.name, "seed": seed, "overrides": dict(overrides),
+        "variant": variant.name, "seed": seed, "overrides": dict(overrides), "cuda_graph": cfg.cuda_graph,
         "env_steps": summary["env_steps"], "updates": summary["updates"],
         "wall_s": round(wall, 1), "curve_rows": len(curve),
         "env_steps_per_s_overall": round(summary["env_steps"] / wall, 1),
