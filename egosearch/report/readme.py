@@ -225,8 +225,9 @@ def block_power(root: Path, profile: str) -> str:
         succ = df[df["metric"] == "success"]
         lo, hi = int(succ["n_scenarios"].min()), int(succ["n_scenarios"].max())
         homes = ", ".join(sorted(set(succ["homes"])))
+        smallest, largest = _fmt(succ["detectable_80"].min()), _fmt(succ["detectable_80"].max())
         lines.append(f"- `{path.stem}`: {lo if lo == hi else f'{lo}–{hi}'} scenarios per cell ({homes}); a success "
-                     f"difference of {_fmt(succ['detectable_80'].min())}–{_fmt(succ['detectable_80'].max())} is "
+                     f"difference of {smallest if smallest == largest else f'{smallest}–{largest}'} is "
                      f"detected with 80% power (`{path.relative_to(root)}`).")
     return "\n".join(lines) + "\n" if lines else "*No stored comparison yet.*\n"
 
