@@ -1,4 +1,4 @@
-"""What machine a run used: the CPU's name, and the GPU's where one was used (stdlib only, so both
+"""What machine a run used: the CPU's name and vector unit, and the GPU's where one was used (stdlib only, so both
 the learner and the report layer can record it without importing each other)."""
 
 from __future__ import annotations
