@@ -347,6 +347,24 @@ def test_bench_timer_runs():
     assert 0 < r["best_s"] <= r["median_s"] < 10
 
 
+def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_graphs(monkeypatch):
+    """The eager Table 2 rows are the baseline the graphed row is read against: they must turn the
+    paper profile's cuda_graph off themselves, or on a GPU both sides would be graphed."""
+    import egosearch.rl.bench as bench
+
+    asked = []
+
+    def fake_time_updates(profile="paper", overrides=None, impl="fast", threads=None, warmup=3, updates=10, **_):
+        asked.append((profile, dict(overrides or {}), impl))
+        return {"median_s": 0.1, "best_s": 0.1}
+
+    monkeypatch.setattr(bench, "time_updates", fake_time_updates)
+    result = bench.bench_learner(quick=True, cpu_profile_run=False)
+    fast_table2 = [o for profile, o, impl in asked if profile == "paper" and impl == "fast"]
+    assert len(fast_table2) == 3 and all(o.get("cuda_graph") is False for o in fast_table2)
+    assert "updates_per_s_table2" in result
+
+
 def test_cuda_graph_is_on_in_the_paper_profile_alone_and_ignored_on_the_cpu():
     assert load_config("paper", {}).cuda_graph and not load_config("cpu", {}).cuda_graph
     assert not load_config("smoke", {}).cuda_graph
