@@ -7,7 +7,7 @@ import sys
 
 from snakemake.utils import min_version, validate
 
-from egosearch.workflow_check import checked_variants
+from egosearch.workflow.check import checked_variants
 
 min_version("9.0")
 
@@ -48,12 +48,12 @@ rule all:
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other
 # snakemake runs here, then --rerun-incomplete (profiles/default) reruns the killed jobs.
 if workflow.is_main_process:
-    from egosearch.stale_lock import clear_stale_locks
+    from egosearch.core.stale_lock import clear_stale_locks
 
     if clear_stale_locks():
         print("Removed the lock of a snakemake run that was killed (no snakemake process runs here).")
 
-    from egosearch.workflow_check import reports_missing_inputs
+    from egosearch.workflow.check import reports_missing_inputs
 
     # input functions (compare's) are resolved only when the DAG is built: their paths are unknown here
     for line in reports_missing_inputs(

@@ -1,8 +1,8 @@
 """The depth sensor's C rasteriser, built at ``pip install`` as an optional extension (the project's
 metadata is in pyproject.toml).
 
-``raster.c`` is a plain shared library that :mod:`egosearch.sensor` loads with ctypes (no Python
-headers involved), so it is built as ``egosearch/_raster<extension suffix>``. Without a working C
+``raster.c`` is a plain shared library that :mod:`egosearch.sim.sensor` loads with ctypes (no Python
+headers involved), so it is built as ``egosearch/sim/_raster<extension suffix>``. Without a working C
 compiler the install goes on without it, as PyYAML's and msgpack's C speed-ups do: the sensor then
 compiles it on first use when a compiler appears, else uses Embree (slower, same images).
 """
@@ -18,7 +18,7 @@ from setuptools.errors import CCompilerError, ExecError, PlatformError
 
 def _rasterbuild():
     # by path: the package's __init__ and dependencies are not importable while it is being built
-    path = Path(__file__).resolve().parent / "egosearch" / "rasterbuild.py"
+    path = Path(__file__).resolve().parent / "egosearch" / "sim" / "rasterbuild.py"
     spec = importlib.util.spec_from_file_location("_egosearch_rasterbuild", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -30,7 +30,7 @@ BUILD_ERRORS = (CCompilerError, ExecError, PlatformError, OSError)
 
 
 class OptionalBuildExt(build_ext):
-    """Tries the flags of :func:`egosearch.rasterbuild.flag_sets` in turn; when none builds, warns and
+    """Tries the flags of :func:`egosearch.sim.rasterbuild.flag_sets` in turn; when none builds, warns and
     leaves the extension out instead of failing the install."""
 
     def run(self):
@@ -58,7 +58,7 @@ class OptionalBuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension(f"egosearch.{rasterbuild.LIBRARY}", sources=["egosearch/raster.c"],
+    ext_modules=[Extension(f"egosearch.sim.{rasterbuild.LIBRARY}", sources=["egosearch/sim/raster.c"],
                            libraries=[] if sys.platform == "win32" else ["m"], optional=True)],
     cmdclass={"build_ext": OptionalBuildExt},
 )

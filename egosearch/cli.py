@@ -12,8 +12,8 @@ import sys
 
 
 def _cmd_scenarios(args) -> None:
-    from egosearch.outputs import check_outputs
-    from egosearch.scenarios import generate_scenarios, write_scenarios
+    from egosearch.core.outputs import check_outputs
+    from egosearch.sim.scenarios import generate_scenarios, write_scenarios
 
     check_outputs(files={"--out": args.out})
 
@@ -52,14 +52,14 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int, env_id: str 
     """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
     trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
     here, before any episode."""
-    from egosearch.policies import OraclePolicy, RandomPolicy
+    from egosearch.searchers.policies import OraclePolicy, RandomPolicy
 
     if kind == "oracle":
         return OraclePolicy, env_id or "EgoSearch-v0"
     if kind == "random":
         return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), env_id or "EgoSearch-v0"
     if kind in ("frontier", "frontier_head_off"):
-        from egosearch.frontier import FrontierPolicy
+        from egosearch.searchers.frontier import FrontierPolicy
 
         return FrontierPolicy, env_id or ("EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0")
     if kind == "actor":
@@ -75,14 +75,14 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int, env_id: str 
 
 
 def _cmd_evaluate(args) -> None:
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
 
     check_outputs(files={"--out": args.out, "--traces": args.traces})
     _acting_threads(args.threads)
-    from egosearch.envs import ENV_IDS
-    from egosearch.evaluate import evaluate, write_episodes
-    from egosearch.metrics import spl
-    from egosearch.scenarios import read_scenarios
+    from egosearch.runs.evaluate import evaluate, write_episodes
+    from egosearch.runs.metrics import spl
+    from egosearch.sim.envs import ENV_IDS
+    from egosearch.sim.scenarios import read_scenarios
 
     if args.env_id and args.env_id not in ENV_IDS:
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
@@ -90,7 +90,7 @@ def _cmd_evaluate(args) -> None:
     scenarios = read_scenarios(args.scenarios)
     recorder = None
     if args.traces:
-        from egosearch.trace import TraceRecorder
+        from egosearch.runs.trace import TraceRecorder
 
         if not args.traces.endswith(".npz"):
             raise ValueError(f"--traces={args.traces!r}: a trace file must end in .npz")
@@ -107,10 +107,10 @@ def _cmd_evaluate(args) -> None:
 
 
 def _cmd_train(args) -> None:
-    from egosearch.evaluate import scenario_evaluator
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
     from egosearch.rl.config import load_config
     from egosearch.rl.train import train
+    from egosearch.runs.evaluate import scenario_evaluator
     from egosearch.variants import load_variant
 
     check_outputs(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir})
@@ -122,8 +122,8 @@ def _cmd_train(args) -> None:
         overrides["num_threads"] = args.threads
     cfg = load_config(args.profile, overrides)
     env = variant.train_env
-    from egosearch.envs import observed_env_id
-    from egosearch.home_pool import curve_homes
+    from egosearch.sim.envs import observed_env_id
+    from egosearch.sim.home_pool import curve_homes
 
     env_id = observed_env_id(variant.env_id, cfg.target_memory)
     evaluator = scenario_evaluator(env_id, curve_homes(env), env["placement"], n=cfg.eval_episodes)
@@ -133,19 +133,19 @@ def _cmd_train(args) -> None:
     finally:
         evaluator.close()
     if args.work_dir and not summary.get("stopped"):
-        from egosearch.staging import publish_run
+        from egosearch.core.staging import publish_run
 
         publish_run(args.work_dir, args.out_dir)
     print(json.dumps(summary))
 
 
 def _cmd_fullbody(args) -> None:
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
 
     check_outputs(files={"--out": args.out})
     _acting_threads(args.threads)
     from egosearch.motion.replan import evaluate_fullbody, parse_setting, write_fullbody
-    from egosearch.scenarios import read_scenarios
+    from egosearch.sim.scenarios import read_scenarios
 
     method, m, mg = parse_setting(args.setting)
     make_policy, env_id = _make_policy_factory(args.policy, args.weights, args.seed)
@@ -169,7 +169,7 @@ def _group_curves(paths: list[str]) -> dict[str, list[str]]:
 
 def _report_outputs(args) -> None:
     """Every path a report writes, checked before it reads anything."""
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
 
     check_outputs(files={"--out": getattr(args, "out", None), "--out-csv": getattr(args, "out_csv", None),
                          "--readme": None if args.what != "readme" or args.check else args.readme},
@@ -229,7 +229,7 @@ def _cmd_report(args) -> None:
         for path in behaviour_report(args.files, args.out_prefix, head_on=args.head_on, head_off=args.head_off):
             print(f"wrote {path}")
     elif args.what == "searches":
-        from egosearch.searches import searches_report
+        from egosearch.report.searches import searches_report
 
         for path in searches_report(args.files, args.out_dir, seed=args.seed):
             print(f"wrote {path}")
@@ -276,9 +276,9 @@ def _cmd_report(args) -> None:
 
 def _success_radius() -> float:
     """Distance (m) from a target's centre to the body's axis within which success is possible: success is
-    measured from the body's surface (egosearch.scenarios.SUCCESS_DISTANCE), so the body's radius adds."""
-    from egosearch.agent import AgentSpec
-    from egosearch.scenarios import SUCCESS_DISTANCE
+    measured from the body's surface (egosearch.sim.scenarios.SUCCESS_DISTANCE), so the body's radius adds."""
+    from egosearch.sim.agent import AgentSpec
+    from egosearch.sim.scenarios import SUCCESS_DISTANCE
 
     return SUCCESS_DISTANCE + AgentSpec().body_radius
 
@@ -289,13 +289,13 @@ def _regenerate(profile: str, reference: str | None) -> None:
     the files `snakemake all` would."""
     from pathlib import Path
 
-    from egosearch.home_pool import curve_homes
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
     from egosearch.report import cli as report
     from egosearch.report.provenance import check_stored
     from egosearch.report.readme import variants_of_all, workflow_config
     from egosearch.report.tables import BOUNDS
     from egosearch.rl.config import departure_rows, load_config, table2_rows
+    from egosearch.sim.home_pool import curve_homes
     from egosearch.variants import load_variant
 
     config = workflow_config()
@@ -346,12 +346,12 @@ def _regenerate(profile: str, reference: str | None) -> None:
 
 
 def _cmd_video(args) -> None:
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
 
     check_outputs(files={"--out": args.out, "--still": args.still})
     _acting_threads(args.threads)
     from egosearch.motion.video import NotACleanSuccess, clean_successes, write_search_video
-    from egosearch.scenarios import read_scenarios
+    from egosearch.sim.scenarios import read_scenarios
 
     scenarios = {sc.scenario_id: sc for sc in read_scenarios(args.scenarios)}
     candidates = []
@@ -388,8 +388,8 @@ def _cmd_video(args) -> None:
 
 
 def _cmd_bench(args) -> None:
-    from egosearch import bench
-    from egosearch.outputs import check_outputs
+    from egosearch.core.outputs import check_outputs
+    from egosearch.sim import bench
 
     check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
     if args.what == "gpu" and not args.out_dir:
@@ -434,8 +434,8 @@ def _cmd_bench(args) -> None:
 
 
 def _cmd_pictures(args) -> None:
-    from egosearch.outputs import check_outputs
-    from egosearch.pictures import make_pictures
+    from egosearch.core.outputs import check_outputs
+    from egosearch.sim.pictures import make_pictures
 
     check_outputs(dirs={"--out-dir": args.out_dir})
 
@@ -447,7 +447,7 @@ def _cmd_variant(args) -> None:
     from egosearch.variants import check_learner_config, load_variant, new_variant
 
     if args.what == "new":
-        from egosearch.outputs import check_outputs
+        from egosearch.core.outputs import check_outputs
         from egosearch.variants import ABLATIONS_DIR
 
         check_outputs(dirs={"the variants folder": ABLATIONS_DIR})
@@ -574,9 +574,9 @@ def _report_parsers(sub) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from egosearch.agent import EVAL_HEIGHTS, HEIGHT_RANGE
     from egosearch.scene.layouts import LAYOUT_NAMES
     from egosearch.scene.placement import PLACEMENT_SCHEMES
+    from egosearch.sim.agent import EVAL_HEIGHTS, HEIGHT_RANGE
 
     parser = argparse.ArgumentParser(prog="egosearch", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -611,7 +611,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
                                                         "what the camera's centre looks at, distances) to this "
-                                                        "compressed file (egosearch.trace)")
+                                                        "compressed file (egosearch.runs.trace)")
     p.add_argument("--threads", type=int, default=1, help=threads)
     p.set_defaults(func=_cmd_evaluate)
 

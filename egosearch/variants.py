@@ -140,7 +140,7 @@ def _check_homes(train_env: dict, path: Path) -> None:
         raise VariantError(f"{path}: train_env: " + ("layout: generated needs home_seeds: [first, stop)" if generated
                                                     else "home_seeds is only read with layout: generated"))
     if generated:
-        from egosearch.home_pool import check_home_split
+        from egosearch.sim.home_pool import check_home_split
 
         try:
             check_home_split(seeds)

@@ -11,7 +11,7 @@ import torch
 
 from egosearch.cli import main
 from egosearch.variants import VariantError, load_variant, new_variant, variant_names
-from egosearch.workflow_check import ConfigError, check_config, checked_variants, coerce_numbers
+from egosearch.workflow.check import ConfigError, check_config, checked_variants, coerce_numbers
 
 REPO = Path(__file__).resolve().parent.parent
 HEAD = "name: NAME\nenv_id: EgoSearch-v0\ntrain_env: {layout: kitchen_living, placement: everywhere}\n"
@@ -65,7 +65,7 @@ BAD_VARIANT_FILES = [
      "ablations/split_without_generated.yaml: train_env: home_seeds is only read with layout: generated"),
     ("split_draws_heldout", HEAD.replace("layout: kitchen_living", "layout: generated, home_seeds: [899990, 900005]"),
      "ablations/split_draws_heldout.yaml: train_env: home_seeds=[899990, 900005) overlaps the held-out homes "
-     "[900000, 900020) that no training may draw (egosearch.home_pool.HELDOUT_HOME_SEEDS)"),
+     "[900000, 900020) that no training may draw (egosearch.sim.home_pool.HELDOUT_HOME_SEEDS)"),
 ]
 
 # (--config entries, the one line) of `snakemake -n all`.
@@ -302,15 +302,15 @@ def test_report_subcommands_print_their_own_help(capsys):
 @pytest.fixture
 def no_work(monkeypatch):
     """Episodes, training and scenario generation fail the test: a bad output path must be refused first."""
-    import egosearch.evaluate
     import egosearch.rl.train
-    import egosearch.scenarios
+    import egosearch.runs.evaluate
+    import egosearch.sim.scenarios
 
     def work(*args, **kwargs):
         raise AssertionError("work started before the output paths were checked")
 
-    for module, name in ((egosearch.evaluate, "evaluate"), (egosearch.rl.train, "train"),
-                         (egosearch.scenarios, "generate_scenarios")):
+    for module, name in ((egosearch.runs.evaluate, "evaluate"), (egosearch.rl.train, "train"),
+                         (egosearch.sim.scenarios, "generate_scenarios")):
         monkeypatch.setattr(module, name, work)
 
 
@@ -364,7 +364,7 @@ def test_an_output_where_nothing_can_be_written_is_one_line(capsys, no_work):
 
 
 def test_a_failed_csv_write_leaves_no_tmp(tmp_path):
-    from egosearch.csvio import write_csv_atomic
+    from egosearch.core.csvio import write_csv_atomic
 
     (tmp_path / "out.csv").mkdir()
     with pytest.raises(IsADirectoryError):
@@ -376,7 +376,7 @@ def test_a_failed_csv_write_leaves_no_tmp(tmp_path):
 def test_nonsense_scenarios_are_one_line_before_any_episode(tmp_path, capsys, no_work):
     from dataclasses import replace
 
-    from egosearch.scenarios import read_scenarios, write_scenarios
+    from egosearch.sim.scenarios import read_scenarios, write_scenarios
 
     stored = read_scenarios(REPO / "results/cpu/scenarios/kitchen_living/everywhere/h1.05.csv")[:3]
     spoiled = {
@@ -447,7 +447,7 @@ def test_an_actor_in_the_wrong_env_is_one_line_naming_its_env(tmp_path, capsys, 
 def test_the_sizes_an_actor_is_checked_against_are_the_envs():
     import gymnasium
 
-    from egosearch.envs import env_space_dims
+    from egosearch.sim.envs import env_space_dims
 
     env = gymnasium.make("EgoSearchNoHeadMap-v0")
     try:

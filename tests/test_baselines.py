@@ -8,8 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from egosearch.agent import AgentSpec, AgentState
 from egosearch.motion.replan import NoisySearchPolicy, line_plan
+from egosearch.sim.agent import AgentSpec, AgentState
 
 
 class Recorder:

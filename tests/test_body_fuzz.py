@@ -14,11 +14,11 @@ import math
 import numpy as np
 import pytest
 
-from egosearch.agent import AgentSpec
-from egosearch.env import SearchEnv
-from egosearch.scenarios import _sample_start, navgrid_for
 from egosearch.scene.geometry import deepest_penetration, part_penetration
 from egosearch.scene.parts import TAG_OBSTACLE, Part
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.env import SearchEnv
+from egosearch.sim.scenarios import _sample_start, navgrid_for
 
 #: The rule of the body: never more than this deep (m) in the home after a step or a reset.
 MAX_DEPTH = 0.01

@@ -9,13 +9,13 @@ import sys
 
 import pytest
 
-from egosearch.bullet import connect, pybullet, quiet_native_output
+from egosearch.sim.bullet import connect, pybullet, quiet_native_output
 
 _SCRIPT = """
-from egosearch.agent import AgentSpec
+from egosearch.sim.agent import AgentSpec
 from egosearch.motion.collision import PenetrationCounter
 from egosearch.scene.layouts import get_scene
-from egosearch.world import World
+from egosearch.sim.world import World
 
 worlds = [World(get_scene("studio"), AgentSpec()) for _ in range(2)]
 counter = PenetrationCounter(get_scene("studio"), "humanoid")

@@ -30,11 +30,11 @@ import torch
 # cuBLAS reads this when it starts: before any test of this process touches CUDA (deterministic GEMMs)
 os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
 
-from egosearch.env import PRIVILEGED_STATE_DIM  # noqa: E402
 from egosearch.rl.bench import _filled_replay  # noqa: E402
 from egosearch.rl.config import load_config  # noqa: E402
 from egosearch.rl.sac_curl import load_actor_net  # noqa: E402
 from egosearch.rl.train import make_agent, train  # noqa: E402
+from egosearch.sim.env import PRIVILEGED_STATE_DIM  # noqa: E402
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))

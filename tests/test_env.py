@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from egosearch.env import FLOOR_MAP_DIM, TARGET_MEMORY_DIM
-from egosearch.envs import ENV_IDS
-from egosearch.evaluate import evaluate, make_env
-from egosearch.policies import OraclePolicy, RandomPolicy
-from egosearch.scenarios import generate_scenarios
+from egosearch.runs.evaluate import evaluate, make_env
+from egosearch.searchers.policies import OraclePolicy, RandomPolicy
+from egosearch.sim.env import FLOOR_MAP_DIM, TARGET_MEMORY_DIM
+from egosearch.sim.envs import ENV_IDS
+from egosearch.sim.scenarios import generate_scenarios
 
 
 @pytest.mark.parametrize("env_id", sorted(ENV_IDS))
@@ -106,7 +106,7 @@ def test_evaluation_env_uses_the_scenario():
 def test_start_radius_curriculum_starts_near_the_target():
     import math
 
-    from egosearch.env import SearchEnv
+    from egosearch.sim.env import SearchEnv
 
     env = SearchEnv(layout="kitchen_living")
     far = []
@@ -142,7 +142,7 @@ def test_training_heights_of_the_cpu_profile_reach_the_lowest_evaluation_camera(
 def test_geodesic_shaping_telescopes_to_the_change_of_the_shortest_path():
     """With ``distance_reward="geodesic"`` the r_d of an episode sums to ℓ at the start minus ℓ at
     the end (potential-based shaping), and r_c is the unclipped collision count."""
-    from egosearch.env import COLLISION_PENALTY_PER_HIT, SearchEnv
+    from egosearch.sim.env import COLLISION_PENALTY_PER_HIT, SearchEnv
 
     env = SearchEnv(layout="kitchen_living", distance_reward="geodesic")
     env.reset(seed=0)

@@ -7,8 +7,8 @@ import gymnasium
 import numpy as np
 import pytest
 
-import egosearch.envs  # noqa: F401
-from egosearch.env import MASK_FEATURE_DIM, TARGET_MEMORY_DIM
+import egosearch.sim.envs  # noqa: F401
+from egosearch.sim.env import MASK_FEATURE_DIM, TARGET_MEMORY_DIM
 
 
 def _run_until_seen(env, rng, max_episodes=30):
@@ -79,7 +79,7 @@ def test_coverage_bonus_pays_once_per_new_cell():
 
 
 def test_floor_map_marks_what_the_body_saw_and_where_it_stood():
-    from egosearch.env import FLOOR_MAP_CELLS, FLOOR_MAP_DIM
+    from egosearch.sim.env import FLOOR_MAP_CELLS, FLOOR_MAP_DIM
 
     env = gymnasium.make("EgoSearchMap-v0", layout="kitchen_living", placement="everywhere")
     obs, _ = env.reset(seed=4)

@@ -8,8 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from egosearch.env import COLLISION_PENALTY_FLOOR, SearchEnv
-from egosearch.scenarios import MAX_STEPS, SUCCESS_DISTANCE, generate_scenarios, navgrid_for, success_region
+from egosearch.sim.env import COLLISION_PENALTY_FLOOR, SearchEnv
+from egosearch.sim.scenarios import MAX_STEPS, SUCCESS_DISTANCE, generate_scenarios, navgrid_for, success_region
 
 STAY = np.zeros(5, np.float32)
 

@@ -3,10 +3,10 @@ finds targets without learning."""
 
 import numpy as np
 
-import egosearch.envs  # noqa: F401
-from egosearch.evaluate import evaluate, make_env
-from egosearch.frontier import FrontierPolicy
-from egosearch.scenarios import generate_scenarios
+import egosearch.sim.envs  # noqa: F401
+from egosearch.runs.evaluate import evaluate, make_env
+from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.sim.scenarios import generate_scenarios
 
 
 class PoseOnly:

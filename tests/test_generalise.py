@@ -7,8 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from egosearch.home_pool import HELDOUT_HOME_SEEDS, HomePoolEnv, check_home_split, curve_homes
 from egosearch.report.generalise import generalise_frame, generalise_report
+from egosearch.sim.home_pool import HELDOUT_HOME_SEEDS, HomePoolEnv, check_home_split, curve_homes
 
 EPISODE = ["scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions", "episode_return"]
 

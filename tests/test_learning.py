@@ -15,11 +15,11 @@ on the first 20 of the scenarios below, 8 minutes beside two trainings), more th
 import numpy as np
 import pytest
 
-from egosearch.evaluate import evaluate
-from egosearch.policies import RandomPolicy
 from egosearch.rl.config import load_config
 from egosearch.rl.train import ActorPolicy, train
-from egosearch.scenarios import generate_scenarios
+from egosearch.runs.evaluate import evaluate
+from egosearch.searchers.policies import RandomPolicy
+from egosearch.sim.scenarios import generate_scenarios
 
 STEPS = 12_000
 

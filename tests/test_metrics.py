@@ -2,8 +2,8 @@ import math
 
 import pytest
 
-from egosearch.env import reward_terms
-from egosearch.metrics import episode_spl, spl
+from egosearch.runs.metrics import episode_spl, spl
+from egosearch.sim.env import reward_terms
 
 
 def test_spl_hand_worked():

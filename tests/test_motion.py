@@ -10,7 +10,6 @@ import pybullet
 import pytest
 from pybullet_utils import bullet_client
 
-from egosearch.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
 from egosearch.motion import mocap, quat, skeleton
 from egosearch.motion.base import SUBSTEP_SECONDS, IdentityMG
 from egosearch.motion.collision import PENETRATION_DEPTH, PenetrationCounter
@@ -25,8 +24,9 @@ from egosearch.motion.replan import (
     run_fullbody_episode,
 )
 from egosearch.motion.video import TARGET_RING_COLOR
-from egosearch.policies import OraclePolicy
-from egosearch.scenarios import Scenario, generate_scenarios
+from egosearch.searchers.policies import OraclePolicy
+from egosearch.sim.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
+from egosearch.sim.scenarios import Scenario, generate_scenarios
 
 LAYOUT = "kitchen_living"
 
@@ -38,7 +38,7 @@ def scenarios():
 
 @pytest.fixture(scope="module")
 def env(scenarios):
-    from egosearch.evaluate import make_env
+    from egosearch.runs.evaluate import make_env
 
     e = make_env("EgoSearch-v0", scenarios[0])
     yield e
@@ -379,7 +379,7 @@ def test_video_refuses_to_film_a_penetrating_replay(tmp_path, scenarios, capsys)
     import pandas as pd
 
     from egosearch.cli import main
-    from egosearch.scenarios import write_scenarios
+    from egosearch.sim.scenarios import write_scenarios
 
     write_scenarios(tmp_path / "s.csv", scenarios)
     # The oracle's humanoid brushes furniture in scenario 3 (its replay below has penetrating poses).

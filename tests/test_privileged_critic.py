@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 import torch
 
-from egosearch.agent import AgentState
-from egosearch.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
-from egosearch.envs import env_space_dims, observed_env_id
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import ActorPolicy, train, train_env_kwargs
 from egosearch.scene.parts import Part
+from egosearch.sim.agent import AgentState
+from egosearch.sim.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
+from egosearch.sim.envs import env_space_dims, observed_env_id
 
 DRQ = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 4, "encoder_num_layers": 2,
        "encoder_stride2_layers": 2, "aug_pad": 1}

@@ -262,8 +262,8 @@ def test_smoke_training_with_interrupt_and_resume_equals_the_uninterrupted_run(t
 
 @pytest.mark.slow
 def test_recurrent_learner_beats_random_on_the_fake_env(tmp_path):
-    from egosearch.policies import RandomPolicy
     from egosearch.rl.train import default_evaluator
+    from egosearch.searchers.policies import RandomPolicy
 
     # test_rl_train's sac_drq learning run, with sequences: 8 of 8 steps (+ 4 burn-in) per update.
     # Twice its env steps: at 1200 steps seeds 0-2 reached only 0.2-0.55 (the batch holds 8

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import torch
 
-from egosearch.machine import cpu_model
+from egosearch.core.machine import cpu_model
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.train import (
@@ -258,7 +258,7 @@ LEARNERS = {
 
 @pytest.mark.parametrize("learner", list(LEARNERS))
 def test_learning_beats_random_on_the_fake_env(tmp_path, learner):
-    from egosearch.policies import RandomPolicy
+    from egosearch.searchers.policies import RandomPolicy
 
     steps = LEARNERS[learner]["total_env_steps"]
     cfg = load_config("smoke", {**SMOKE, **LEARNERS[learner], "init_steps": 200, "eval_every": steps,
@@ -276,7 +276,7 @@ def test_learning_beats_random_on_the_fake_env(tmp_path, learner):
 def test_target_memory_trains_the_policy_in_the_memory_env_of_its_head(tmp_path):
     """The config field and a variant naming the *Memory-v0 id are one observation: a head-off run with
     target_memory acts, and is checked, in EgoSearchNoHeadMemory-v0, whose mask is wider."""
-    from egosearch.envs import ENV_IDS, env_space_dims, observed_env_id
+    from egosearch.sim.envs import ENV_IDS, env_space_dims, observed_env_id
 
     assert observed_env_id("EgoSearch-v0", True) == "EgoSearchMemory-v0"
     assert observed_env_id("EgoSearchNoHead-v0", True) == "EgoSearchNoHeadMemory-v0"
@@ -310,7 +310,7 @@ def test_a_run_stopped_at_its_wall_time_limit_checkpoints_and_resumes(tmp_path):
 
 
 def test_the_vector_unit_is_read_from_the_cpu_flags(tmp_path):
-    from egosearch.machine import cpu_vector_unit
+    from egosearch.core.machine import cpu_vector_unit
 
     info = tmp_path / "cpuinfo"
     for flags, unit in (("fpu sse2 avx avx2 avx512f avx512bw", "AVX-512"), ("fpu sse2 avx avx2 fma", "AVX2"),

@@ -5,7 +5,9 @@ import math
 
 import pytest
 
-from egosearch.scenarios import (
+from egosearch.scene.layouts import get_scene
+from egosearch.scene.placement import rests_on_support
+from egosearch.sim.scenarios import (
     COLUMNS,
     SUCCESS_DISTANCE,
     ScenarioFileError,
@@ -13,8 +15,6 @@ from egosearch.scenarios import (
     read_scenarios,
     write_scenarios,
 )
-from egosearch.scene.layouts import get_scene
-from egosearch.scene.placement import rests_on_support
 
 
 @pytest.fixture(scope="module")

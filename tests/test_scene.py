@@ -413,8 +413,8 @@ def test_everywhere_puts_a_real_share_inside_low_cabinets(layout):
 
 
 def test_studio_is_small_connected_and_named():
-    from egosearch.agent import AgentSpec
-    from egosearch.navgrid import NavGrid
+    from egosearch.sim.agent import AgentSpec
+    from egosearch.sim.navgrid import NavGrid
 
     scene = get_scene("studio")
     assert scene.size_xy == (4.5, 4.0)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from egosearch.scene.parts import TAG_FLOOR, TAG_FURNITURE, TAG_WALL, Part, Scene
-from egosearch.sensor import (
+from egosearch.sim.sensor import (
     BACKENDS,
     MASK_FEATURE_DIM,
     DepthMaskSensor,
@@ -310,7 +310,7 @@ def raster_frames(furnished):
 @pytest.fixture
 def fresh_loader(monkeypatch, tmp_path):
     """The loader forgets what it loaded, and compiles on first use into an empty cache."""
-    import egosearch.sensor as sensor_mod
+    import egosearch.sim.sensor as sensor_mod
 
     monkeypatch.setenv("EGOSEARCH_CACHE_DIR", str(tmp_path))
     sensor_mod._load_raster_library.cache_clear()
@@ -336,8 +336,7 @@ def test_a_library_built_for_another_cpu_is_not_loaded_but_compiled_anew(fresh_l
     import ctypes
     from pathlib import Path
 
-    from egosearch import rasterbuild
-
+    from egosearch.sim import rasterbuild
     installed = fresh_loader._installed_library()
     if installed is None or fresh_loader._find_compiler() is None:
         pytest.skip("needs the library built at install and a C compiler")
@@ -351,8 +350,7 @@ def test_a_library_built_for_another_cpu_is_not_loaded_but_compiled_anew(fresh_l
 
 
 def test_a_build_is_usable_only_from_this_source_and_for_this_cpu():
-    from egosearch import rasterbuild
-
+    from egosearch.sim import rasterbuild
     here = f"{rasterbuild.source_key()} {rasterbuild.cpu_key()}"
     assert rasterbuild.usable_here(here) is None
     assert rasterbuild.usable_here(f"{rasterbuild.source_key()} {rasterbuild.PORTABLE}") is None
@@ -403,7 +401,7 @@ def scene_renderer(furnished):
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
     scene, target, _ = furnished
     try:
-        from egosearch.render import SceneRenderer
+        from egosearch.sim.render import SceneRenderer
 
         renderer = SceneRenderer(scene, target=target)
         renderer.depth((1.0, 1.0, 1.0), 0.0, 0.0, width=8, height=8)  # initialises EGL
@@ -436,7 +434,7 @@ def test_pyrender_pictures(furnished, scene_renderer):
     top = scene_renderer.third_person_rgb((x0 - 1, y0 - 1, 6.0), ((x0 + x1) / 2, (y0 + y1) / 2, 0.0),
                                           width=80, height=60)
     assert top.shape == (60, 80, 3) and top.std() > 5
-    from egosearch.render import depth_to_colormap
+    from egosearch.sim.render import depth_to_colormap
 
     d, m = DepthMaskSensor(scene).render(*poses[0])
     m[:3, :3] = True

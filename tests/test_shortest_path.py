@@ -1,7 +1,7 @@
 """ℓ, the shortest path behind SPL, is a lower bound on the path of every success the env can produce.
 
-The bound is stated in :data:`egosearch.navgrid.LOWER_BOUND_SLACK` and checked by
-:func:`egosearch.navgrid.lower_bound_holds`. It is checked here on hand-built scenes, on the stored
+The bound is stated in :data:`egosearch.sim.navgrid.LOWER_BOUND_SLACK` and checked by
+:func:`egosearch.sim.navgrid.lower_bound_holds`. It is checked here on hand-built scenes, on the stored
 evaluations, and by driving the env on the stored scenario sets with four searchers: the oracle,
 random actions, a beeline that walks straight at the target into whatever is in the way, and a
 follower of ℓ's own grid that walks into contact with furniture when that is shorter. The default run
@@ -17,12 +17,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import egosearch.scenarios as scenarios_mod
-from egosearch.agent import AgentSpec, wrap_angle
-from egosearch.env import SearchEnv
-from egosearch.navgrid import LOWER_BOUND_SLACK, MAX_PENETRATION, NavGrid, lower_bound_holds
-from egosearch.policies import OraclePolicy, RandomPolicy
-from egosearch.scenarios import (
+import egosearch.sim.scenarios as scenarios_mod
+from egosearch.scene import layouts
+from egosearch.scene.objects import get_object, target_part
+from egosearch.scene.parts import TAG_OBSTACLE, TAG_TARGET, TAG_WALL, Part, Scene
+from egosearch.searchers.policies import OraclePolicy, RandomPolicy
+from egosearch.sim.agent import AgentSpec, wrap_angle
+from egosearch.sim.env import SearchEnv
+from egosearch.sim.navgrid import LOWER_BOUND_SLACK, MAX_PENETRATION, NavGrid, lower_bound_holds
+from egosearch.sim.scenarios import (
     SUCCESS_DISTANCE,
     navgrid_for,
     read_scenarios,
@@ -31,10 +34,7 @@ from egosearch.scenarios import (
     success_region,
     visible_from,
 )
-from egosearch.scene import layouts
-from egosearch.scene.objects import get_object, target_part
-from egosearch.scene.parts import TAG_OBSTACLE, TAG_TARGET, TAG_WALL, Part, Scene
-from egosearch.world import PENETRATION_TOLERANCE
+from egosearch.sim.world import PENETRATION_TOLERANCE
 
 ROOT = Path(__file__).resolve().parents[1]
 STORED_SETS = sorted(ROOT.glob("results/*/scenarios/*/*/h*.csv"))
@@ -149,7 +149,7 @@ def test_ell_bounds_a_success_in_contact_with_the_table(diner_layout):
     ℓ measured to surely-free cells was the way round the table's corner."""
     from dataclasses import replace
 
-    from egosearch.scenarios import Scenario
+    from egosearch.sim.scenarios import Scenario
 
     keys = (-0.9 - 0.48, 0.0)
     sc = Scenario(scenario_id=0, layout=diner_layout, placement="everywhere", height=1.6, start_x=-0.9 + R + 0.1,

@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from egosearch.evaluate import evaluate, make_env
-from egosearch.policies import RandomPolicy
 from egosearch.report.behaviour import read_trace_file
-from egosearch.scenarios import generate_scenarios
-from egosearch.trace import TRACE_COLUMNS, HomeProbe, TraceRecorder
+from egosearch.runs.evaluate import evaluate, make_env
+from egosearch.runs.trace import TRACE_COLUMNS, HomeProbe, TraceRecorder
+from egosearch.searchers.policies import RandomPolicy
+from egosearch.sim.scenarios import generate_scenarios
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +134,7 @@ def test_a_three_seed_cell_of_incompressible_steps_stays_under_10_mb(tmp_path):
 
 def test_evaluate_refuses_a_trace_file_that_is_not_npz_before_running(recorded, tmp_path, capsys):
     from egosearch.cli import main
-    from egosearch.scenarios import write_scenarios
+    from egosearch.sim.scenarios import write_scenarios
 
     scenarios = tmp_path / "s.csv"
     write_scenarios(scenarios, recorded[0])

@@ -168,7 +168,7 @@ def test_config_file_is_valid_yaml_with_all_profiles():
 
 
 def test_a_report_with_stored_outputs_and_missing_inputs_is_named():
-    from egosearch.workflow_check import reports_missing_inputs
+    from egosearch.workflow.check import reports_missing_inputs
 
     stored = {"fig6.png", "fig6.csv", "a/curve.csv"}
     rules = [("fig6", ["fig6.png", "fig6.csv"], ["a/curve.csv", "new/curve.csv"]),

@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from egosearch.agent import AgentSpec
-from egosearch.navgrid import MAX_PENETRATION, NavGrid
 from egosearch.scene.geometry import deepest_penetration
 from egosearch.scene.parts import TAG_OBSTACLE, TAG_WALL, Part, Scene
-from egosearch.world import PENETRATION_TOLERANCE, SWEEP_TOLERANCE, World, random_free_pose
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.navgrid import MAX_PENETRATION, NavGrid
+from egosearch.sim.world import PENETRATION_TOLERANCE, SWEEP_TOLERANCE, World, random_free_pose
 
 WALL = frozenset({TAG_OBSTACLE, TAG_WALL})
 

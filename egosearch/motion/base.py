@@ -1,13 +1,13 @@
 """One interface for motion generators (MG of paper section 5, Algorithm 1 line 8).
 
 ``MotionGenerator.generate(plan, m, start)`` takes the abstract plan s_0..s_T (one
-:class:`~egosearch.agent.AgentState` per env step of :data:`~egosearch.agent.STEP_SECONDS`) and
+:class:`~egosearch.sim.agent.AgentState` per env step of :data:`~egosearch.sim.agent.STEP_SECONDS`) and
 returns the ``m`` full-body poses that follow ``start`` (the character's current pose, taken at
 the time of s_0), i.e. the poses at the times of s_1..s_m. ``start=None`` starts the character
 standing at s_0. Each generator moves with its own limits, so its poses deviate from the plan.
 
 Inside, every generator integrates at :data:`SUBSTEPS` sub-steps per env step and, when bound
-to a :class:`~egosearch.world.World`, stops the root where the abstract body cylinder would end
+to a :class:`~egosearch.sim.world.World`, stops the root where the abstract body cylinder would end
 inside an obstacle (``FullBodyPose.blocked``): the realised path is collision-checked.
 """
 
@@ -18,8 +18,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from egosearch.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
-from egosearch.world import PENETRATION_TOLERANCE
+from egosearch.sim.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
+from egosearch.sim.world import PENETRATION_TOLERANCE
 
 #: Integration sub-steps per env step (0.03 s each, the rate of the mocap clips).
 SUBSTEPS = 5

@@ -1,7 +1,7 @@
 """Full-body penetration of the home: the paper's Figure 8 failure as a measured rate.
 
 A :class:`PenetrationCounter` holds its own pybullet client with the home's static obstacles
-built exactly as :class:`egosearch.world.World` builds them (boxes, cylinders, meshes by their
+built exactly as :class:`egosearch.sim.world.World` builds them (boxes, cylinders, meshes by their
 bounding box) plus one character body (humanoid capsules, Fetch cylinders or the abstract
 cylinder). Keeping it apart from the env's world means posing the character never disturbs the
 abstract model's physics. A pose *penetrates* when any of the character's collision shapes is
@@ -14,12 +14,12 @@ import math
 
 import numpy as np
 
-from egosearch.agent import AgentSpec
-from egosearch.bullet import connect, pybullet
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose
 from egosearch.scene.parts import Scene
-from egosearch.world import add_static_part
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.bullet import connect, pybullet
+from egosearch.sim.world import add_static_part
 
 #: A shape this deep (m) inside an obstacle counts as a penetration; shallower contact is touch.
 PENETRATION_DEPTH = 0.01

@@ -17,8 +17,6 @@ import math
 
 import numpy as np
 
-from egosearch.agent import AgentState, wrap_angle
-from egosearch.bullet import pybullet
 from egosearch.motion import quat
 from egosearch.motion.base import (
     SUBSTEP_SECONDS,
@@ -27,6 +25,8 @@ from egosearch.motion.base import (
     Limits,
     MotionGenerator,
 )
+from egosearch.sim.agent import AgentState, wrap_angle
+from egosearch.sim.bullet import pybullet
 
 FETCH_CAMERA_HEIGHT = 1.05
 FETCH_BASE_RADIUS = 0.28

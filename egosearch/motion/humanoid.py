@@ -16,8 +16,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from egosearch.agent import AgentSpec
-from egosearch.bullet import pybullet, quiet_native_output
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose, Limits
 from egosearch.motion.collision import union_aabb
@@ -31,6 +29,8 @@ from egosearch.motion.skeleton import (
     shape_segments,
     standing_root_height,
 )
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.bullet import pybullet, quiet_native_output
 
 HUMANOID_SCALE = 0.2735
 """pybullet ``globalScaling`` of the humanoid: mean walking eye height 1.65 m."""

@@ -13,7 +13,7 @@ root, camera height and head, and its depth history ends with the frame seen fro
 4. the next cycle plans from s_M = q_M (line 17).
 
 The episode's success is judged on the realised trajectory: the target within
-:data:`~egosearch.scenarios.SUCCESS_DISTANCE` of the abstract body's surface placed at the
+:data:`~egosearch.sim.scenarios.SUCCESS_DISTANCE` of the abstract body's surface placed at the
 character's root and seen from the character's camera; at most ``MAX_STEPS`` = 100 realised
 steps. Every realised pose is checked for full-body penetration of the home.
 
@@ -38,16 +38,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from egosearch.agent import AgentState
-from egosearch.csvio import write_csv_atomic
-from egosearch.env import FRAME_HISTORY, target_distance
-from egosearch.metrics import episode_spl
+from egosearch.core.csvio import write_csv_atomic
 from egosearch.motion.base import FullBodyPose, IdentityMG, MotionGenerator
 from egosearch.motion.collision import PenetrationCounter
 from egosearch.motion.fetch import FetchMG
 from egosearch.motion.matching import MatchingMG
 from egosearch.motion.phase import PhaseMG
-from egosearch.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario
+from egosearch.runs.metrics import episode_spl
+from egosearch.sim.agent import AgentState
+from egosearch.sim.env import FRAME_HISTORY, target_distance
+from egosearch.sim.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario
 
 DEFAULT_T = 20
 DEFAULT_M = 5
@@ -281,7 +281,7 @@ def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], metho
                       seed: int = 0, progress: bool = False) -> list[dict]:
     """``make_policy(env)`` realised by motion generator ``mg_name`` with ``method`` on every scenario.
     ``M=None`` takes the method's default (the one-step baselines execute their whole line)."""
-    from egosearch.evaluate import make_env
+    from egosearch.runs.evaluate import make_env
 
     meth = get_method(method)
     if mg_name not in MOTION_GENERATORS:

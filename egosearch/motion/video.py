@@ -24,9 +24,9 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
 
-from egosearch.agent import STEP_SECONDS  # noqa: E402
 from egosearch.motion import quat  # noqa: E402
 from egosearch.motion.base import FullBodyPose  # noqa: E402
+from egosearch.sim.agent import STEP_SECONDS  # noqa: E402
 
 CHARACTERS = ("humanoid_phase", "humanoid_matching", "fetch")
 FRAME_HEIGHT = 384
@@ -36,7 +36,7 @@ FETCH_COLOR = (0.85, 0.85, 0.88)
 CAMERA_COLOR = (0.1, 0.1, 0.1)
 PLAN_COLOR = (0.55, 0.55, 0.55)
 TARGET_RING_COLOR = (230, 30, 30)
-"""The first-person mask's red (:func:`egosearch.render.depth_to_colormap`): one colour for the target."""
+"""The first-person mask's red (:func:`egosearch.sim.render.depth_to_colormap`): one colour for the target."""
 TARGET_RING_RADIUS = 0.3
 """m around the target's centre: wide enough to read at the follow camera's distance."""
 THIRD_YFOV_DEG = 55.0
@@ -133,8 +133,8 @@ class CharacterView:
     def __init__(self, scene, target=None, width: int = THIRD_WIDTH, height: int = FRAME_HEIGHT):
         import pyrender
 
-        from egosearch.render import look_at_pose
         from egosearch.scene.meshes import part_mesh
+        from egosearch.sim.render import look_at_pose
 
         self._pyrender = pyrender
         self._look_at_pose = look_at_pose
@@ -266,11 +266,11 @@ def write_search_video(layout: str, character: str, policy, scenario, out_path: 
     """
     import imageio.v2 as imageio
 
-    from egosearch.env import target_distance
-    from egosearch.evaluate import make_env
     from egosearch.motion.replan import make_motion_generator, run_fullbody_episode
-    from egosearch.render import depth_to_colormap, upscale
-    from egosearch.scenarios import MAX_STEPS
+    from egosearch.runs.evaluate import make_env
+    from egosearch.sim.env import target_distance
+    from egosearch.sim.render import depth_to_colormap, upscale
+    from egosearch.sim.scenarios import MAX_STEPS
 
     if character not in CHARACTERS:
         raise ValueError(f"character={character!r}; allowed: {', '.join(CHARACTERS)}")

@@ -1,7 +1,7 @@
 """The report layer: CSV in, files out (Tables 1 and 2, Figures 6 and 7, variant comparisons).
 
 Imports pandas, scipy, matplotlib and yaml only; never torch, the simulator, gymnasium or other
-egosearch modules but the stdlib-only ``egosearch.machine`` (the CLI passes Table 2's rows in).
+egosearch modules but the stdlib-only ``egosearch.core.machine`` (the CLI passes Table 2's rows in).
 """
 
 from egosearch.report.data import (

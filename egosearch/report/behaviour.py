@@ -47,7 +47,7 @@ import pandas as pd
 PathLike = str | os.PathLike
 
 OPENING_KINDS = ("low_cabinet_interior", "wall_cabinet_interior", "shelf")
-"""Gaze kinds inside furniture (``egosearch.trace.OPENING_KINDS``; this layer may not import it)."""
+"""Gaze kinds inside furniture (``egosearch.runs.trace.OPENING_KINDS``; this layer may not import it)."""
 NEAR_OPENING = 1.0
 """A step starting this close (m) to an opening is "around cabinets"."""
 BACKWARD_MIN = 0.02

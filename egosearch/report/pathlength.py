@@ -4,7 +4,7 @@ CSV in, files out. Each episode of a variant's evaluation CSVs is joined to its 
 target, ℓ) and binned:
 
 - by ℓ, the scenario's shortest path (the geodesic length from the start to the nearest pose that
-  satisfies success; ``egosearch.scenarios``): :data:`LENGTH_BINS`, in metres;
+  satisfies success; ``egosearch.sim.scenarios``): :data:`LENGTH_BINS`, in metres;
 - by the detour ``ℓ − max(0, |start − target| − r)``: how much longer the shortest path is than
   the straight line from the start to the ring of radius ``r`` around the target where success
   becomes possible (``r`` = the success distance plus the body radius: success is measured from

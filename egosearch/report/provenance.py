@@ -17,7 +17,7 @@ from collections.abc import Iterable
 from importlib import metadata
 from pathlib import Path
 
-from egosearch.machine import cpu_model, cpu_vector_unit
+from egosearch.core.machine import cpu_model, cpu_vector_unit
 
 
 def _git(*args: str) -> str:

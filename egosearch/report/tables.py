@@ -40,7 +40,7 @@ because the paper tests in both of its homes (Section 6) and gives one number pe
 BOUNDS = ("random", "frontier", "frontier_head_off", "oracle")
 """The searchers Table 1 sets beside each policy, on the same scenario sets: uniform random actions, the
 classical frontier searcher from the actor's observation and its own pose (head moving, then held
-fixed: ``egosearch.frontier``), and the privileged oracle (knows the target and walks the shortest path
+fixed: ``egosearch.searchers.frontier``), and the privileged oracle (knows the target and walks the shortest path
 to it)."""
 BOUND_LABELS = {"random": "random searcher", "frontier": "frontier searcher (classical)",
                 "frontier_head_off": "frontier searcher, head fixed", "oracle": "privileged oracle"}

@@ -31,12 +31,12 @@ import time
 import numpy as np
 import torch
 
-from egosearch.env import PRIVILEGED_STATE_DIM
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
 from egosearch.rl.train import make_agent, torch_threads
+from egosearch.sim.env import PRIVILEGED_STATE_DIM
 
 
 def _cpu_seconds_all() -> float | None:
@@ -221,10 +221,10 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
 
 def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, overrides: dict) -> dict:
     """A paper-profile training for ``seconds``, and its rates read back from its CSVs."""
-    from egosearch.envs import observed_env_id
-    from egosearch.evaluate import scenario_evaluator
-    from egosearch.home_pool import curve_homes
     from egosearch.rl.train import train
+    from egosearch.runs.evaluate import scenario_evaluator
+    from egosearch.sim.envs import observed_env_id
+    from egosearch.sim.home_pool import curve_homes
     from egosearch.variants import load_variant
 
     variant = load_variant(variant_name)

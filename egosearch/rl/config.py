@@ -37,7 +37,7 @@ CURRICULUM_END_RADIUS = 12.0
 ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent", "ppo")
 """Learners :mod:`egosearch.rl.train` can run (see ``LearnerConfig.algorithm``)."""
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
-"""Forms of r_d (the env's ``egosearch.env.DISTANCE_REWARDS``; a test keeps them equal)."""
+"""Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; a test keeps them equal)."""
 ENCODER_AUX_LOSSES = ("none", "reconstruction")
 """Auxiliary losses on the "sac_drq" encoder (see ``LearnerConfig.encoder_aux_loss``)."""
 
@@ -204,7 +204,7 @@ class LearnerConfig:
     policy trains, and so is evaluated, in the ``*Memory-v0`` env of its variant's id
     (EgoSearch-v0 -> EgoSearchMemory-v0, EgoSearchNoHead-v0 -> EgoSearchNoHeadMemory-v0), whose
     observation also carries where the target was last seen, by the searcher's own odometry, and
-    the steps since (``egosearch.env``): the same as naming that id in the variant file. This
+    the steps since (``egosearch.sim.env``): the same as naming that id in the variant file. This
     CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
     ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
     profile never."""
@@ -237,7 +237,7 @@ class LearnerConfig:
     and "ppo" only; for "ppo" the value network reads it): an asymmetric
     actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
     and the target's positions, the target in the body's frame, its distance: see
-    ``egosearch.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
+    ``egosearch.sim.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
     (history + state, not state alone). The actor, and so every policy and actor file, sees only
     the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
     ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""

@@ -41,7 +41,7 @@ import gymnasium
 import numpy as np
 import torch
 
-from egosearch.machine import cpu_model, cpu_vector_unit, gpu_model
+from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
@@ -228,7 +228,7 @@ class ActorPolicy:
 
     def fits(self, env_id: str) -> bool:
         """Whether the actor's action and observation sizes are those of the registered ``env_id``."""
-        from egosearch.envs import env_space_dims
+        from egosearch.sim.envs import env_space_dims
 
         dims = env_space_dims(env_id)
         if "mask_dim" in self.arch and "proprio_dim" in self.arch:
@@ -239,7 +239,7 @@ class ActorPolicy:
     def trained_env_id(self) -> str | None:
         """The env id the actor was trained in: the one its file records, else the one registered id
         whose sizes it fits (None when no single id does)."""
-        from egosearch.envs import ENV_IDS
+        from egosearch.sim.envs import ENV_IDS
 
         if self.env_id:
             return self.env_id
@@ -252,7 +252,7 @@ class ActorPolicy:
         the first episode's step."""
         if self.fits(env_id):
             return
-        from egosearch.envs import env_space_dims
+        from egosearch.sim.envs import env_space_dims
 
         trained = self.trained_env_id()
         dims = env_space_dims(env_id)
@@ -486,12 +486,12 @@ def torch_threads(requested: int = 0) -> int:
 def _make_env(env_id: str, env_kwargs: dict):
     if env_id not in gymnasium.registry:
         try:
-            import egosearch.envs  # noqa: F401  (registers the EgoSearch ids)
+            import egosearch.sim.envs  # noqa: F401  (registers the EgoSearch ids)
         except ImportError:
             pass
-    if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.home_pool)
-        from egosearch.home_pool import HomePoolEnv
+    if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.sim.home_pool)
         from egosearch.scene.layouts import LAYOUT_NAMES
+        from egosearch.sim.home_pool import HomePoolEnv
 
         if env_kwargs["layout"] == "paper_homes":
             return HomePoolEnv(env_id, home_names=LAYOUT_NAMES, **env_kwargs)
@@ -517,7 +517,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     lent for minutes); the summary then has ``"stopped": True`` and no actor is written. The next
     call resumes from that checkpoint.
     """
-    from egosearch.envs import observed_env_id
+    from egosearch.sim.envs import observed_env_id
 
     cfg = cfg.validate()
     env_id = observed_env_id(env_id, cfg.target_memory)
@@ -565,7 +565,7 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
     privileged state when the critic reads it (``critic_privileged_state``). The paper's values are
     the env's defaults, so they are not passed (envs without the options still train)."""
-    from egosearch.agent import AgentSpec
+    from egosearch.sim.agent import AgentSpec
 
     aids: dict = {}
     if cfg.train_distance_reward != "distance":

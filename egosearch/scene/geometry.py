@@ -3,7 +3,7 @@
 This reads the scene description only (no physics engine), so it can check what pybullet does:
 the body is an upright cylinder of ``radius`` from ``z0`` to ``z1`` centred at (x, y). Boxes are
 yawed rectangles extruded along z, cylinders upright circles, meshes their bounding box (as
-:func:`egosearch.world.add_static_part` builds them).
+:func:`egosearch.sim.world.add_static_part` builds them).
 """
 
 from __future__ import annotations

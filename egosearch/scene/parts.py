@@ -1,9 +1,9 @@
 """The scene description: plain data, no engine.
 
 A home is a tuple of :class:`Part` (what is solid) and a tuple of :class:`SupportSurface`
-(where a target may rest). Physics (``egosearch.world``), the depth sensor
-(``egosearch.sensor``), the pictures (``egosearch.render``) and the navigation grid
-(``egosearch.navgrid``) each build their own view from this one description.
+(where a target may rest). Physics (``egosearch.sim.world``), the depth sensor
+(``egosearch.sim.sensor``), the pictures (``egosearch.sim.render``) and the navigation grid
+(``egosearch.sim.navgrid``) each build their own view from this one description.
 
 Conventions, shared by every consumer:
 - world frame: metres, z up, the floor is the plane z = 0;

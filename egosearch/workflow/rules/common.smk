@@ -122,7 +122,7 @@ def bound_files(bounds=BOUNDS, placements=None, homes=None):
 def fig6_random_files():
     """The random searcher on the Table 1 cells the reference is evaluated in during training (Figure 6's
     curves): its level in that figure."""
-    from egosearch.home_pool import curve_homes
+    from egosearch.sim.home_pool import curve_homes
 
     train_env = VARIANTS[REF].train_env
     homes = [h for h in curve_homes(train_env) if h in HOMES]
@@ -153,7 +153,7 @@ def budget_inputs():
 
 # The generalisation benchmark (generalise.smk): each group of homes is one scenario file per
 # placement; GEN_GROUPS maps a group to its generated home seeds [first, stop).
-from egosearch.home_pool import HELDOUT_HOME_SEEDS
+from egosearch.sim.home_pool import HELDOUT_HOME_SEEDS
 
 GEN = config["generalise"]
 GEN_HEIGHT = f"{GEN['height']:g}"

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
-SCHEMA_PATH = Path(__file__).resolve().parent / "workflow" / "config.schema.json"
+SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
 
 
 class ConfigError(ValueError):

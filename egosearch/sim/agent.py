@@ -1,6 +1,6 @@
 """The abstract searcher of paper section 4: a cylinder body with a 2-DOF camera.
 
-Plain numbers only; the physics lives in :mod:`egosearch.world`.
+Plain numbers only; the physics lives in :mod:`egosearch.sim.world`.
 
 An env step lasts :data:`STEP_SECONDS` so that the paper's 100 steps are about 15 s of
 human motion (paper 6.1). The per-step bounds below are human limits at that rate.

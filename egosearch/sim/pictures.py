@@ -19,8 +19,8 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 def agent_parts(x: float, y: float, yaw: float, camera_height: float):
     """The abstract searcher drawn as parts: a body cylinder and a camera box on a neck."""
-    from egosearch.agent import AgentSpec
     from egosearch.scene.parts import Part
+    from egosearch.sim.agent import AgentSpec
 
     spec = AgentSpec()
     body_top = max(0.2, camera_height - 0.15)
@@ -34,7 +34,7 @@ def agent_parts(x: float, y: float, yaw: float, camera_height: float):
 
 def _viewpoint(layout: str, target, height: float, rng, near: float = 0.8, far: float = 1.8):
     """A free body position from which the camera at ``height`` sees the target."""
-    from egosearch.scenarios import navgrid_for, visible_from
+    from egosearch.sim.scenarios import navgrid_for, visible_from
 
     grid = navgrid_for(layout)
     gx, gy = np.meshgrid(grid.xs, grid.ys)
@@ -52,8 +52,8 @@ def _viewpoint(layout: str, target, height: float, rng, near: float = 0.8, far: 
 
 def _over_the_shoulder(layout: str, scene, x: float, y: float, yaw: float, height: float):
     """A third-person eye behind the searcher that sees it past walls and furniture."""
-    from egosearch.scenarios import visible_from
     from egosearch.scene.parts import Part
+    from egosearch.sim.scenarios import visible_from
 
     head = Part("probe", "box", (x, y, height - 0.3), (0.3, 0.3, 0.6))
     x0, y0, x1, y1 = scene.bounds
@@ -74,12 +74,12 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from egosearch.render import SceneRenderer, depth_to_colormap
     from egosearch.scene.layouts import get_scene
     from egosearch.scene.objects import TARGET_OBJECTS, get_object
     from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
     from egosearch.scene.topdown import plot_topdown
-    from egosearch.sensor import DepthMaskSensor
+    from egosearch.sim.render import SceneRenderer, depth_to_colormap
+    from egosearch.sim.sensor import DepthMaskSensor
 
     scene = get_scene(layout)
     out = Path(out_dir)

@@ -1,7 +1,7 @@
 """Per-step traces of evaluation episodes: where the body was, where the camera looked, what it saw.
 
 ``egosearch evaluate --traces FILE.npz`` hands a :class:`TraceRecorder` to
-:func:`egosearch.evaluate.evaluate`; it writes one compressed ``.npz`` per scenario file (read back by
+:func:`egosearch.runs.evaluate.evaluate`; it writes one compressed ``.npz`` per scenario file (read back by
 ``egosearch.report.behaviour.read_trace_file``). Every array
 of length N is a column (one row per step, episodes stacked); the 0-d arrays are the file's facts
 (``env_id``, ``head``, ``step_seconds``, ``max_depth``, ``format``). Row 0 of an episode is the state
@@ -179,7 +179,7 @@ class HomeProbe:
 
 
 class TraceRecorder:
-    """Collects the rows of every episode :func:`egosearch.evaluate.run_episode` runs with it."""
+    """Collects the rows of every episode :func:`egosearch.runs.evaluate.run_episode` runs with it."""
 
     def __init__(self):
         self.columns: dict[str, list] = {name: [] for name in TRACE_COLUMNS}
@@ -187,7 +187,7 @@ class TraceRecorder:
         self._probes: dict[str, HomeProbe] = {}
 
     def start(self, env, scenario, info: dict) -> None:
-        from egosearch.scenarios import navgrid_for, shortest_path_region
+        from egosearch.sim.scenarios import navgrid_for, shortest_path_region
 
         base = env.unwrapped
         if scenario.layout not in self._probes:
@@ -206,7 +206,7 @@ class TraceRecorder:
         self._add(env.unwrapped, action, info, collided=bool(info.get("collided", False)))
 
     def _add(self, base, action, info: dict, collided: bool) -> None:
-        from egosearch.sensor import camera_axes
+        from egosearch.sim.sensor import camera_axes
 
         s, target, probe = base.state, base.target, self._probe
         point, kind, part, surface = probe.gaze(s.camera_position, camera_axes(s.camera_yaw, s.pitch)[2],
@@ -253,6 +253,6 @@ class TraceRecorder:
 
 
 def _step_seconds() -> float:
-    from egosearch.agent import STEP_SECONDS
+    from egosearch.sim.agent import STEP_SECONDS
 
     return STEP_SECONDS

@@ -6,10 +6,10 @@ import os
 
 import gymnasium
 
-import egosearch.envs  # noqa: F401  (registers the ids)
-from egosearch.csvio import write_csv_atomic
-from egosearch.metrics import episode_spl
-from egosearch.scenarios import Scenario
+import egosearch.sim.envs  # noqa: F401  (registers the ids)
+from egosearch.core.csvio import write_csv_atomic
+from egosearch.runs.metrics import episode_spl
+from egosearch.sim.scenarios import Scenario
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl",
                    "collisions", "episode_return")
@@ -23,7 +23,7 @@ def make_env(env_id: str, scenario: Scenario, **kwargs) -> gymnasium.Env:
 
 def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0, recorder=None) -> dict:
     """One deterministic episode of ``policy`` on ``scenario``; ``recorder`` (an
-    :class:`egosearch.trace.TraceRecorder`) is shown the state after the reset and after every step."""
+    :class:`egosearch.runs.trace.TraceRecorder`) is shown the state after the reset and after every step."""
     obs, info = env.reset(seed=seed, options={"scenario": scenario})
     policy.reset(seed=seed)
     if recorder is not None:
@@ -85,9 +85,9 @@ def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: 
     in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
     ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
     variant trains with, so that the curves of variants are on one scale."""
-    from egosearch.agent import EVAL_HEIGHTS
-    from egosearch.metrics import spl
-    from egosearch.scenarios import generate_scenarios
+    from egosearch.runs.metrics import spl
+    from egosearch.sim.agent import EVAL_HEIGHTS
+    from egosearch.sim.scenarios import generate_scenarios
 
     layouts = [layout] if isinstance(layout, str) else list(layout)
     groups = [(home, h) for home in layouts for h in EVAL_HEIGHTS]

@@ -4,7 +4,7 @@ Cells are unknown, free or occupied (0.1 m). Each depth frame marks the floor it
 floor along each ray up to what it hits, as free, and every point at a body's height
 (``OBSTACLE_BAND``) as occupied; occupied is never overwritten by free. The map also counts the
 steps the body spent in each cell. The classical frontier searcher plans on it
-(:mod:`egosearch.frontier`); the env's ``floor_map`` option summarises it around the body for a
+(:mod:`egosearch.searchers.frontier`); the env's ``floor_map`` option summarises it around the body for a
 learned actor (:meth:`FloorMap.egocentric`).
 
 It reads the pose as habitat's GPS+compass sensor gives it (position, heading, head angles and
@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from egosearch.sensor import camera_axes, pixel_rays_camera
+from egosearch.sim.sensor import camera_axes, pixel_rays_camera
 
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2
 

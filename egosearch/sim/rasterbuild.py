@@ -1,6 +1,6 @@
 """How the depth sensor's C rasteriser (``raster.c``) is compiled, in one place for both builds:
 ``setup.py`` builds it at ``pip install`` (beside this file, as ``_raster<extension suffix>``), and
-:mod:`egosearch.sensor` compiles it on first use into a cache when the install could not.
+:mod:`egosearch.sim.sensor` compiles it on first use into a cache when the install could not.
 
 Standard library only: ``setup.py`` loads this file by its path, before egosearch's dependencies
 (numpy...) are installed.
@@ -8,7 +8,7 @@ Standard library only: ``setup.py`` loads this file by its path, before egosearc
 Every build records what it was built from and for, as the string its ``egosearch_raster_build()``
 returns (``"<source key> <target>"``), and the loader uses a library only when :func:`usable_here`:
 an installed library left from an older ``raster.c`` (an editable install whose source changed
-since) may not match the calls of :mod:`egosearch.sensor`, and one tuned with ``-march=native`` may
+since) may not match the calls of :mod:`egosearch.sim.sensor`, and one tuned with ``-march=native`` may
 stop with an illegal instruction on another CPU (an install shared by cluster nodes of another kind).
 """
 
@@ -21,7 +21,7 @@ from pathlib import Path
 
 SOURCE = Path(__file__).with_name("raster.c")
 LIBRARY = "_raster"
-"""The installed library's name in the package: ``egosearch/_raster<EXTENSION_SUFFIX>``."""
+"""The installed library's name in the package: ``egosearch/sim/_raster<EXTENSION_SUFFIX>``."""
 PORTABLE = "portable"
 BASE_FLAGS = ("-O3", "-fno-math-errno")
 """Beside the compiler's own for a shared library (-fPIC -shared)."""

@@ -18,10 +18,10 @@ same odometry), the cheapest memory the policy lacks: it forgets a target as soo
 With ``floor_map=True`` (the ``*Map-v0`` ids, also a CHANGE OF OBSERVATION) it gains
 :data:`FLOOR_MAP_DIM` more: a 7 x 7 grid of 0.6 m squares around the body, turning with it, saying
 how much of each square's floor it has seen, how much of it is occupied, and whether it has stood
-there (:class:`egosearch.floormap.FloorMap`, built from its own depth frames and pose): the map a
+there (:class:`egosearch.sim.floormap.FloorMap`, built from its own depth frames and pose): the map a
 classical searcher plans on, as a memory of where it has been and what it has not seen.
 
-Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.agent.AgentSpec`
+Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.sim.agent.AgentSpec`
 (head-off: [dx, dy, dtheta]).
 
 Reward: r = 1.0 r_s + 1.0 r_d + 1.0 r_l + 0.1 r_c with r_s = 10 on success, r_d = minus the
@@ -35,7 +35,7 @@ Two ways to start an episode:
   collision-free start, camera height U[1.0, 1.8] m per episode plus U[-0.1, 0.1] m per step;
   ``reset(options={"start_radius": r})`` draws the start within r m of the target (a training
   curriculum: ``LearnerConfig.curriculum_steps``);
-- evaluation: ``reset(options={"scenario": s})`` with an :class:`egosearch.scenarios.Scenario`,
+- evaluation: ``reset(options={"scenario": s})`` with an :class:`egosearch.sim.scenarios.Scenario`,
   at its fixed height without noise.
 """
 
@@ -48,9 +48,13 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from egosearch.agent import AgentSpec, AgentState, check_height
-from egosearch.floormap import FloorMap
-from egosearch.scenarios import (
+from egosearch.scene import layouts as layouts_mod
+from egosearch.scene.objects import TARGET_OBJECTS, get_object
+from egosearch.scene.parts import Part
+from egosearch.scene.placement import sample_target
+from egosearch.sim.agent import AgentSpec, AgentState, check_height
+from egosearch.sim.floormap import FloorMap
+from egosearch.sim.scenarios import (
     MAX_STEPS,
     SUCCESS_DISTANCE,
     Scenario,
@@ -58,12 +62,8 @@ from egosearch.scenarios import (
     navgrid_for,
     shortest_path_region,
 )
-from egosearch.scene import layouts as layouts_mod
-from egosearch.scene.objects import TARGET_OBJECTS, get_object
-from egosearch.scene.parts import Part
-from egosearch.scene.placement import sample_target
-from egosearch.sensor import DepthMaskSensor, camera_axes, mask_feature, pixel_rays_camera
-from egosearch.world import World
+from egosearch.sim.sensor import DepthMaskSensor, camera_axes, mask_feature, pixel_rays_camera
+from egosearch.sim.world import World
 
 FRAME_HISTORY = 5
 """K of paper 4.1."""
@@ -448,7 +448,7 @@ class SearchEnv(gymnasium.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
-        from egosearch.render import depth_to_colormap
+        from egosearch.sim.render import depth_to_colormap
 
         return depth_to_colormap(self._last_depth.astype(np.float32) / 255.0 * self.sensor.max_depth,
                                  self._last_mask, max_depth=self.sensor.max_depth)

@@ -12,9 +12,9 @@ from typing import Protocol
 
 import numpy as np
 
-from egosearch.agent import wrap_angle
-from egosearch.navgrid import NavGrid
-from egosearch.scenarios import SUCCESS_DISTANCE, navgrid_for, success_region
+from egosearch.sim.agent import wrap_angle
+from egosearch.sim.navgrid import NavGrid
+from egosearch.sim.scenarios import SUCCESS_DISTANCE, navgrid_for, success_region
 
 
 class Policy(Protocol):

@@ -75,9 +75,9 @@ from pathlib import Path
 
 import numpy as np
 
-from egosearch import rasterbuild
 from egosearch.scene.meshes import part_mesh, scene_meshes
 from egosearch.scene.parts import Part, Scene
+from egosearch.sim import rasterbuild
 
 DEFAULT_WIDTH = 100
 DEFAULT_HEIGHT = 100
@@ -293,7 +293,7 @@ def _installed_library() -> Path | None:
 
 
 def _build_of(lib) -> str:
-    """What ``lib`` was built from and for (see :mod:`egosearch.rasterbuild`)."""
+    """What ``lib`` was built from and for (see :mod:`egosearch.sim.rasterbuild`)."""
     try:
         fn = lib.egosearch_raster_build
     except AttributeError:

@@ -25,14 +25,14 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from egosearch.agent import AgentSpec
 from egosearch.scene.parts import Part, Scene
+from egosearch.sim.agent import AgentSpec
 
 _MOVES = [(1, 0), (0, 1), (1, 1), (1, -1), (2, 1), (1, 2), (2, -1), (1, -2)]
 #: Grid cell size (m): a tenth of the body diameter.
 DEFAULT_RESOLUTION = 0.05
 #: The deepest the env may leave the body inside an obstacle after a step (m): the rule that
-#: egosearch.world enforces (this module must not import the physics engine).
+#: egosearch.sim.world enforces (this module must not import the physics engine).
 MAX_PENETRATION = 0.01
 #: ℓ's guarantee: the path p of any success satisfies p >= (ℓ - additive) / (1 + relative).
 #: relative: the 16-connected grid's 2.7% excess over a straight line; additive: the start

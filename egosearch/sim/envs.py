@@ -1,8 +1,8 @@
-"""Every gymnasium id egosearch provides, registered in one place (``import egosearch.envs``)."""
+"""Every gymnasium id egosearch provides, registered in one place (``import egosearch.sim.envs``)."""
 
 from gymnasium.envs.registration import register, registry
 
-#: id -> fixed keyword arguments of :class:`egosearch.env.SearchEnv`.
+#: id -> fixed keyword arguments of :class:`egosearch.sim.env.SearchEnv`.
 ENV_IDS = {
     "EgoSearch-v0": {"head": True},
     "EgoSearchNoHead-v0": {"head": False},
@@ -17,12 +17,12 @@ ENV_IDS = {
 for _env_id, _kwargs in ENV_IDS.items():
     if _env_id not in registry:
         # SearchEnv enforces T_max itself (truncated=True at step 100), so no TimeLimit wrapper.
-        register(id=_env_id, entry_point="egosearch.env:SearchEnv", kwargs=dict(_kwargs))
+        register(id=_env_id, entry_point="egosearch.sim.env:SearchEnv", kwargs=dict(_kwargs))
 
 
 def env_space_dims(env_id: str) -> dict[str, int]:
     """``{"action", "mask", "proprio"}`` sizes of a registered id, without building its env."""
-    from egosearch.env import space_dims
+    from egosearch.sim.env import space_dims
 
     return space_dims(**ENV_IDS[env_id])
 

@@ -3,7 +3,7 @@
 The body is a cylinder on a planar (x, y, yaw) joint chain; each env step sets a target
 configuration and pybullet's position control tracks it, so walls and furniture stop the body
 instead of being teleported through. The camera joints need no physics: they are clamped
-angles in :class:`egosearch.agent.AgentState`.
+angles in :class:`egosearch.sim.agent.AgentState`.
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from egosearch.agent import AgentSpec
-from egosearch.bullet import connect, pybullet
 from egosearch.scene.parts import Part, Scene
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.bullet import connect, pybullet
 
 #: Physics sub-steps per env step. Enough that the body (moving <= 0.25 m per env step)
 #: advances less than half its radius per sub-step, so it cannot tunnel through a 0.1 m wall.
@@ -26,7 +26,7 @@ PENETRATION_TOLERANCE = 0.005
 #: Deepest (m) the body may be in the home after any sub-step. Deeper means the motors are
 #: squeezing it through a gap narrower than itself (two chair and sofa arms 33 cm apart let a
 #: 40 cm body through, 4.5 cm deep at the pinch, and the step ended outside both); the step then
-#: stops before the pinch. Below ``egosearch.navgrid.MAX_PENETRATION`` (1 cm), the bound that
+#: stops before the pinch. Below ``egosearch.sim.navgrid.MAX_PENETRATION`` (1 cm), the bound that
 #: ℓ's grid assumes, by 2 mm for pybullet's cylinder against the exact geometry (a test keeps it
 #: below; this module must not import that one's scipy).
 SWEEP_TOLERANCE = 0.008

@@ -1,8 +1,8 @@
 """Pictures of a scene with pyrender (figures, videos, and a cross-check of the sensor).
 
-Never on the training hot path: the training sensor is :class:`egosearch.sensor.DepthMaskSensor`.
+Never on the training hot path: the training sensor is :class:`egosearch.sim.sensor.DepthMaskSensor`.
 The camera convention (yaw, pitch, pixel centres, z-depth, horizontal field of view) is the one
-documented in :mod:`egosearch.sensor`.
+documented in :mod:`egosearch.sim.sensor`.
 
 Headless use needs ``PYOPENGL_PLATFORM=egl`` (set here by default before pyrender is imported).
 The depth pass runs WITHOUT multisampling: pyrender 0.1.45 always renders into a 4x multisample
@@ -27,7 +27,7 @@ import trimesh  # noqa: E402
 
 from egosearch.scene.meshes import part_mesh  # noqa: E402
 from egosearch.scene.parts import Part, Scene  # noqa: E402
-from egosearch.sensor import (  # noqa: E402
+from egosearch.sim.sensor import (  # noqa: E402
     DEFAULT_FOV_DEG,
     DEFAULT_HEIGHT,
     DEFAULT_MAX_DEPTH,

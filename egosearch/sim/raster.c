@@ -182,7 +182,7 @@ int render_frame(const float* sv, const int* st, const int* sg, const double* ss
 
 /* What this library was built from and for: "<source key> <target>", target "portable" or the key
    of the CPU it was tuned for (-march=native). The loader compares it with the raster.c and the CPU
-   it has (egosearch/rasterbuild.py); the build passes it as a define. */
+   it has (egosearch/sim/rasterbuild.py); the build passes it as a define. */
 #ifndef EGOSEARCH_RASTER_BUILD
 #define EGOSEARCH_RASTER_BUILD "unknown"
 #endif

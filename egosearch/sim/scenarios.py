@@ -6,7 +6,7 @@ camera height, placement scheme), so that every policy is evaluated on the same 
 satisfies success (within :data:`SUCCESS_DISTANCE` of the target *and* seeing it at this
 camera height). ℓ counts every position where the env may leave the body, in contact with
 furniture too, so that it is a lower bound on the path of every success, up to
-:data:`egosearch.navgrid.LOWER_BOUND_SLACK`. A scenario is kept only when the privileged oracle's
+:data:`egosearch.sim.navgrid.LOWER_BOUND_SLACK`. A scenario is kept only when the privileged oracle's
 route, through surely free cells, reaches a success within :data:`MAX_SHORTEST_PATH`.
 """
 
@@ -21,14 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
-from egosearch.agent import AgentSpec, check_height
-from egosearch.csvio import write_csv_atomic
-from egosearch.navgrid import NavGrid
+from egosearch.core.csvio import write_csv_atomic
 from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.meshes import scene_meshes
 from egosearch.scene.objects import TARGET_OBJECTS, get_object, target_part
 from egosearch.scene.parts import Part, Scene
 from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
+from egosearch.sim.agent import AgentSpec, check_height
+from egosearch.sim.navgrid import NavGrid
 
 SUCCESS_DISTANCE = 0.5
 """Paper 4.1: success when the target is within 0.5 m and seen. We measure it horizontally from
@@ -250,7 +250,7 @@ def shortest_path_region(layout: str, target: Part, height: float, distance: flo
 
 def shortest_path_length(layout: str, target: Part, height: float, x: float, y: float) -> float:
     """ℓ of SPL from a start at (x, y): a lower bound on the path of every success, up to
-    :data:`egosearch.navgrid.LOWER_BOUND_SLACK`."""
+    :data:`egosearch.sim.navgrid.LOWER_BOUND_SLACK`."""
     grid = navgrid_for(layout)
     return grid.lower_bound_length(grid.distances_to(shortest_path_region(layout, target, height), reachable=True),
                                    x, y)

@@ -20,10 +20,10 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from egosearch.agent import wrap_angle
-from egosearch.floormap import FREE, OCCUPIED, UNKNOWN, FloorMap
-from egosearch.scenarios import SUCCESS_DISTANCE
-from egosearch.sensor import camera_axes
+from egosearch.sim.agent import wrap_angle
+from egosearch.sim.floormap import FREE, OCCUPIED, UNKNOWN, FloorMap
+from egosearch.sim.scenarios import SUCCESS_DISTANCE
+from egosearch.sim.sensor import camera_axes
 
 
 class FrontierPolicy:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import gymnasium
 
-import egosearch.envs  # noqa: F401  (registers the ids this env builds)
+import egosearch.sim.envs  # noqa: F401  (registers the ids this env builds)
 
 HELDOUT_HOME_SEEDS = range(900_000, 900_020)
 """The held-out split: generated homes ``home900000`` ... ``home900019``, evaluated by
@@ -54,7 +54,7 @@ def check_home_split(home_seeds) -> range:
     held = HELDOUT_HOME_SEEDS
     if first < held.stop and held.start < stop:
         raise ValueError(f"home_seeds=[{first}, {stop}) overlaps the held-out homes [{held.start}, {held.stop}) "
-                         "that no training may draw (egosearch.home_pool.HELDOUT_HOME_SEEDS)")
+                         "that no training may draw (egosearch.sim.home_pool.HELDOUT_HOME_SEEDS)")
     return range(first, stop)
 
 
