@@ -65,7 +65,7 @@ def _make_policy_factory(kind: str, weights: str | None, seed: int, env_id: str 
     if kind == "actor":
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
-        from egosearch.rl.train import ActorPolicy
+        from egosearch.rl.actor import ActorPolicy
 
         actor = ActorPolicy(weights)
         env_id = env_id or actor.trained_env_id() or "EgoSearch-v0"

@@ -418,7 +418,7 @@ def test_a_variant_compared_with_itself_is_one_line(tmp_path, capsys, suite, mon
 
 def _actor_file(path: Path, action_dim: int, metadata: dict) -> Path:
     from egosearch.rl.config import load_config
-    from egosearch.rl.train import make_agent
+    from egosearch.rl.registry import make_agent
 
     agent = make_agent(load_config("smoke", {"device": "cpu"}), action_dim, 30, 4, torch.device("cpu"))
     torch.save(agent.actor_state(metadata), path)
@@ -428,7 +428,7 @@ def _actor_file(path: Path, action_dim: int, metadata: dict) -> Path:
 def test_an_actor_in_the_wrong_env_is_one_line_naming_its_env(tmp_path, capsys, no_work):
     """A head_off actor (3 action values) in EgoSearch-v0 (5) failed only in the first step, with numpy's
     broadcasting error; its file records the env id, or the sizes tell it."""
-    from egosearch.rl.train import ActorPolicy
+    from egosearch.rl.actor import ActorPolicy
 
     recorded = _actor_file(tmp_path / "recorded.pt", 3, {"variant": "head_off", "env_id": "EgoSearchNoHead-v0"})
     unrecorded = _actor_file(tmp_path / "unrecorded.pt", 3, {})

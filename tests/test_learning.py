@@ -15,8 +15,9 @@ on the first 20 of the scenarios below, 8 minutes beside two trainings), more th
 import numpy as np
 import pytest
 
+from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.config import load_config
-from egosearch.rl.train import ActorPolicy, train
+from egosearch.rl.train import train
 from egosearch.runs.evaluate import evaluate
 from egosearch.searchers.policies import RandomPolicy
 from egosearch.sim.scenarios import generate_scenarios

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import SacDrqAgent
-from egosearch.rl.train import ActorPolicy, train, train_env_kwargs
+from egosearch.rl.train import train, train_env_kwargs
 from egosearch.scene.parts import Part
 from egosearch.sim.agent import AgentState
 from egosearch.sim.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state

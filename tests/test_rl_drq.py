@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import PooledConvEncoder, SacDrqAgent, conv_sides, pool_depth, random_shift
-from egosearch.rl.train import ActorPolicy, train
+from egosearch.rl.train import train
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.config import load_config
 from egosearch.rl.ppo import PpoAgent, clipped_surrogate, gae, squashed_log_prob
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import ACTOR_FORMAT as DRQ_ACTOR_FORMAT
-from egosearch.rl.train import ActorPolicy
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))

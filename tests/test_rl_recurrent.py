@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.rl.actor import ActorPolicy, load_any_actor_net
 from egosearch.rl.config import load_config, table2_rows
 from egosearch.rl.replay import MultiReplay
+from egosearch.rl.run_files import CHECKPOINT_NAME
 from egosearch.rl.sac_drq_recurrent import (
     ACTOR_FORMAT,
     SacDrqRecurrentAgent,
@@ -18,7 +20,7 @@ from egosearch.rl.sac_drq_recurrent import (
     sample_sequences,
     sequences_per_batch,
 )
-from egosearch.rl.train import CHECKPOINT_NAME, ActorPolicy, load_any_actor_net, train
+from egosearch.rl.train import train
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))

@@ -33,9 +33,10 @@ import torch
 
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
+from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
-from egosearch.rl.train import make_agent, torch_threads
+from egosearch.rl.train import torch_threads
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
 
 

@@ -320,7 +320,7 @@ class SacDrqRecurrentAgent(PooledReplay):
             self._h[env_index] = 0.0
 
     def reset_policy_state(self) -> None:
-        """Zero the evaluation policy's hidden state (:class:`egosearch.rl.train.AgentPolicy`)."""
+        """Zero the evaluation policy's hidden state (:class:`egosearch.rl.actor.AgentPolicy`)."""
         self._eval_h = None
 
     def _step(self, obs: dict, h: torch.Tensor | None, deterministic: bool):

@@ -1,5 +1,6 @@
-"""Train a learner (SAC + CURL or SAC-DrQ, ``cfg.algorithm``) on an egosearch env, resumably; and
-``ActorPolicy`` to run the result.
+"""The training loop: train the learner ``cfg.algorithm`` names (:mod:`egosearch.rl.registry`) on an
+egosearch env, resumably. Its files are written by :mod:`egosearch.rl.run_files`; the actor it
+leaves is run by :class:`egosearch.rl.actor.ActorPolicy`.
 
 ``train(env_id, cfg, out_dir)`` writes into ``out_dir``:
 
@@ -14,7 +15,7 @@
   deleted at the end unless ``cfg.keep_checkpoint`` (it holds the replay buffer: up to ~1 GB,
   never commit it);
 - ``actor.pt``: actor-only weights + metadata (variant, env_id, config), readable with
-  ``torch.load(weights_only=True)``; load it with :class:`ActorPolicy`;
+  ``torch.load(weights_only=True)``; load it with :class:`egosearch.rl.actor.ActorPolicy`;
 - ``done.json``: written last; its presence means the run is complete.
 
 Killing the process at any moment and running the same call again resumes from the last
@@ -42,108 +43,37 @@ import numpy as np
 import torch
 
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
-from egosearch.rl.common import METRIC_KEYS, AgentStateError, obs_to_tensors, resolve_device
+from egosearch.rl.actor import AgentPolicy
+from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.registry import ALGORITHM_NAMES, make_agent
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.sac_curl import SacCurlAgent, load_actor_net
+from egosearch.rl.run_files import (
+    CHECKPOINT_FORMAT,
+    CHECKPOINT_NAME,
+    CheckpointError,
+    CsvLogger,
+    atomic_json,
+    atomic_write,
+    check_same_run,
+    describe_error,
+    env_kwargs_key,
+    load_checkpoint,
+    restore_rng_states,
+    rng_states,
+    to_numpy,
+    to_tensors,
+)
 
-CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
-CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
-"""The resumable state inside ``out_dir`` (``*.ckpt`` is git-ignored: it holds the replay)."""
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
 CURVE_EPISODE_COLUMNS = ("env_steps", "home", "height", "scenario_id", "success", "shortest_path", "path_length")
 TRAIN_COLUMNS = ("env_steps", "episodes", "updates", "train_return", "train_success", "critic_loss",
                  "actor_loss", "alpha_loss", "curl_loss", "aux_loss", "alpha", "entropy", "q_mean", "steps_per_s",
                  "updates_per_s", "wall_s")
-_ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recurrent": "recurrent SAC-DrQ",
-                    "ppo": "PPO"}
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
-RESUMABLE_FIELDS = ("device", "num_threads", "compile", "cuda_graph", "keep_checkpoint")
-"""Config fields that may differ between a checkpoint and the run resuming it."""
-
-
-class CheckpointError(RuntimeError):
-    """A checkpoint / finished run in ``out_dir`` is unreadable or belongs to another run."""
-
-
-# ---- small utilities ----------------------------------------------------------------------
-
-def atomic_write(path: Path, write: Callable[[Any], None], mode: str = "wb") -> None:
-    """Write ``path`` via a temp file in the same folder, fsync, ``os.replace``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".tmp{os.getpid()}.{path.name}")  # same suffix: same ignore rules
-    try:
-        with open(tmp, mode) as f:
-            write(f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    try:  # make the rename itself durable
-        fd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-    except OSError:
-        pass
-
-
-def atomic_json(path: Path, obj: Any) -> None:
-    atomic_write(path, lambda f: f.write(json.dumps(obj, indent=2, sort_keys=True) + "\n"), mode="w")
-
-
-class CsvLogger:
-    """A fixed-column CSV (DrQ-v2 style): header once, one row per ``write``, flushed and fsynced.
-
-    Values are written with ``repr``-precision floats; NaN for missing metrics. ``truncate(n)``
-    keeps the header and the first ``n`` rows (used on resume)."""
-
-    def __init__(self, path: Path, columns: tuple[str, ...]):
-        self.path, self.columns = Path(path), tuple(columns)
-        self.header = ",".join(self.columns)
-
-    def rows(self) -> int:
-        if not self.path.exists():
-            return 0
-        with open(self.path) as f:
-            lines = [line for line in f.read().splitlines() if line]
-        return max(0, len(lines) - 1)
-
-    def truncate(self, n_rows: int) -> None:
-        lines: list[str] = []
-        if self.path.exists():
-            with open(self.path) as f:
-                lines = [line for line in f.read().splitlines() if line]
-            if lines and lines[0] != self.header:
-                raise CheckpointError(f"{self.path} has columns {lines[0]!r}, expected {self.header!r}")
-        body = lines[1:1 + n_rows]
-        if len(body) < n_rows:
-            raise CheckpointError(f"{self.path} has {len(body)} rows but the checkpoint expects {n_rows}")
-        atomic_write(self.path, lambda f: f.write("\n".join([self.header] + body) + "\n"), mode="w")
-
-    def write(self, row: dict[str, Any]) -> None:
-        extra = set(row) - set(self.columns)
-        if extra:
-            raise ValueError(f"{self.path.name}: unknown column(s) {sorted(extra)}")
-        values = []
-        for c in self.columns:
-            v = row.get(c, float("nan"))
-            if isinstance(v, str):  # a name (a home): the writer's own columns never hold commas
-                values.append(v)
-                continue
-            values.append(str(int(v)) if isinstance(v, (int, np.integer)) and not isinstance(v, bool)
-                          else repr(float(v)))
-        with open(self.path, "a") as f:
-            f.write(",".join(values) + "\n")
-            f.flush()
-            os.fsync(f.fileno())
 
 
 class _Mean:
@@ -165,114 +95,6 @@ class _Mean:
 
 
 # ---- policies -----------------------------------------------------------------------------
-
-class AgentPolicy:
-    """The live agent behind the shared policy interface (deterministic actions)."""
-
-    def __init__(self, agent):
-        self.agent = agent
-
-    def reset(self, seed: int | None = None) -> None:
-        reset_state = getattr(self.agent, "reset_policy_state", None)  # a recurrent agent's memory
-        if reset_state is not None:
-            reset_state()
-
-    def act(self, obs: dict) -> np.ndarray:
-        return self.agent.act(obs, deterministic=True)
-
-
-def load_any_actor_net(state: dict, device) -> torch.nn.Module:
-    """An actor file's network, SAC+CURL's, SAC-DrQ's or recurrent SAC-DrQ's (by its ``format``)."""
-    from egosearch.rl import sac_drq, sac_drq_recurrent
-
-    if isinstance(state, dict) and state.get("format") == sac_drq.ACTOR_FORMAT:
-        return sac_drq.load_drq_actor_net(state, device)
-    if isinstance(state, dict) and state.get("format") == sac_drq_recurrent.ACTOR_FORMAT:
-        return sac_drq_recurrent.load_recurrent_actor_net(state, device)
-    return load_actor_net(state, device)
-
-
-class ActorPolicy:
-    """A trained actor (``actor.pt``) behind the project's policy interface:
-    ``reset(seed=None)`` (no-op: the actor is memoryless given the env's frame history; a recurrent
-    actor's hidden state is zeroed) and ``act(obs) -> np.ndarray`` (deterministic: tanh of the
-    Gaussian mean, in [-1, 1]; a recurrent actor carries its hidden state to the next call)."""
-
-    def __init__(self, path: str | os.PathLike, device: str = "auto"):
-        path = Path(path)
-        # torch's own message for a non-torch file advises weights_only=False, which is wrong here.
-        not_actor = (f"{path} is not an egosearch actor file; an actor file is the actor.pt that "
-                     "`egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt)")
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no such actor file" if not path.exists() else not_actor)
-        try:
-            state = torch.load(path, map_location="cpu", weights_only=True)
-        except Exception as err:  # noqa: BLE001 - any unreadable file gets one line
-            raise AgentStateError(f"{not_actor} (torch cannot read it: {type(err).__name__})") from None
-        if not isinstance(state, dict) or "format" not in state:
-            raise AgentStateError(not_actor)
-        self.device = resolve_device(device)
-        try:
-            self.net = load_any_actor_net(state, self.device)
-        except AgentStateError as err:
-            raise AgentStateError(f"{path}: {err}") from None
-        self.path = path
-        self.arch = state["arch"]
-        self.metadata = state.get("metadata", {})
-        self.variant = self.metadata.get("variant")
-        self.env_id = self.metadata.get("env_id")
-        self.config = self.metadata.get("config")
-        self.action_dim = int(self.arch["action_dim"])
-        self.recurrent = bool(getattr(self.net, "recurrent", False))
-        self._h = None
-
-    def fits(self, env_id: str) -> bool:
-        """Whether the actor's action and observation sizes are those of the registered ``env_id``."""
-        from egosearch.sim.envs import env_space_dims
-
-        dims = env_space_dims(env_id)
-        if "mask_dim" in self.arch and "proprio_dim" in self.arch:
-            return (self.action_dim, int(self.arch["mask_dim"]), int(self.arch["proprio_dim"])) == (
-                dims["action"], dims["mask"], dims["proprio"])
-        return (self.action_dim, int(self.arch["extra_dim"])) == (dims["action"], dims["mask"] + dims["proprio"])
-
-    def trained_env_id(self) -> str | None:
-        """The env id the actor was trained in: the one its file records, else the one registered id
-        whose sizes it fits (None when no single id does)."""
-        from egosearch.sim.envs import ENV_IDS
-
-        if self.env_id:
-            return self.env_id
-        fitting = [env_id for env_id in ENV_IDS if self.fits(env_id)]
-        return fitting[0] if len(fitting) == 1 else None
-
-    def check_env(self, env_id: str) -> None:
-        """Raise :class:`AgentStateError` (one line naming the env id it was trained for) unless the
-        actor can act in ``env_id``: a mismatch otherwise surfaces only as a broadcasting error in
-        the first episode's step."""
-        if self.fits(env_id):
-            return
-        from egosearch.sim.envs import env_space_dims
-
-        trained = self.trained_env_id()
-        dims = env_space_dims(env_id)
-        told = f"was trained in {trained}" if trained else "fits no registered env id"
-        hint = f": run it in {trained}" if trained else ""
-        raise AgentStateError(f"{self.path}: this actor {told} ({self.action_dim} action values, "
-                              f"{self.arch['extra_dim']} observation values besides depth), not in {env_id} "
-                              f"({dims['action']} and {dims['mask'] + dims['proprio']}){hint}")
-
-    def reset(self, seed: int | None = None) -> None:
-        self._h = None
-
-    def act(self, obs: dict) -> np.ndarray:
-        with torch.inference_mode():
-            depth, extra = obs_to_tensors(obs, self.device, self.arch["crop_size"])
-            if self.recurrent:
-                mu, _, self._h = self.net(depth.float(), extra, self._h)
-            else:
-                mu, _ = self.net(depth.float(), extra)
-            return torch.tanh(mu)[0].cpu().numpy().astype(np.float32)
 
 
 # ---- evaluation ---------------------------------------------------------------------------
@@ -309,128 +131,6 @@ def default_evaluator(env_id: str, env_kwargs: dict, episodes: int) -> Callable[
 
 
 # ---- checkpoint helpers -------------------------------------------------------------------
-
-def _to_tensors(obj: Any) -> Any:
-    """numpy arrays -> torch tensors (so ``weights_only=True`` can read the checkpoint)."""
-    if isinstance(obj, np.ndarray):
-        return torch.from_numpy(np.ascontiguousarray(obj))
-    if isinstance(obj, dict):
-        return {k: _to_tensors(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_to_tensors(v) for v in obj]
-    return obj
-
-
-def _to_numpy(obj: Any) -> Any:
-    if isinstance(obj, torch.Tensor):
-        return obj.numpy()
-    if isinstance(obj, dict):
-        return {k: _to_numpy(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_to_numpy(v) for v in obj]
-    return obj
-
-
-def _plain_bitgen_state(state: dict) -> dict:
-    """numpy bit-generator state with its (128-bit) ints as strings: pickle-safe, plain."""
-    out: dict[str, Any] = {}
-    for k, v in state.items():
-        if isinstance(v, dict):
-            out[k] = _plain_bitgen_state(v)
-        elif isinstance(v, int) and not isinstance(v, bool):
-            out[k] = str(v)
-        else:
-            out[k] = v
-    return out
-
-
-def _from_plain_bitgen_state(state: dict) -> dict:
-    out: dict[str, Any] = {}
-    for k, v in state.items():
-        if isinstance(v, dict):
-            out[k] = _from_plain_bitgen_state(v)
-        elif isinstance(v, str) and k != "bit_generator":
-            out[k] = int(v)
-        else:
-            out[k] = v
-    return out
-
-
-def _rng_states(envs) -> dict:
-    np_state = np.random.get_state()
-    states = {
-        "torch": torch.get_rng_state(),
-        "numpy": {"key": torch.from_numpy(np_state[1].astype(np.int64)), "pos": int(np_state[2]),
-                  "has_gauss": int(np_state[3]), "cached_gaussian": float(np_state[4])},
-        "python": random.getstate(),
-        "action_space": _plain_bitgen_state(envs[0].action_space.np_random.bit_generator.state),
-    }
-    if len(envs) > 1:
-        states["action_spaces"] = [_plain_bitgen_state(e.action_space.np_random.bit_generator.state) for e in envs]
-    if torch.cuda.is_available():
-        states["cuda"] = torch.cuda.get_rng_state_all()
-    return states
-
-
-def _restore_rng_states(states: dict, envs) -> None:
-    torch.set_rng_state(states["torch"])
-    n = states["numpy"]
-    np.random.set_state(("MT19937", n["key"].numpy().astype(np.uint32), n["pos"], n["has_gauss"],
-                         n["cached_gaussian"]))
-    version, internal, gauss = states["python"]
-    random.setstate((version, tuple(internal), gauss))
-    envs[0].action_space.np_random.bit_generator.state = _from_plain_bitgen_state(states["action_space"])
-    for e, state in zip(envs[1:], states.get("action_spaces", [])[1:]):
-        e.action_space.np_random.bit_generator.state = _from_plain_bitgen_state(state)
-    if "cuda" in states and torch.cuda.is_available():
-        torch.cuda.set_rng_state_all(states["cuda"])
-
-
-def _describe(err: BaseException) -> str:
-    text = str(err).strip().splitlines()
-    return f"{type(err).__name__}: {text[0] if text else ''}"
-
-
-def load_checkpoint(path: Path) -> dict:
-    """Read a checkpoint (``weights_only=True``); unreadable -> one-line ``CheckpointError``."""
-    try:
-        state = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as err:  # noqa: BLE001
-        raise CheckpointError(f"cannot read checkpoint {path} ({_describe(err)}); delete it to "
-                              "start over") from None
-    if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
-        raise CheckpointError(f"{path} is not a SAC+CURL training checkpoint")
-    return state
-
-
-def _kwargs_key(env_kwargs: dict) -> str:
-    return repr(sorted(env_kwargs.items()))
-
-
-def _check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str, env_kwargs: dict,
-                    cfg: LearnerConfig) -> None:
-    if saved.get("variant") != variant or saved.get("env_id") != env_id:
-        raise CheckpointError(f"{path} belongs to variant={saved.get('variant')!r} env_id={saved.get('env_id')!r}, "
-                              f"not variant={variant!r} env_id={env_id!r}; use another out_dir")
-    if saved.get("env_kwargs") != _kwargs_key(env_kwargs):
-        raise CheckpointError(f"{what} {path} was written with env_kwargs {saved.get('env_kwargs')}, "
-                              f"not {_kwargs_key(env_kwargs)}; use another out_dir")
-    # runs saved before these fields existed ran without them, i.e. as their defaults
-    theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
-    mine = cfg.to_dict()
-    diff = sorted(k for k in set(mine) | set(theirs) if k not in RESUMABLE_FIELDS and mine.get(k) != theirs.get(k))
-    if diff:
-        shown = ", ".join(f"{k}={theirs.get(k)!r} (now {mine.get(k)!r})" for k in diff[:4])
-        raise CheckpointError(f"{what} {path} was written with a different config: {shown}"
-                              f"{' ...' if len(diff) > 4 else ''}; use another out_dir")
-
-
-_DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
-                             for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
-                                       "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
-                                       "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",
-                                       "target_memory")}
-"""Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults."""
 
 
 def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
@@ -532,8 +232,8 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
         try:
             done = json.loads(done_path.read_text())
         except (OSError, ValueError) as err:
-            raise CheckpointError(f"cannot read {done_path} ({_describe(err)})") from None
-        _check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
+            raise CheckpointError(f"cannot read {done_path} ({describe_error(err)})") from None
+        check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
         return done
     ours = {CHECKPOINT_NAME.name, "actor.pt", "done.json", "config.json", "curve.csv", "curve_episodes.csv",
             "train.csv"}
@@ -542,7 +242,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
             stale.unlink()
     ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if ckpt is not None:
-        _check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
+        check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
 
     threads_before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
@@ -576,25 +276,6 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     if cfg.critic_privileged_state:
         aids["privileged_state"] = True
     return {**aids, **env_kwargs}
-
-
-def make_agent(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
-               state_dim: int = 0):
-    """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state);
-    ``state_dim``: size of the env's privileged state (``critic_privileged_state``)."""
-    if cfg.algorithm == "ppo":
-        from egosearch.rl.ppo import PpoAgent
-
-        return PpoAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    if cfg.algorithm == "sac_drq_recurrent":
-        from egosearch.rl.sac_drq_recurrent import SacDrqRecurrentAgent
-
-        return SacDrqRecurrentAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    if cfg.algorithm == "sac_drq":
-        from egosearch.rl.sac_drq import SacDrqAgent
-
-        return SacDrqAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    return SacCurlAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
 
 
 def _act_batch(agent, observations: list[dict]) -> list[np.ndarray]:
@@ -693,7 +374,7 @@ class _Run:
         self.stored = [self.to_replay(o) for o in self.observations]  # as the replay stores them, each computed once
         self.ep_returns = [0.0] * len(envs)
         atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
-                                              "env_kwargs": _kwargs_key(env_kwargs), "config": cfg.to_dict()})
+                                              "env_kwargs": env_kwargs_key(env_kwargs), "config": cfg.to_dict()})
         self.policy = AgentPolicy(self.agent)
         self.say = print
         self.means = {"curve": _Mean(), "train": _Mean()}
@@ -709,10 +390,11 @@ class _Run:
         """Load the agent, replay and RNG states; drop the CSV rows written after the checkpoint."""
         try:
             self.agent.load_state_dict(ckpt["agent"])
-            self.replay.load_state_dict(_to_numpy(ckpt["replay"]))
-            _restore_rng_states(ckpt["rng"], self.envs)
+            self.replay.load_state_dict(to_numpy(ckpt["replay"]))
+            restore_rng_states(ckpt["rng"], self.envs)
         except (AgentStateError, ValueError, KeyError, RuntimeError) as err:
-            raise CheckpointError(f"checkpoint {self.ckpt_path} does not fit this run ({_describe(err)})") from None
+            raise CheckpointError(f"checkpoint {self.ckpt_path} does not fit this run "
+                                  f"({describe_error(err)})") from None
         self.step, self.episodes = int(ckpt["env_steps"]), int(ckpt["episodes"])
         self.wall_before = float(ckpt["wall_s"])
         self.recent.extend((float(r), float(s)) for r, s in ckpt["recent"])
@@ -736,7 +418,7 @@ class _Run:
             bar = tqdm(total=cfg.total_env_steps, initial=self.step, unit="step", dynamic_ncols=True,
                        mininterval=1.0, desc=f"{self.variant} seed {cfg.seed}")
             self.say = bar.write
-        self.say(f"{_ALGORITHM_NAMES[cfg.algorithm]} {self.variant} on {self.env_id} -> {self.out_dir} | device "
+        self.say(f"{ALGORITHM_NAMES[cfg.algorithm]} {self.variant} on {self.env_id} -> {self.out_dir} | device "
                  f"{self.device}, {torch.get_num_threads()} torch threads, {cfg.num_envs} env(s) | "
                  f"{'resuming at step ' + str(self.step) if self.step else 'fresh start'}")
         self.say("config: " + json.dumps(cfg.to_dict(), sort_keys=True))
@@ -867,13 +549,13 @@ class _Run:
     def save_checkpoint(self) -> None:
         state = {
             "format": CHECKPOINT_FORMAT, "variant": self.variant, "env_id": self.env_id,
-            "env_kwargs": _kwargs_key(self.env_kwargs), "config": self.cfg.to_dict(),
+            "env_kwargs": env_kwargs_key(self.env_kwargs), "config": self.cfg.to_dict(),
             "env_steps": self.step, "episodes": self.episodes, "wall_s": self.wall(),
             "csv_rows": {"curve": self.curve.rows(), "train": self.train_log.rows(),
                          "curve_episodes": self.curve_episodes.rows()},
             "recent": [list(x) for x in self.recent],
-            "agent": self.agent.state_dict(), "replay": _to_tensors(self.replay.state_dict()),
-            "rng": _rng_states(self.envs),
+            "agent": self.agent.state_dict(), "replay": to_tensors(self.replay.state_dict()),
+            "rng": rng_states(self.envs),
         }
         atomic_write(self.ckpt_path, lambda f: torch.save(state, f))
 
@@ -884,7 +566,7 @@ class _Run:
 
     def stopped(self) -> dict:
         """The summary of a run stopped at its wall-time limit (its checkpoint is written)."""
-        return {"variant": self.variant, "env_id": self.env_id, "env_kwargs": _kwargs_key(self.env_kwargs),
+        return {"variant": self.variant, "env_id": self.env_id, "env_kwargs": env_kwargs_key(self.env_kwargs),
                 "stopped": True, "env_steps": self.step, "updates": self.agent.num_updates,
                 "episodes": self.episodes, "wall_s": round(self.wall(), 3),
                 "machine": self.machine(), "config": self.cfg.to_dict()}
@@ -897,7 +579,7 @@ class _Run:
             with open(self.curve.path) as f:
                 rows = list(csv.DictReader(f))
             last_row = {k: float(v) for k, v in rows[-1].items()} if rows else {}
-        cfg, agent, key = self.cfg, self.agent, _kwargs_key(self.env_kwargs)
+        cfg, agent, key = self.cfg, self.agent, env_kwargs_key(self.env_kwargs)
         meta = {"variant": self.variant, "env_id": self.env_id, "env_kwargs": key,
                 "config": cfg.to_dict(), "env_steps": self.step,
                 "updates": agent.num_updates, "seed": cfg.seed, "torch": str(torch.__version__)}

@@ -1,0 +1,119 @@
+"""A trained actor as a policy: :class:`ActorPolicy` loads ``actor.pt`` (any learner's, by its
+``format``) behind the project's policy interface, ``reset(seed)`` and ``act(obs)``;
+:class:`AgentPolicy` puts a live agent behind the same interface (the training loop's evaluations).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
+from egosearch.rl.sac_curl import load_actor_net
+from egosearch.sim.envs import ENV_IDS, env_space_dims
+
+
+class AgentPolicy:
+    """The live agent behind the shared policy interface (deterministic actions)."""
+
+    def __init__(self, agent):
+        self.agent = agent
+
+    def reset(self, seed: int | None = None) -> None:
+        reset_state = getattr(self.agent, "reset_policy_state", None)  # a recurrent agent's memory
+        if reset_state is not None:
+            reset_state()
+
+    def act(self, obs: dict) -> np.ndarray:
+        return self.agent.act(obs, deterministic=True)
+
+
+def load_any_actor_net(state: dict, device) -> torch.nn.Module:
+    """An actor file's network, SAC+CURL's, SAC-DrQ's or recurrent SAC-DrQ's (by its ``format``)."""
+    from egosearch.rl import sac_drq, sac_drq_recurrent
+
+    if isinstance(state, dict) and state.get("format") == sac_drq.ACTOR_FORMAT:
+        return sac_drq.load_drq_actor_net(state, device)
+    if isinstance(state, dict) and state.get("format") == sac_drq_recurrent.ACTOR_FORMAT:
+        return sac_drq_recurrent.load_recurrent_actor_net(state, device)
+    return load_actor_net(state, device)
+
+
+class ActorPolicy:
+    """A trained actor (``actor.pt``) behind the project's policy interface:
+    ``reset(seed=None)`` (no-op: the actor is memoryless given the env's frame history; a recurrent
+    actor's hidden state is zeroed) and ``act(obs) -> np.ndarray`` (deterministic: tanh of the
+    Gaussian mean, in [-1, 1]; a recurrent actor carries its hidden state to the next call)."""
+
+    def __init__(self, path: str | os.PathLike, device: str = "auto"):
+        path = Path(path)
+        # torch's own message for a non-torch file advises weights_only=False, which is wrong here.
+        not_actor = (f"{path} is not an egosearch actor file; an actor file is the actor.pt that "
+                     "`egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt)")
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: no such actor file" if not path.exists() else not_actor)
+        try:
+            state = torch.load(path, map_location="cpu", weights_only=True)
+        except Exception as err:  # noqa: BLE001 - any unreadable file gets one line
+            raise AgentStateError(f"{not_actor} (torch cannot read it: {type(err).__name__})") from None
+        if not isinstance(state, dict) or "format" not in state:
+            raise AgentStateError(not_actor)
+        self.device = resolve_device(device)
+        try:
+            self.net = load_any_actor_net(state, self.device)
+        except AgentStateError as err:
+            raise AgentStateError(f"{path}: {err}") from None
+        self.path = path
+        self.arch = state["arch"]
+        self.metadata = state.get("metadata", {})
+        self.variant = self.metadata.get("variant")
+        self.env_id = self.metadata.get("env_id")
+        self.config = self.metadata.get("config")
+        self.action_dim = int(self.arch["action_dim"])
+        self.recurrent = bool(getattr(self.net, "recurrent", False))
+        self._h = None
+
+    def fits(self, env_id: str) -> bool:
+        """Whether the actor's action and observation sizes are those of the registered ``env_id``."""
+        dims = env_space_dims(env_id)
+        if "mask_dim" in self.arch and "proprio_dim" in self.arch:
+            return (self.action_dim, int(self.arch["mask_dim"]), int(self.arch["proprio_dim"])) == (
+                dims["action"], dims["mask"], dims["proprio"])
+        return (self.action_dim, int(self.arch["extra_dim"])) == (dims["action"], dims["mask"] + dims["proprio"])
+
+    def trained_env_id(self) -> str | None:
+        """The env id the actor was trained in: the one its file records, else the one registered id
+        whose sizes it fits (None when no single id does)."""
+        if self.env_id:
+            return self.env_id
+        fitting = [env_id for env_id in ENV_IDS if self.fits(env_id)]
+        return fitting[0] if len(fitting) == 1 else None
+
+    def check_env(self, env_id: str) -> None:
+        """Raise :class:`AgentStateError` (one line naming the env id it was trained for) unless the
+        actor can act in ``env_id``: a mismatch otherwise surfaces only as a broadcasting error in
+        the first episode's step."""
+        if self.fits(env_id):
+            return
+        trained = self.trained_env_id()
+        dims = env_space_dims(env_id)
+        told = f"was trained in {trained}" if trained else "fits no registered env id"
+        hint = f": run it in {trained}" if trained else ""
+        raise AgentStateError(f"{self.path}: this actor {told} ({self.action_dim} action values, "
+                              f"{self.arch['extra_dim']} observation values besides depth), not in {env_id} "
+                              f"({dims['action']} and {dims['mask'] + dims['proprio']}){hint}")
+
+    def reset(self, seed: int | None = None) -> None:
+        self._h = None
+
+    def act(self, obs: dict) -> np.ndarray:
+        with torch.inference_mode():
+            depth, extra = obs_to_tensors(obs, self.device, self.arch["crop_size"])
+            if self.recurrent:
+                mu, _, self._h = self.net(depth.float(), extra, self._h)
+            else:
+                mu, _ = self.net(depth.float(), extra)
+            return torch.tanh(mu)[0].cpu().numpy().astype(np.float32)
