@@ -1,4 +1,6 @@
-"""Variants as data: one YAML file per variant in ``ablations/``.
+"""Variants as data: one YAML file per variant in ``ablations/``, and the one place where a variant
+at a learner profile becomes what a training runs (:func:`resolve_variant`: the learner config and
+the env id it observes). The CLI, the benchmarks and the DAG's checks all resolve through it.
 
 Adding a variant is adding a file; nothing else changes. A file is validated against
 ``egosearch/workflow/variant.schema.json`` and its ``config`` against the learner's config, so a
@@ -10,10 +12,16 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import re
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+import jsonschema
 import yaml
+
+from egosearch.rl.config import LearnerConfig, load_config
+from egosearch.sim.envs import observed_env_id
+from egosearch.sim.home_pool import check_home_split
 
 #: ``ablations/`` of the working directory (where Snakemake runs), else of this checkout.
 ABLATIONS_DIR = next((p for p in (Path.cwd() / "ablations", Path(__file__).resolve().parent.parent / "ablations")
@@ -69,8 +77,6 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
 
     Its ``config`` is checked against ``LearnerConfig`` here (names and types): a typo fails on
     reading, wherever a variant is read, not when a training job builds its config."""
-    import jsonschema
-
     path = _resolve(name_or_path, directory)
     try:
         data = yaml.safe_load(path.read_text())
@@ -94,13 +100,41 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
                    description=data.get("description", ""), path=str(path))
 
 
+@dataclass(frozen=True)
+class ResolvedVariant:
+    """A variant at a learner profile: the config and env id a training of it runs with."""
+    variant: Variant
+    profile: str
+    """The learner profile (smoke, cpu or paper) the config starts from."""
+    config: LearnerConfig
+    """The profile's config with the variant's overrides, then the caller's, on top."""
+    env_id: str
+    """The id the policy trains and is evaluated in: the variant's ``env_id``, or its ``*Memory-v0``
+    form when the config's ``target_memory`` changes the observation."""
+
+    @property
+    def name(self) -> str:
+        return self.variant.name
+
+    @property
+    def train_env(self) -> dict:
+        return self.variant.train_env
+
+
+def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict | None = None) -> ResolvedVariant:
+    """``variant`` (a name, a path or a loaded :class:`Variant`) at the learner ``profile``, with
+    ``overrides`` (seed, threads, ...) on top of the variant's own config fields."""
+    if not isinstance(variant, Variant):
+        variant = load_variant(variant)
+    config = load_config(profile, {**variant.config, **(overrides or {})})
+    return ResolvedVariant(variant, profile, config, observed_env_id(variant.env_id, config.target_memory))
+
+
 def check_learner_config(variant: Variant, learner_profile: str) -> None:
     """The variant's overrides on top of ``learner_profile`` give a valid learner config (ranges and
     cross-field rules such as ``crop_size <= image_size``), else one-line ``VariantError``."""
-    from egosearch.rl.config import load_config
-
     try:
-        load_config(learner_profile, variant.config)
+        resolve_variant(variant, learner_profile)
     except ValueError as err:
         raise VariantError(f"{variant.path or variant.name}: config (on the {learner_profile} learner profile): "
                            f"{err}") from None
@@ -109,8 +143,6 @@ def check_learner_config(variant: Variant, learner_profile: str) -> None:
 def _learner_overrides(config: dict, path: Path) -> dict:
     """``config`` checked field by field against ``LearnerConfig``. PyYAML reads ``1e-4`` (no dot)
     as a string, so a float field also takes a string that reads as a finite number."""
-    from egosearch.rl.config import LearnerConfig
-
     kinds = {f.name: f.type for f in fields(LearnerConfig)}
     out = {}
     for key, value in config.items():
@@ -140,8 +172,6 @@ def _check_homes(train_env: dict, path: Path) -> None:
         raise VariantError(f"{path}: train_env: " + ("layout: generated needs home_seeds: [first, stop)" if generated
                                                     else "home_seeds is only read with layout: generated"))
     if generated:
-        from egosearch.sim.home_pool import check_home_split
-
         try:
             check_home_split(seeds)
         except ValueError as err:
@@ -151,6 +181,7 @@ def _check_homes(train_env: dict, path: Path) -> None:
 def _check_objects(names: list[str], path: Path) -> None:
     if not names:
         return
+    # local: the object catalogue loads trimesh (~2 s), which the Snakefile's checks need only here
     from egosearch.scene.objects import TARGET_OBJECTS
 
     unknown = [n for n in names if n not in TARGET_OBJECTS]
@@ -161,8 +192,6 @@ def _check_objects(names: list[str], path: Path) -> None:
 
 def new_variant(name: str, template: str = "head_on", directory: Path = ABLATIONS_DIR) -> Path:
     """Write ``<directory>/<name>.yaml``: a copy of ``template`` with ``name:`` set, ready to edit."""
-    import re
-
     if not re.fullmatch(r"[A-Za-z0-9_\-]+", name):
         raise VariantError(f"variant name {name!r}: use letters, digits, '_' and '-' only (it names output folders)")
     path = _shown(Path(directory) / f"{name}.yaml")

@@ -222,7 +222,7 @@ def test_a_jobs_cpu_time_is_recorded_beside_its_wall_time(tmp_path):
 
 def test_a_resumed_training_costs_its_whole_run_in_the_estimate(tmp_path):
     from egosearch.report.provenance import rule_times
-    from egosearch.report.readme import job_cost_s
+    from egosearch.report.workflow_jobs import job_cost_s
 
     benchmarks = tmp_path / "benchmarks"
     header = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"

@@ -346,3 +346,14 @@ class IdentityMG(MotionGenerator):
 
     def limit_head(self, previous: FullBodyPose, pitch: float, head_yaw: float) -> tuple[float, float]:
         return pitch, head_yaw  # the env already applied the abstract limits
+
+
+def union_aabb(client, body_id: int) -> tuple[list[float], list[float]]:
+    """The axis-aligned box around every link of a pybullet body (its base included)."""
+    lo = np.full(3, math.inf)
+    hi = np.full(3, -math.inf)
+    for link in range(-1, client.getNumJoints(body_id)):
+        a, b = client.getAABB(body_id, link)
+        lo = np.minimum(lo, a)
+        hi = np.maximum(hi, b)
+    return lo.tolist(), hi.tolist()

@@ -10,12 +10,10 @@ more than :data:`PENETRATION_DEPTH` inside an obstacle (pybullet ``getClosestPoi
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
-
 from egosearch.motion import quat
 from egosearch.motion.base import FullBodyPose
+from egosearch.motion.fetch import FetchBody
+from egosearch.motion.humanoid import HumanoidBody
 from egosearch.scene.parts import Scene
 from egosearch.sim.agent import AgentSpec
 from egosearch.sim.bullet import connect, pybullet
@@ -34,12 +32,8 @@ class PenetrationCounter:
         self._static_set = frozenset(self.static_ids)
         self._part_of = dict(zip(self.static_ids, scene.obstacles))
         if character == "humanoid":
-            from egosearch.motion.humanoid import HumanoidBody
-
             self.body = HumanoidBody(self._p)
         elif character == "fetch":
-            from egosearch.motion.fetch import FetchBody
-
             self.body = FetchBody(self._p)
         elif character == "abstract":
             self.body = CylinderBody(self._p, AgentSpec())
@@ -97,12 +91,3 @@ class CylinderBody:
     def aabb(self):
         return self._p.getAABB(self.body_id, -1)
 
-
-def union_aabb(client, body_id: int) -> tuple[list[float], list[float]]:
-    lo = np.full(3, math.inf)
-    hi = np.full(3, -math.inf)
-    for link in range(-1, client.getNumJoints(body_id)):
-        a, b = client.getAABB(body_id, link)
-        lo = np.minimum(lo, a)
-        hi = np.maximum(hi, b)
-    return lo.tolist(), hi.tolist()

@@ -17,8 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 from egosearch.motion import quat
-from egosearch.motion.base import FullBodyPose, Limits
-from egosearch.motion.collision import union_aabb
+from egosearch.motion.base import FullBodyPose, Limits, union_aabb
 from egosearch.motion.skeleton import (
     REVOLUTE,
     SPHERICAL,

@@ -44,6 +44,7 @@ from egosearch.motion.collision import PenetrationCounter
 from egosearch.motion.fetch import FetchMG
 from egosearch.motion.matching import MatchingMG
 from egosearch.motion.phase import PhaseMG
+from egosearch.runs.evaluate import make_env
 from egosearch.runs.metrics import episode_spl
 from egosearch.sim.agent import AgentState
 from egosearch.sim.env import FRAME_HISTORY, target_distance
@@ -281,8 +282,6 @@ def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], metho
                       seed: int = 0, progress: bool = False) -> list[dict]:
     """``make_policy(env)`` realised by motion generator ``mg_name`` with ``method`` on every scenario.
     ``M=None`` takes the method's default (the one-step baselines execute their whole line)."""
-    from egosearch.runs.evaluate import make_env
-
     meth = get_method(method)
     if mg_name not in MOTION_GENERATORS:
         raise ValueError(f"motion generator {mg_name!r} is unknown; allowed: {', '.join(MOTION_GENERATORS)}")

@@ -26,7 +26,15 @@ import trimesh  # noqa: E402
 
 from egosearch.motion import quat  # noqa: E402
 from egosearch.motion.base import FullBodyPose  # noqa: E402
+from egosearch.motion.fetch import FETCH_PARTS
+from egosearch.motion.humanoid import HUMANOID_SCALE, limb_shapes
+from egosearch.motion.replan import make_motion_generator, run_fullbody_episode
+from egosearch.runs.evaluate import make_env
+from egosearch.scene.meshes import part_mesh
 from egosearch.sim.agent import STEP_SECONDS  # noqa: E402
+from egosearch.sim.env import target_distance
+from egosearch.sim.render import depth_to_colormap, look_at_pose, upscale
+from egosearch.sim.scenarios import MAX_STEPS
 
 CHARACTERS = ("humanoid_phase", "humanoid_matching", "fetch")
 FRAME_HEIGHT = 384
@@ -84,8 +92,6 @@ def camera_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
 
 
 def humanoid_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
-    from egosearch.motion.humanoid import HUMANOID_SCALE, limb_shapes
-
     s = HUMANOID_SCALE
     meshes = []
     for shape, centre, rot in limb_shapes(pose, s):
@@ -101,8 +107,6 @@ def humanoid_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
 
 
 def fetch_mesh(pose: FullBodyPose) -> trimesh.Trimesh:
-    from egosearch.motion.fetch import FETCH_PARTS
-
     meshes = []
     for kind, centre, dims in FETCH_PARTS:
         if kind == "cylinder":
@@ -133,8 +137,6 @@ class CharacterView:
     def __init__(self, scene, target=None, width: int = THIRD_WIDTH, height: int = FRAME_HEIGHT):
         import pyrender
 
-        from egosearch.scene.meshes import part_mesh
-        from egosearch.sim.render import look_at_pose
 
         self._pyrender = pyrender
         self._look_at_pose = look_at_pose
@@ -266,11 +268,6 @@ def write_search_video(layout: str, character: str, policy, scenario, out_path: 
     """
     import imageio.v2 as imageio
 
-    from egosearch.motion.replan import make_motion_generator, run_fullbody_episode
-    from egosearch.runs.evaluate import make_env
-    from egosearch.sim.env import target_distance
-    from egosearch.sim.render import depth_to_colormap, upscale
-    from egosearch.sim.scenarios import MAX_STEPS
 
     if character not in CHARACTERS:
         raise ValueError(f"character={character!r}; allowed: {', '.join(CHARACTERS)}")

@@ -1,7 +1,7 @@
-"""The report layer: CSV in, files out (Tables 1 and 2, Figures 6 and 7, variant comparisons).
+"""The report layer: stored CSVs and JSON in; tables, figures, studies and the docs' generated blocks out.
 
-Imports pandas, scipy, matplotlib and yaml only; never torch, the simulator, gymnasium or other
-egosearch modules but the stdlib-only ``egosearch.core.machine`` (the CLI passes Table 2's rows in).
+Imports numpy, pandas, scipy, matplotlib, yaml and ``egosearch.core`` only (``searches`` also ``egosearch.scene``,
+when it draws); never torch, the simulator or gymnasium. Imported by the CLI, which passes Table 2's rows in.
 """
 
 from egosearch.report.data import (

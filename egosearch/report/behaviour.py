@@ -29,7 +29,7 @@ formulas, over the steps t = 1..T of an episode of T steps (row 0 is the state a
 - revisit: step t ends in a :data:`REVISIT_CELL` floor square that the body had stood in and left
   before (staying where it is does not count, coming back does, and so does each step it then stays).
 
-Numbers only: numpy and pandas, no simulator (the trace holds what the report needs).
+Numbers only: numpy, pandas and the report's own helpers, no simulator (the trace holds what the report needs).
 """
 
 from __future__ import annotations
@@ -43,6 +43,9 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from egosearch.report.data import output_base
+from egosearch.report.stats import quantile_interval
 
 PathLike = str | os.PathLike
 
@@ -278,15 +281,6 @@ def _drawn(sums: dict[str, np.ndarray], rows: np.ndarray, cols: np.ndarray) -> d
     return {name: out[:, i] for i, name in enumerate(names)}
 
 
-def _interval(draws: np.ndarray, confidence: float) -> tuple[float, float]:
-    draws = draws[np.isfinite(draws)]
-    if draws.size == 0:
-        return math.nan, math.nan
-    alpha = (1 - confidence) / 2
-    lo, hi = np.quantile(draws, [alpha, 1 - alpha])
-    return float(lo), float(hi)
-
-
 def summarise(episodes: pd.DataFrame, head_on: str = "head_on", head_off: str = "head_off",
               confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0, chunk: int = 1000) -> pd.DataFrame:
     """Every statistic per variant, and ``{head_on} - {head_off}`` on the scenarios both ran (rows with
@@ -309,7 +303,7 @@ def summarise(episodes: pd.DataFrame, head_on: str = "head_on", head_off: str = 
                 draws[s.name].append(_estimate(s, drawn))
         totals = {c: sums[c].sum() for c in columns}
         for s in STATISTICS:
-            lo, hi = _interval(np.concatenate(draws[s.name]), confidence)
+            lo, hi = quantile_interval(np.concatenate(draws[s.name]), confidence)
             rows.append({"variant": variant, "statistic": s.name, "value": float(_estimate(s, totals)),
                          "ci_low": lo, "ci_high": hi, "unit": s.unit, "n_scenarios": n_s, "n_seeds": n_k,
                          "n_episodes": int(totals["episodes"]), "description": s.text})
@@ -340,7 +334,7 @@ def _paired(on, off, label, confidence, n_resamples, seed, chunk) -> list[dict]:
     out = []
     for s in STATISTICS:
         values = [_estimate(s, {c: m[c].sum() for c in m}) for m in mats]
-        lo, hi = _interval(np.concatenate(draws[s.name]), confidence)
+        lo, hi = quantile_interval(np.concatenate(draws[s.name]), confidence)
         out.append({"variant": label, "statistic": s.name, "value": float(values[0] - values[1]), "ci_low": lo,
                     "ci_high": hi, "unit": s.unit, "n_scenarios": n_s, "n_seeds": f"{pick[0][2]}+{pick[1][2]}",
                     "n_episodes": int(mats[0]["episodes"].sum() + mats[1]["episodes"].sum()),
@@ -454,8 +448,6 @@ def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, head_on: s
     """``{prefix}_episodes.csv``, ``{prefix}.csv`` / ``.md`` (every statistic) and ``{prefix}_claims.csv`` /
     ``.md`` from trace files; a folder as ``out_prefix`` (an existing one, or ending in ``/``) means
     ``folder/behaviour``."""
-    from egosearch.report.data import output_base
-
     out = output_base(out_prefix, "behaviour")
     episodes = behaviour_episodes(paths)
     summary = summarise(episodes, head_on, head_off, n_resamples=n_resamples)

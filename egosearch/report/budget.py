@@ -27,8 +27,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
-from egosearch.report.data import _with, output_base, read_curves, read_episodes
-from egosearch.report.figures import OKABE_ITO, STYLE, _save
+from egosearch.report.data import output_base, read_curves, read_episodes, suffixed
+from egosearch.report.figures import OKABE_ITO, STYLE, save_figure
 from egosearch.report.stats import scenario_seed_matrix, two_level_ci, wilson_ci
 
 PathLike = str | os.PathLike
@@ -114,7 +114,7 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
     """Two panels: success vs env steps (per run) and vs core-hours (per run), one marker per setting
     with its 95% interval; ``chosen`` is drawn filled and named in the legend."""
     base = output_base(out_prefix, "budget")
-    df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    df.to_csv(suffixed(base, ".csv"), index=False, float_format="%.6g")
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(7.0, 2.9))
         FigureCanvasAgg(fig)
@@ -143,8 +143,8 @@ def budget_figure(df: pd.DataFrame, out_prefix: PathLike, cell: str = "1.05 m, e
         axes[0].set_ylim(-0.02, 1.02)
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=2)
-        outs = _save(fig, base)
-    return [_with(base, ".csv"), *outs]
+        outs = save_figure(fig, base)
+    return [suffixed(base, ".csv"), *outs]
 
 
 __all__ = ["BUDGET_COLUMNS", "NOT_RECORDED", "budget_figure", "budget_frame", "log_ticks", "run_layout", "run_machine"]

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from egosearch.report.data import _with, cells_from_paths, group_eval_paths, output_base, parse_eval_path
+from egosearch.report.data import cells_from_paths, group_eval_paths, output_base, parse_eval_path, suffixed
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
 from egosearch.report.pathlength import by_length_path, compare_by_length, format_by_length, pathlength_report
 from egosearch.report.provenance import check_stored
@@ -53,7 +53,7 @@ def cmd_table1(episode_files: Mapping | Iterable[PathLike], out_prefix: PathLike
         episode_files = group_eval_paths(episode_files, variant=variant)
     df = table1(episode_files, out_prefix, bounds=None if bounds is None else group_bounds(bounds), variant=variant)
     base = output_base(out_prefix, "table1")
-    _say(_with(base, e) for e in (".csv", ".md", ".tex"))
+    _say(suffixed(base, e) for e in (".csv", ".md", ".tex"))
     return df
 
 
@@ -63,7 +63,7 @@ def cmd_table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike,
     profile's departures from the paper (``egosearch.rl.config.departure_rows(cfg)``)."""
     table2(rows, out_prefix, departures=departures)
     base = output_base(out_prefix, "table2")
-    _say(_with(base, e) for e in (".md", ".tex"))
+    _say(suffixed(base, e) for e in (".md", ".tex"))
 
 
 def cmd_fig6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike,

@@ -33,10 +33,12 @@ PathLike = str | os.PathLike
 
 _SEED_DIR = re.compile(r"^seed(\d+)$")
 _SEED_FILE = re.compile(r"^seed(\d+)\.csv$")
-_HEIGHT_FILE = re.compile(r"^h(\d+(?:\.\d+)?)\.csv$")
+HEIGHT_FILE = re.compile(r"^h(\d+(?:\.\d+)?)\.csv$")
+"""The name of a per-episode evaluation CSV, ``h{height}.csv``: group 1 is the camera height."""
 
 
-def _read_csv(path: PathLike, required: tuple[str, ...], what: str) -> pd.DataFrame:
+def read_checked_csv(path: PathLike, required: tuple[str, ...], what: str) -> pd.DataFrame:
+    """The CSV at ``path``; an error naming ``what`` when it is missing or lacks a ``required`` column."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{what} CSV not found: {path}")
@@ -79,7 +81,7 @@ def parse_eval_path(path: PathLike) -> dict:
     """``{variant, seed, layout, placement, height}`` of a per-episode evaluation CSV path."""
     p = Path(path)
     parts = p.parts
-    m = _HEIGHT_FILE.match(parts[-1])
+    m = HEIGHT_FILE.match(parts[-1])
     if m is None or len(parts) < 5 or not _SEED_DIR.match(parts[-4]):
         raise ValueError(f"{path}: expected .../{{variant}}/seed{{seed}}/{{layout}}/{{placement}}/h{{height}}.csv")
     return {"variant": parts[-5], "seed": int(_SEED_DIR.match(parts[-4]).group(1)), "layout": parts[-3],
@@ -106,7 +108,7 @@ def read_episodes(paths: PathLike | Iterable[PathLike], seed: int | None = None)
         raise ValueError("no per-episode CSVs given")
     frames, seen = [], set()
     for path in paths:
-        df = _read_csv(path, EPISODE_COLUMNS, "per-episode evaluation")
+        df = read_checked_csv(path, EPISODE_COLUMNS, "per-episode evaluation")
         if df.empty:
             raise ValueError(f"{path}: no episodes")
         if seed is None:
@@ -132,7 +134,7 @@ def read_curves(paths: Iterable[PathLike]) -> pd.DataFrame:
     or the position when the path names no seed); rows without a success rate are dropped."""
     frames = []
     for i, path in enumerate(_as_paths(paths)):
-        df = _read_csv(path, ("env_steps", "success_rate"), "training curve")
+        df = read_checked_csv(path, ("env_steps", "success_rate"), "training curve")
         try:
             seed = seed_from_path(path)
         except ValueError:
@@ -148,7 +150,7 @@ def read_fullbody(paths: Iterable[PathLike]) -> pd.DataFrame:
     """Full-body CSVs stacked with a ``seed`` column (from ``seed{N}.csv``; the position in ``paths`` otherwise)."""
     frames = []
     for i, path in enumerate(_as_paths(paths)):
-        df = _read_csv(path, FULLBODY_COLUMNS, "full-body")
+        df = read_checked_csv(path, FULLBODY_COLUMNS, "full-body")
         try:
             seed = seed_from_path(path)
         except ValueError:
@@ -186,7 +188,8 @@ def cells_from_paths(paths: Iterable[PathLike]) -> dict:
     return out
 
 
-def _sorted_cells(cells: Iterable[tuple]) -> list[tuple]:
+def sorted_cells(cells: Iterable[tuple]) -> list[tuple]:
+    """``(height, placement)`` cells in the tables' order: by height, then no_low_cabinets, everywhere, others."""
     order = {"no_low_cabinets": 0, "everywhere": 1}
     return sorted(cells, key=lambda c: (float(c[0]), order.get(c[1], 2), str(c[1])))
 
@@ -202,5 +205,6 @@ def output_base(out_prefix: PathLike, default_name: str) -> Path:
     return base
 
 
-def _with(base: Path, ext: str) -> Path:
+def suffixed(base: Path, ext: str) -> Path:
+    """``base`` with ``ext`` added to its name: ``out/h1.65`` -> ``out/h1.65.csv`` (``with_suffix`` drops ``.65``)."""
     return base.with_name(base.name + ext)

@@ -20,7 +20,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
-from egosearch.report.data import _with, output_base, read_curves, read_episodes, read_fullbody, seed_from_path
+from egosearch.report.data import output_base, read_curves, read_episodes, read_fullbody, seed_from_path, suffixed
 from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, scenario_seed_matrix, two_level_ci, wilson_ci
 
 PathLike = str | os.PathLike
@@ -79,9 +79,10 @@ PDF_METADATA = {"CreationDate": None}
 changed the tracked PDF on every run (the PNG writer stamps none)."""
 
 
-def _save(fig: Figure, base: Path) -> list[Path]:
+def save_figure(fig: Figure, base: Path) -> list[Path]:
+    """Write ``fig`` to ``{base}.png`` (300 dpi) and ``{base}.pdf`` (no time stamp); return the two paths."""
     FigureCanvasAgg(fig)
-    outs = [_with(base, ".png"), _with(base, ".pdf")]
+    outs = [suffixed(base, ".png"), suffixed(base, ".pdf")]
     fig.savefig(outs[0], dpi=300)
     fig.savefig(outs[1], metadata=PDF_METADATA)
     return outs
@@ -174,7 +175,7 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     """
     df = figure6_frame(curves, labels, confidence, n_resamples, seed, random_files=random_files)
     base = output_base(out_prefix, "fig6")
-    df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    df.to_csv(suffixed(base, ".csv"), index=False, float_format="%.6g")
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(3.5, 2.5))
         ax = fig.add_subplot()
@@ -200,8 +201,8 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
         ax.xaxis.set_major_formatter(FuncFormatter(_steps_formatter))
         # Above the axes: inside, any corner would hide a curve at some profile's success rates.
         ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.01), borderaxespad=0.0)
-        outs = _save(fig, base)
-    return [*outs, _with(base, ".csv")]
+        outs = save_figure(fig, base)
+    return [*outs, suffixed(base, ".csv")]
 
 
 # --------------------------------------------------------------------------------------------- Figure 7
@@ -277,10 +278,10 @@ def figure7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, confidence
     """
     df = figure7_frame(fullbody_files, confidence, n_resamples, seed)
     base = output_base(out_prefix, "fig7")
-    df.to_csv(_with(base, ".csv"), index=False, float_format="%.6g")
+    df.to_csv(suffixed(base, ".csv"), index=False, float_format="%.6g")
     with matplotlib.rc_context(STYLE):
-        outs = _save(figure7_figure(df, title), base)
-    return [*outs, _with(base, ".csv")]
+        outs = save_figure(figure7_figure(df, title), base)
+    return [*outs, suffixed(base, ".csv")]
 
 
 ALL_ZERO_NOTE = "every SPL is 0: no method found the target in any episode"

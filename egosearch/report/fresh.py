@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from egosearch.report.data import _sorted_cells, output_base, parse_eval_path, read_episodes
+from egosearch.report.data import output_base, parse_eval_path, read_episodes, sorted_cells
 from egosearch.report.stats import scenario_seed_matrix, shared_seed_difference_ci, two_level_ci
 
 FRESH_COLUMNS = ("home", "height", "placement", "stored", "stored_low", "stored_high", "fresh", "fresh_low",
@@ -52,7 +52,7 @@ def fresh_frame(stored_files: Iterable[PathLike], fresh_files: Iterable[PathLike
         raise ValueError(f"the stored and fresh evaluations cover different cells: {only}")
     rows = []
     homes = sorted({home for home, _, _ in stored})
-    for height, placement in _sorted_cells({(h, p) for _, h, p in stored}):
+    for height, placement in sorted_cells({(h, p) for _, h, p in stored}):
         for home in [*homes, POOLED]:
             pick = homes if home == POOLED else [home]
             if home == POOLED and len(homes) < 2:

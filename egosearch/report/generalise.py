@@ -26,11 +26,13 @@ import textwrap
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
+import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from egosearch.report.data import _with, output_base, parse_eval_path, read_episodes
-from egosearch.report.stats import scenario_seed_matrix
+from egosearch.report.data import output_base, parse_eval_path, read_episodes, suffixed
+from egosearch.report.stats import quantile_interval, scenario_seed_matrix
 
 GROUP_ORDER = ("generated_train", "generated_heldout", "kitchen_living", "bedroom_bath")
 GROUP_LABELS = {"generated_train": "generated homes (training split)",
@@ -82,15 +84,6 @@ def _boot_group(m: np.ndarray, rnd: np.ndarray, orc: np.ndarray, rows: np.ndarra
     return p, rnd[rows].mean(axis=1), orc[rows].mean(axis=1)
 
 
-def _interval(x: np.ndarray, confidence: float) -> tuple[float, float]:
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        return math.nan, math.nan
-    a = (1 - confidence) / 2
-    lo, hi = np.quantile(x, [a, 1 - a])
-    return float(lo), float(hi)
-
-
 def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[PathLike],
                      trained_on: Mapping[str, str] | None = None, generated: str | None = None,
                      confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
@@ -125,11 +118,12 @@ def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[Pat
             mean_p, mean_r, mean_o = success.mean(), bound["random"].mean(), bound["oracle"].mean()
             rows.append({"variant": variant, "trained_on": (trained_on or {}).get(variant, ""), "group": group,
                          "n_scenarios": n_s, "n_seeds": n_k, "success": float(mean_p),
-                         **dict(zip(("success_low", "success_high"), _interval(p, confidence))),
-                         "spl": float(spl.mean()), **dict(zip(("spl_low", "spl_high"), _interval(spl_b, confidence))),
+                         **dict(zip(("success_low", "success_high"), quantile_interval(p, confidence))),
+                         "spl": float(spl.mean()),
+                         **dict(zip(("spl_low", "spl_high"), quantile_interval(spl_b, confidence))),
                          "random_success": float(mean_r), "oracle_success": float(mean_o),
                          "normalised": float(_normalised(np.array(mean_p), np.array(mean_r), np.array(mean_o))),
-                         **dict(zip(("normalised_low", "normalised_high"), _interval(norm_b, confidence))),
+                         **dict(zip(("normalised_low", "normalised_high"), quantile_interval(norm_b, confidence))),
                          "gap_to_train": math.nan, "gap_low": math.nan, "gap_high": math.nan,
                          "vs_reference": math.nan, "vs_reference_low": math.nan, "vs_reference_high": math.nan})
     if generated is not None and (generated, "generated_train") in boots:
@@ -147,7 +141,7 @@ def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[Pat
             gap = _normalised(*gp) - _normalised(*tp)
             train_row = next(r for r in rows if r["variant"] == generated and r["group"] == "generated_train")
             row["gap_to_train"] = row["normalised"] - train_row["normalised"]
-            row["gap_low"], row["gap_high"] = _interval(gap, confidence)
+            row["gap_low"], row["gap_high"] = quantile_interval(gap, confidence)
     if generated is not None and reference is not None:
         for row in rows:
             group = row["group"]
@@ -160,7 +154,7 @@ def generalise_frame(policy_files: Iterable[PathLike], bound_files: Iterable[Pat
             ref_b = _boot_group(ref_m, b["random"], b["oracle"], scenarios, _draws(n_resamples, ref_m.shape[1], rng))
             ref_row = next(r for r in rows if r["variant"] == reference and r["group"] == row["group"])
             row["vs_reference"] = row["normalised"] - ref_row["normalised"]
-            row["vs_reference_low"], row["vs_reference_high"] = _interval(
+            row["vs_reference_low"], row["vs_reference_high"] = quantile_interval(
                 _normalised(*gen_b) - _normalised(*ref_b), confidence)
     return pd.DataFrame(rows, columns=list(COLUMNS))
 
@@ -180,7 +174,7 @@ def generalise_report(policy_files: Iterable[PathLike], bound_files: Iterable[Pa
     """Write ``{prefix}.csv``, ``.md`` and ``.png``; return their paths."""
     df = generalise_frame(policy_files, bound_files, trained_on, generated, confidence, n_resamples, seed, reference)
     base = output_base(out_prefix, "generalise")
-    csv, md_path, png = _with(base, ".csv"), _with(base, ".md"), _with(base, ".png")
+    csv, md_path, png = suffixed(base, ".csv"), suffixed(base, ".md"), suffixed(base, ".png")
     df.to_csv(csv, index=False, float_format="%.6g")
     pct = f"{confidence * 100:g}%"
     md = ["Generalisation: each policy (rows) read in four groups of homes (columns): normalised score "
@@ -222,11 +216,7 @@ def _groups(df: pd.DataFrame) -> list[str]:
 
 
 def _figure(df: pd.DataFrame, path: Path, pct: str) -> None:
-    import matplotlib
-
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     groups, variants = _groups(df), list(dict.fromkeys(df["variant"]))
     width = 0.8 / max(1, len(variants))
     fig, ax = plt.subplots(figsize=(8, 3.6), dpi=120)

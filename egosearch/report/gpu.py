@@ -14,6 +14,8 @@ import json
 import re
 from pathlib import Path
 
+from egosearch.report.workflow_jobs import job_cost_s, job_study, variants_of_all, workflow_config
+
 GPU_CHECK = Path("results") / "paper" / "gpu_check"
 """Where the GPU check is stored, under the project root."""
 
@@ -39,8 +41,6 @@ def projection(root: Path) -> dict | None:
     at a time at the measured rate (curve evaluations included), plus the other jobs of ``all``, CPU
     jobs, from the stored cpu run's recorded costs (the full-body ones scaled to the paper profile's
     count of runs) spread over the machine's cores. None without a GPU check."""
-    from egosearch.report.readme import job_cost_s, job_study, variants_of_all, workflow_config
-
     record = _record(root)
     if record is None:
         return None

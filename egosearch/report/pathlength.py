@@ -35,10 +35,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from egosearch.report.data import _HEIGHT_FILE, _read_csv, _with, output_base, parse_eval_path, read_episodes
-from egosearch.report.figures import OKABE_ITO, STYLE, _save
-from egosearch.report.stats import METRICS, compare_cells, holm, scenario_seed_matrix, two_level_ci
-from egosearch.report.tables import BOUND_LABELS
+from egosearch.report.data import HEIGHT_FILE, output_base, parse_eval_path, read_checked_csv, read_episodes, suffixed
+from egosearch.report.figures import OKABE_ITO, STYLE, save_figure
+from egosearch.report.stats import METRICS, compare_cells, scenario_seed_matrix, two_level_ci
+from egosearch.report.tables import BOUND_LABELS, holm_and_write
 
 PathLike = str | os.PathLike
 
@@ -97,7 +97,7 @@ def _scenario_set(path: PathLike) -> str:
     """``.../{home}/{placement}/h{height}.csv`` -> ``{home}/{placement}/h{height}.csv``: the key an
     evaluation CSV's episodes carry (``data.scenario_set_from_path``)."""
     parts = Path(path).parts
-    if len(parts) < 3 or not _HEIGHT_FILE.match(parts[-1]):
+    if len(parts) < 3 or not HEIGHT_FILE.match(parts[-1]):
         raise ValueError(f"{path}: expected a scenario file .../{{home}}/{{placement}}/h{{height}}.csv")
     return "/".join(parts[-3:])
 
@@ -119,7 +119,7 @@ def read_with_scenarios(eval_files: Iterable[PathLike], scenario_files: Iterable
     for sset, part in eps.groupby("scenario_set", sort=True):
         if sset not in scenarios:
             raise ValueError(f"no scenario file for the evaluated set {sset} (pass .../scenarios/{sset})")
-        scen = _read_csv(scenarios[sset], SCENARIO_COLUMNS, "scenario")[list(SCENARIO_COLUMNS)]
+        scen = read_checked_csv(scenarios[sset], SCENARIO_COLUMNS, "scenario")[list(SCENARIO_COLUMNS)]
         joined = part.merge(scen, on="scenario_id", how="left", suffixes=("", "_scenario"), validate="many_to_one")
         lost = joined["start_x"].isna()
         if lost.any():
@@ -133,7 +133,7 @@ def read_with_scenarios(eval_files: Iterable[PathLike], scenario_files: Iterable
                              f"{r.shortest_path:g} in the evaluation")
         home, placement, name = sset.split("/")
         frames.append(joined.drop(columns="shortest_path_scenario").assign(
-            home=home, placement=placement, height=float(_HEIGHT_FILE.match(name).group(1))))
+            home=home, placement=placement, height=float(HEIGHT_FILE.match(name).group(1))))
     return pd.concat(frames, ignore_index=True)
 
 
@@ -280,7 +280,7 @@ def _figure(df: pd.DataFrame, policy: str, base: Path) -> list[Path]:
         fig.legend(handles, [h.get_label() for h in handles], loc="upper center", bbox_to_anchor=(0.5, 1.0),
                    ncol=min(len(handles), 4))
         fig.subplots_adjust(top=0.78 if len(handles) > 4 else 0.86, wspace=0.08)
-        return _save(fig, base)
+        return save_figure(fig, base)
 
 
 def pathlength_report(eval_files: Iterable[PathLike], scenario_files: Iterable[PathLike], success_radius: float,
@@ -292,10 +292,10 @@ def pathlength_report(eval_files: Iterable[PathLike], scenario_files: Iterable[P
     df = pathlength_frame(eval_files, scenario_files, success_radius, bound_files, confidence, n_resamples, seed)
     policy = parse_eval_path(eval_files[0])["variant"]
     base = output_base(out_prefix, "pathlength")
-    csv = Path(out_csv) if out_csv is not None else _with(base, ".csv")
+    csv = Path(out_csv) if out_csv is not None else suffixed(base, ".csv")
     csv.parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(csv, index=False, float_format="%.6g")
-    md = _with(base, ".md")
+    md = suffixed(base, ".md")
     md.write_text(_markdown(df, policy, success_radius, f"{confidence * 100:g}%", csv.name), encoding="utf-8")
     return [csv, md, *_figure(df, policy, base)]
 
@@ -343,14 +343,7 @@ def compare_by_length(reference_files: Mapping | Iterable[PathLike], candidate_f
     df = pd.DataFrame(rows)
     if df.empty:
         raise ValueError("compare: no episodes in any ℓ bin")
-    df["p_holm"] = holm(df["p_uncorrected"].to_numpy())
-    df["significant_holm"] = df["p_holm"] < 0.05
-    df = df[list(BY_LENGTH_COLUMNS)]
-    if out_csv is not None:
-        out_csv = Path(out_csv)
-        out_csv.parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(out_csv, index=False, float_format="%.6g")
-    return df
+    return holm_and_write(df, BY_LENGTH_COLUMNS, out_csv)
 
 
 def by_length_path(out_csv: PathLike) -> Path:

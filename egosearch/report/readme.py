@@ -23,7 +23,14 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
+
+from egosearch.report.behaviour import block_claims
+from egosearch.report.gpu import block_gpu, block_gpu_projection
+from egosearch.report.speed import block_speed
+from egosearch.report.stats import cell_contrast
+from egosearch.report.tables import BOTH_HOMES, PAPER_TABLE1
+from egosearch.report.workflow_jobs import job_cost_s, job_study, workflow_config
+from egosearch.report.workflow_jobs import variants_of_all as variants_of_all  # re-exported for older callers
 
 BLOCK = re.compile(r"(<!-- egosearch:begin (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- egosearch:end (?P=name) -->)",
                    re.DOTALL)
@@ -75,57 +82,6 @@ def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
                      f"{_fmt(r.attempts, 1)} [{_fmt(r.attempts_low, 1)}, {_fmt(r.attempts_high, 1)}] | "
                      f"{_fmt(r.penetration_rate, 3)} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
-
-
-def workflow_config() -> dict:
-    """The experiment list the Snakefile reads (``egosearch/workflow/config.yaml``)."""
-    return yaml.safe_load((Path(__file__).resolve().parent.parent / "workflow" / "config.yaml").read_text())
-
-
-def variants_of_all(config: dict | None = None) -> list[str]:
-    """The variants `snakemake all` trains, in the DAG's order (comparisons train others)."""
-    config = config or workflow_config()
-    return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
-
-
-GENERATED_GROUPS = ("generated_train", "generated_heldout")
-"""The generalisation benchmark's groups of generated homes (rules/common.smk's layouts)."""
-REPORTS_OUTSIDE_ALL = {"budget": "other", "fresh": "other", "behaviour": "other", "searches": "other",
-                       "generalise": "generalise"}
-
-
-def job_study(job: dict, config: dict | None = None) -> str:
-    """Which command a recorded job belongs to: "all", "generalise", or "other" (comparisons,
-    the budget study, the fresh-set check, the traces)."""
-    config = config or workflow_config()
-    of_all = set(variants_of_all(config))
-    generalise_only = set(config.get("generalise", {}).get("variants", [])) - of_all
-    rule, parts = job["rule"], job["job"].split("/")
-    if rule in ("fresh", "traces"):
-        return "other"
-    if rule == "report":
-        return REPORTS_OUTSIDE_ALL.get(parts[0], "all")
-    if any(part in GENERATED_GROUPS for part in parts):
-        return "generalise"
-    if rule in ("train", "eval"):
-        if parts[0] in of_all:
-            return "all"
-        return "generalise" if parts[0] in generalise_only else "other"
-    return "all"
-
-
-def job_cost_s(job: dict) -> float:
-    """What a one-thread job costs a core of its own: its CPU time where the benchmark recorded it,
-    else its wall time. A job that ran beside more jobs than cores waited for a core part of its wall
-    time (three trainings on two cores take half as long again each). A resumed training's benchmark
-    timed only its last part: its cost is scaled to the whole run by wall time (``run_wall_s``),
-    which assumes the earlier part spent its wall time on the CPU in the same proportion."""
-    cpu = job.get("cpu_s")
-    cost = float(cpu) if cpu is not None and 0 < cpu <= job["wall_s"] else float(job["wall_s"])
-    run_wall = job.get("run_wall_s")
-    if run_wall is not None and run_wall > job["wall_s"] > 0:
-        cost *= run_wall / job["wall_s"]
-    return cost
 
 
 def block_provenance(root: Path, profile: str) -> str:
@@ -313,8 +269,6 @@ def table1_contrast(root: Path, profile: str, variant: str = "head_on") -> Calla
     """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every Table 1
     home it was evaluated in (not the generalisation groups) and every seed, each episode joined to
     its scenario's draw (home, start, target)."""
-    from egosearch.report.stats import cell_contrast
-
     homes = set(workflow_config()["homes"])
 
     def cell(height: float, placement: str) -> pd.DataFrame | None:
@@ -344,17 +298,15 @@ def _reading_table1(df: pd.DataFrame, contrast: Callable[[tuple, tuple], dict | 
     """``contrast((height, placement), (height, placement))``: the first cell minus the second from the
     per-episode files (:func:`stats.cell_contrast`), or None where they are not stored; without it the
     comparisons fall back to whether the cells' own intervals overlap."""
-    from egosearch.report.tables import BOTH_HOMES
-    from egosearch.report.tables import PAPER_TABLE1 as PAPER
-
     if "home" in df.columns:  # the rows set beside the paper's column: every home pooled, or the only one
         homes = set(df["home"])
         df = df[df["home"] == (BOTH_HOMES if BOTH_HOMES in homes else sorted(homes)[0])]
     df = df.assign(height=df["height"].round(2))
     cell = {(r.height, r.placement): r for r in df.itertuples(index=False)}
     out = []
-    close = [(h, pl) for (h, pl), r in cell.items() if abs(r.success_rate - PAPER.get((h, pl), math.nan)) <= 0.10]
-    far = ", ".join(f"{h:g} m {pl.replace('_', ' ')} {_fmt(r.success_rate)} vs {_fmt(PAPER[(h, pl)])}"
+    close = [(h, pl) for (h, pl), r in cell.items()
+             if abs(r.success_rate - PAPER_TABLE1.get((h, pl), math.nan)) <= 0.10]
+    far = ", ".join(f"{h:g} m {pl.replace('_', ' ')} {_fmt(r.success_rate)} vs {_fmt(PAPER_TABLE1[(h, pl)])}"
                     for (h, pl), r in cell.items() if (h, pl) not in close)
     out.append(f"- **Table 1 against the paper:** within 0.10 of the paper's success rate in {len(close)} of "
                f"{len(cell)} cells" + (f"; further off in the others (ours vs paper): {far}." if far else "."))
@@ -368,7 +320,7 @@ def _reading_table1(df: pd.DataFrame, contrast: Callable[[tuple, tuple], dict | 
         if low is None or not tall:
             continue
         ours = np.mean([t.success_rate for t in tall]) - low.success_rate
-        paper = np.mean([PAPER[(t.height, pl)] for t in tall]) - PAPER[(0.45, pl)]
+        paper = np.mean([PAPER_TABLE1[(t.height, pl)] for t in tall]) - PAPER_TABLE1[(0.45, pl)]
         taller = " and ".join(f"{t.height:g}" for t in tall)
         sides = [f"{t.height:g} m minus 0.45 m {t.success_rate - low.success_rate:+.2f}: " + _contrast_text(
                      contrast and contrast((t.height, pl), (0.45, pl)),
@@ -382,7 +334,7 @@ def _reading_table1(df: pd.DataFrame, contrast: Callable[[tuple, tuple], dict | 
         a, b = cell.get((h, "everywhere")), cell.get((h, "no_low_cabinets"))
         if a is None or b is None:
             continue
-        paper = PAPER[(h, "everywhere")] - PAPER[(h, "no_low_cabinets")]
+        paper = PAPER_TABLE1[(h, "everywhere")] - PAPER_TABLE1[(h, "no_low_cabinets")]
         apart = _contrast_text(contrast and contrast((h, "everywhere"), (h, "no_low_cabinets")),
                                (a.success_rate, a.ci_low, a.ci_high, b.success_rate, b.ci_low, b.ci_high))
         moves.append(f"{h:g} m {a.success_rate - b.success_rate:+.2f} (paper {paper:+.2f}; {apart})")
@@ -445,33 +397,6 @@ def block_reading(root: Path, profile: str) -> str:
             + f"`; the height and cabinet contrasts from `results/{profile}/eval/head_on/` and the scenario sets.\n")
 
 
-def _block_speed(root: Path, profile: str) -> str:
-    """The stored benchmark records and trainings' speed (:mod:`egosearch.report.speed`)."""
-    from egosearch.report.speed import block_speed
-
-    return block_speed(root, profile)
-
-
-def _block_claims(root: Path, profile: str) -> str:
-    """The paper's behaviour sentences against the per-step traces (:mod:`egosearch.report.behaviour`)."""
-    from egosearch.report.behaviour import block_claims
-
-    return block_claims(root, profile)
-
-
-def _block_gpu(root: Path, profile: str) -> str:
-    """The stored GPU check and the paper profile's projection (:mod:`egosearch.report.gpu`)."""
-    from egosearch.report.gpu import block_gpu
-
-    return block_gpu(root, profile)
-
-
-def _block_gpu_projection(root: Path, profile: str) -> str:
-    from egosearch.report.gpu import block_gpu_projection
-
-    return block_gpu_projection(root, profile)
-
-
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
@@ -485,10 +410,10 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "compare": block_compare,
     "power": block_power,
     "reading": block_reading,
-    "claims": _block_claims,
-    "speed": _block_speed,
-    "gpu": _block_gpu,
-    "gpu_projection": _block_gpu_projection,
+    "claims": block_claims,  # the paper's behaviour sentences against the per-step traces
+    "speed": block_speed,  # the stored benchmark records and trainings' speed
+    "gpu": block_gpu,  # the stored GPU check and the paper profile's projection
+    "gpu_projection": block_gpu_projection,
 }
 
 DOCS = "docs"

@@ -8,7 +8,8 @@
 - :func:`gaze_heatmap`: where the camera's centre ray lands over every step of every episode of one
   cell, one panel per variant.
 
-Outside ``egosearch.report`` because it draws the floor plan (``egosearch.scene.topdown``).
+Not imported by ``egosearch.report`` or its CLI module: it draws the floor plan with ``egosearch.scene``,
+which loads trimesh (only when drawing: see the ``# local:`` imports).
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
@@ -85,11 +88,8 @@ def _draw_episode(ax, ep: pd.DataFrame, max_depth: float) -> None:
 
 def search_maps(trace: PathLike, out: PathLike, quantiles=PICK_QUANTILES) -> Path:
     """One picture of the episodes :func:`pick_episodes` chooses from ``trace`` (see the module docstring)."""
-    import matplotlib
-
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    # local: egosearch.scene loads trimesh (about 1 s), which the report layer imports only to draw a floor plan
     from egosearch.scene.layouts import get_scene
     from egosearch.scene.topdown import plot_topdown
 
@@ -130,11 +130,8 @@ def gaze_heatmap(traces: Iterable[PathLike], out: PathLike) -> Path:
     step after a reset of every episode in ``traces`` (one cell: one home, placement and height; any
     variants and seeds), one panel per variant, as a share of that variant's steps per
     :data:`HEAT_BIN` square."""
-    import matplotlib
-
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    # local: egosearch.scene loads trimesh (about 1 s), which the report layer imports only to draw a floor plan
     from egosearch.scene.layouts import get_scene
     from egosearch.scene.topdown import plot_topdown
 

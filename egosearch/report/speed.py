@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from egosearch.report.provenance import WHOLE_RUN_SHARE
+from egosearch.report.workflow_jobs import variants_of_all
 
 ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
 """The issue's one-core targets for the sensor and the env."""
@@ -153,8 +154,6 @@ def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
 
 
 def block_speed(root: Path, profile: str) -> str:
-    from egosearch.report.readme import variants_of_all
-
     sections = [_env_lines(root, profile), _learner_lines(root, profile),
                 _training_lines(root, profile, variants_of_all())]
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"

@@ -93,6 +93,16 @@ def _two_level_means(m: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.nd
     return np.take_along_axis(col_sums, cols, axis=1).mean(axis=1) / m.shape[0]
 
 
+def quantile_interval(draws: np.ndarray, confidence: float) -> tuple[float, float]:
+    """The central ``confidence`` percentile interval of the finite ``draws``; ``(nan, nan)`` when none is finite."""
+    draws = draws[np.isfinite(draws)]
+    if draws.size == 0:
+        return math.nan, math.nan
+    alpha = (1 - confidence) / 2
+    lo, hi = np.quantile(draws, [alpha, 1 - alpha])
+    return float(lo), float(hi)
+
+
 def two_level_ci(m: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_000,
                  seed: int = 0) -> tuple[float, float, float]:
     """Mean of a (scenarios x seeds) matrix and its two-level bootstrap interval.

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from egosearch.report.data import _sorted_cells, _with, output_base, read_episodes
+from egosearch.report.data import output_base, read_episodes, sorted_cells, suffixed
 from egosearch.report.stats import (
     METRICS,
     bootstrap_ci,
@@ -114,7 +114,7 @@ def _read_cells(episode_files: Mapping, what: str) -> dict[tuple, pd.DataFrame]:
 
 def _sorted_home_cells(cells) -> list[tuple]:
     homes = sorted({c[0] for c in cells}, key=lambda h: (h == BOTH_HOMES, h))
-    return [(home, h, pl) for home in homes for h, pl in _sorted_cells({c[1:] for c in cells if c[0] == home})]
+    return [(home, h, pl) for home in homes for h, pl in sorted_cells({c[1:] for c in cells if c[0] == home})]
 
 
 def _bound_row(df: pd.DataFrame | None, bound: str, confidence: float) -> dict:
@@ -248,7 +248,7 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
     """
     df = table1_frame(episode_files, confidence, n_resamples, seed, bounds=bounds)
     base = output_base(out_prefix, "table1")
-    out_csv = _with(base, ".csv")
+    out_csv = suffixed(base, ".csv")
     df.to_csv(out_csv, index=False, float_format="%.6g")
     homes = sorted(set(df["home"]), key=lambda h: (h != BOTH_HOMES, h))
     pct = f"{confidence * 100:g}%"
@@ -286,8 +286,8 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
                           "homes (Section 6) and gives one number per cell. " if BOTH_HOMES in homes else "")
                        + f"SPL and its interval, and the {pct} bootstrap over per-seed success rates, are in "
                        f"{out_csv.name}. Paper: Table 1 of Sorokin et al. 2021.", ""]
-    _with(base, ".md").write_text("\n".join(md_all).rstrip("\n") + "\n", encoding="utf-8")
-    _with(base, ".tex").write_text("\n".join(tex_all), encoding="utf-8")
+    suffixed(base, ".md").write_text("\n".join(md_all).rstrip("\n") + "\n", encoding="utf-8")
+    suffixed(base, ".tex").write_text("\n".join(tex_all), encoding="utf-8")
     return df
 
 
@@ -315,7 +315,7 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
                "| Field | This profile | Paper | Source and meaning (the field's docstring) |", "|---|---|---|---|"]
         md += [f"| `{f}` | {_md_escape(mine)} | {_md_escape(paper)} | {_md_escape(doc)} |"
                for f, mine, paper, doc in departures]
-    _with(base, ".md").write_text("\n".join(md) + "\n", encoding="utf-8")
+    suffixed(base, ".md").write_text("\n".join(md) + "\n", encoding="utf-8")
     tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{ll}", r"\toprule",
            r"Parameter & Setting \\", r"\midrule"]
     tex += [f"{_tex_escape(a)} & {_tex_escape(b)} " + r"\\" for a, b in rows]
@@ -325,7 +325,7 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
                 for f, mine, paper, _ in departures]
     tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + _tex_escape(caption) + "}", r"\label{tab:table2}",
             r"\end{table}", ""]
-    _with(base, ".tex").write_text("\n".join(tex), encoding="utf-8")
+    suffixed(base, ".tex").write_text("\n".join(tex), encoding="utf-8")
 
 
 # --------------------------------------------------------------------------------------------- compare
@@ -363,7 +363,7 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
     if not ref_cells:
         raise ValueError("compare: no cells given")
     rows = []
-    for cell in _sorted_cells(ref_cells):
+    for cell in sorted_cells(ref_cells):
         ref = read_episodes(reference_files[cell])
         cand = read_episodes(candidate_files[cell])
         for metric in metrics:
@@ -373,10 +373,15 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
                 raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
             homes = "+".join(sorted({_home_of(x) for x in ref["scenario_set"]}))
             rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res, "homes": homes})
-    df = pd.DataFrame(rows)
+    return holm_and_write(pd.DataFrame(rows), COMPARE_COLUMNS, out_csv)
+
+
+def holm_and_write(df: pd.DataFrame, columns: Iterable[str], out_csv: PathLike | None = None) -> pd.DataFrame:
+    """A comparison frame with ``p_holm`` (Holm over all its rows) and ``significant_holm``, cut to ``columns``,
+    written to ``out_csv`` when given."""
     df["p_holm"] = holm(df["p_uncorrected"].to_numpy())
     df["significant_holm"] = df["p_holm"] < 0.05
-    df = df[list(COMPARE_COLUMNS)]
+    df = df[list(columns)]
     if out_csv is not None:
         out_csv = Path(out_csv)
         out_csv.parent.mkdir(parents=True, exist_ok=True)

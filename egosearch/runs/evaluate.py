@@ -8,8 +8,9 @@ import gymnasium
 
 import egosearch.sim.envs  # noqa: F401  (registers the ids)
 from egosearch.core.csvio import write_csv_atomic
-from egosearch.runs.metrics import episode_spl
-from egosearch.sim.scenarios import Scenario
+from egosearch.runs.metrics import episode_spl, spl
+from egosearch.sim.agent import EVAL_HEIGHTS
+from egosearch.sim.scenarios import Scenario, generate_scenarios
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl",
                    "collisions", "episode_return")
@@ -85,10 +86,6 @@ def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: 
     in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
     ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
     variant trains with, so that the curves of variants are on one scale."""
-    from egosearch.runs.metrics import spl
-    from egosearch.sim.agent import EVAL_HEIGHTS
-    from egosearch.sim.scenarios import generate_scenarios
-
     layouts = [layout] if isinstance(layout, str) else list(layout)
     groups = [(home, h) for home in layouts for h in EVAL_HEIGHTS]
     per_group = [generate_scenarios(home, placement, h, n=-(-n // len(groups)), seed=seed) for home, h in groups]

@@ -39,6 +39,13 @@ from pathlib import Path
 
 import numpy as np
 
+from egosearch.scene.layouts import get_scene
+from egosearch.scene.meshes import part_mesh, scene_meshes
+from egosearch.scene.parts import TAG_FLOOR, TAG_WALL
+from egosearch.sim.agent import STEP_SECONDS
+from egosearch.sim.scenarios import navgrid_for, shortest_path_region
+from egosearch.sim.sensor import camera_axes
+
 TRACE_FORMAT = 1
 GAZE_KINDS = ("target", "low_cabinet_interior", "wall_cabinet_interior", "shelf", "surface", "floor", "wall",
               "furniture", "ceiling", "none")
@@ -86,9 +93,6 @@ class HomeProbe:
     def __init__(self, layout: str):
         import trimesh
 
-        from egosearch.scene.layouts import get_scene
-        from egosearch.scene.meshes import scene_meshes
-        from egosearch.scene.parts import TAG_FLOOR
 
         self.layout = layout
         self.scene = get_scene(layout)
@@ -108,7 +112,6 @@ class HomeProbe:
     def set_target(self, target) -> None:
         import trimesh
 
-        from egosearch.scene.meshes import part_mesh
 
         if target is not self._target:
             self._target = target
@@ -146,8 +149,6 @@ class HomeProbe:
     def gaze(self, origin, direction, max_depth: float) -> tuple[tuple[float, float, float], str, str, str]:
         """Where the ray from ``origin`` along the unit ``direction`` first meets the home or the target
         within ``max_depth`` (m): (point, kind, part name, surface name)."""
-        from egosearch.scene.parts import TAG_FLOOR, TAG_WALL
-
         o, d = np.asarray([origin], float), np.asarray([direction], float)
         hits = []
         locs, _, tris = self._rays.intersects_location(o, d, multiple_hits=False)
@@ -187,8 +188,6 @@ class TraceRecorder:
         self._probes: dict[str, HomeProbe] = {}
 
     def start(self, env, scenario, info: dict) -> None:
-        from egosearch.sim.scenarios import navgrid_for, shortest_path_region
-
         base = env.unwrapped
         if scenario.layout not in self._probes:
             self._probes[scenario.layout] = HomeProbe(scenario.layout)
@@ -206,8 +205,6 @@ class TraceRecorder:
         self._add(env.unwrapped, action, info, collided=bool(info.get("collided", False)))
 
     def _add(self, base, action, info: dict, collided: bool) -> None:
-        from egosearch.sim.sensor import camera_axes
-
         s, target, probe = base.state, base.target, self._probe
         point, kind, part, surface = probe.gaze(s.camera_position, camera_axes(s.camera_yaw, s.pitch)[2],
                                                 base.sensor.max_depth)
@@ -253,6 +250,4 @@ class TraceRecorder:
 
 
 def _step_seconds() -> float:
-    from egosearch.sim.agent import STEP_SECONDS
-
     return STEP_SECONDS

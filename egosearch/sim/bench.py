@@ -17,6 +17,13 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+import egosearch.sim.envs  # noqa: F401  (registers the ids)
+from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
+from egosearch.scene.layouts import get_scene
+from egosearch.scene.meshes import triangle_count
+from egosearch.sim.scenarios import MAX_STEPS
+from egosearch.sim.sensor import bench_sensor
+
 
 @contextlib.contextmanager
 def one_core():
@@ -35,11 +42,6 @@ def one_core():
 
 def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3000, seed: int = 0) -> dict:
     import gymnasium
-
-    import egosearch.sim.envs  # noqa: F401
-    from egosearch.scene.layouts import get_scene
-    from egosearch.scene.meshes import triangle_count
-    from egosearch.sim.sensor import bench_sensor
 
     scene = get_scene(layout)
     with one_core() as core:
@@ -83,9 +85,6 @@ def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: 
     with :class:`egosearch.sim.home_pool.HomePoolEnv`'s pool (one build every ``episodes_per_swap``
     episodes, ``pool_size`` at the start, amortised over a 300k-step run of 100-step episodes)."""
     import gymnasium
-
-    import egosearch.sim.envs  # noqa: F401
-    from egosearch.sim.scenarios import MAX_STEPS
 
     builds, steps_s = [], []
     rng = np.random.default_rng(seed)
@@ -149,8 +148,6 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     and how busy the machine was. A speed figure means little without the load beside it: the load
     average before and after, and ``other_load_cores``, the CPU time other processes used during the
     run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
-    from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
-
     load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
     busy0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
     result = run()

@@ -448,6 +448,7 @@ class SearchEnv(gymnasium.Env):
     def render(self):
         if self.render_mode != "rgb_array":
             return None
+        # local: pyrender and its EGL context load only when a picture is asked for
         from egosearch.sim.render import depth_to_colormap
 
         return depth_to_colormap(self._last_depth.astype(np.float32) / 255.0 * self.sensor.max_depth,

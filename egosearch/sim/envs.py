@@ -22,6 +22,7 @@ for _env_id, _kwargs in ENV_IDS.items():
 
 def env_space_dims(env_id: str) -> dict[str, int]:
     """``{"action", "mask", "proprio"}`` sizes of a registered id, without building its env."""
+    # local: registering the ids must not load pybullet and the sensor (the Snakefile's checks import this)
     from egosearch.sim.env import space_dims
 
     return space_dims(**ENV_IDS[env_id])

@@ -32,6 +32,7 @@ PAPER_HOMES = "paper_homes"
 def curve_homes(train_env: dict) -> list[str]:
     """The homes a variant's training curve (Figure 6) is read in: both paper homes for a policy trained in
     either or both of them; a policy trained in generated homes is read in its split's first home."""
+    # local: egosearch.scene loads trimesh (~2 s); the Snakefile's variant checks import this module
     from egosearch.scene.layouts import LAYOUT_NAMES
 
     layout = train_env["layout"]

@@ -14,14 +14,21 @@ from pathlib import Path
 
 import numpy as np
 
+from egosearch.scene.layouts import get_scene
+from egosearch.scene.objects import TARGET_OBJECTS, get_object
+from egosearch.scene.parts import TAG_LOW_CABINET_INTERIOR, Part
+from egosearch.scene.placement import PLACEMENT_SCHEMES, rests_on_support, sample_target
+from egosearch.scene.topdown import plot_topdown
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.render import SceneRenderer, depth_to_colormap
+from egosearch.sim.scenarios import navgrid_for, visible_from
+from egosearch.sim.sensor import DepthMaskSensor
+
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 
 def agent_parts(x: float, y: float, yaw: float, camera_height: float):
     """The abstract searcher drawn as parts: a body cylinder and a camera box on a neck."""
-    from egosearch.scene.parts import Part
-    from egosearch.sim.agent import AgentSpec
-
     spec = AgentSpec()
     body_top = max(0.2, camera_height - 0.15)
     parts = [Part("agent/body", "cylinder", (x, y, body_top / 2), (2 * spec.body_radius,) * 2 + (body_top,),
@@ -34,8 +41,6 @@ def agent_parts(x: float, y: float, yaw: float, camera_height: float):
 
 def _viewpoint(layout: str, target, height: float, rng, near: float = 0.8, far: float = 1.8):
     """A free body position from which the camera at ``height`` sees the target."""
-    from egosearch.sim.scenarios import navgrid_for, visible_from
-
     grid = navgrid_for(layout)
     gx, gy = np.meshgrid(grid.xs, grid.ys)
     d = np.hypot(gx - target.center[0], gy - target.center[1])
@@ -52,9 +57,6 @@ def _viewpoint(layout: str, target, height: float, rng, near: float = 0.8, far: 
 
 def _over_the_shoulder(layout: str, scene, x: float, y: float, yaw: float, height: float):
     """A third-person eye behind the searcher that sees it past walls and furniture."""
-    from egosearch.scene.parts import Part
-    from egosearch.sim.scenarios import visible_from
-
     head = Part("probe", "box", (x, y, height - 0.3), (0.3, 0.3, 0.6))
     x0, y0, x1, y1 = scene.bounds
     candidates = []
@@ -74,12 +76,6 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from egosearch.scene.layouts import get_scene
-    from egosearch.scene.objects import TARGET_OBJECTS, get_object
-    from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
-    from egosearch.scene.topdown import plot_topdown
-    from egosearch.sim.render import SceneRenderer, depth_to_colormap
-    from egosearch.sim.sensor import DepthMaskSensor
 
     scene = get_scene(layout)
     out = Path(out_dir)
@@ -98,7 +94,6 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
     written.append(path)
 
     # Figure 5: close-ups of placements, half of them inside low cabinets when possible.
-    from egosearch.scene.parts import TAG_LOW_CABINET_INTERIOR
 
     shots = []
     tries = 0
@@ -108,8 +103,6 @@ def make_pictures(layout: str, out_dir: str | os.PathLike, seed: int = 0) -> lis
         obj = get_object(names[int(rng.integers(len(names)))])
         target = sample_target(scene, obj, scheme, rng)
         if scheme == "everywhere":
-            from egosearch.scene.placement import rests_on_support
-
             surface = rests_on_support(scene, target)
             if surface is None or TAG_LOW_CABINET_INTERIOR not in surface.tags:
                 continue

@@ -1,0 +1,34 @@
+"""``egosearch evaluate``."""
+
+from __future__ import annotations
+
+from egosearch.cli.acting import policy_factory, set_acting_threads
+from egosearch.core.outputs import check_outputs
+from egosearch.runs.evaluate import evaluate, write_episodes
+from egosearch.runs.metrics import spl
+from egosearch.runs.trace import TraceRecorder
+from egosearch.sim.envs import ENV_IDS
+from egosearch.sim.scenarios import read_scenarios
+
+
+def run(args) -> None:
+    check_outputs(files={"--out": args.out, "--traces": args.traces})
+    set_acting_threads(args.threads)
+    if args.env_id and args.env_id not in ENV_IDS:
+        raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
+    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id)
+    scenarios = read_scenarios(args.scenarios)
+    recorder = None
+    if args.traces:
+        if not args.traces.endswith(".npz"):
+            raise ValueError(f"--traces={args.traces!r}: a trace file must end in .npz")
+        recorder = TraceRecorder()
+    rows = evaluate(env_id, make_policy, scenarios, seed=args.seed, progress=True,
+                    desc=f"evaluate {args.policy} on {env_id}", recorder=recorder)
+    write_episodes(args.out, rows)
+    if recorder is not None:
+        print(f"wrote {recorder.write(args.traces)}: {len(recorder.columns['step'])} steps of {len(rows)} episodes")
+    rate = sum(r["success"] for r in rows) / len(rows)
+    value = spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
+                [r["path_length"] for r in rows])
+    print(f"{args.policy}: success {rate:.3f}  SPL {value:.3f}  over {len(rows)} episodes -> {args.out}")

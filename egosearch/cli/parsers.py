@@ -1,0 +1,253 @@
+"""The command line's parsers: one small function per command, each adding its sub-parser.
+
+Standard library and plain scene data only, so that ``egosearch --help`` is instant; each command's
+body lives in ``egosearch/cli/<command>.py``, imported only when that command runs.
+"""
+
+from __future__ import annotations
+
+from egosearch.scene.layouts import LAYOUT_NAMES
+from egosearch.scene.placement import PLACEMENT_SCHEMES
+from egosearch.sim.agent import EVAL_HEIGHTS, HEIGHT_RANGE
+
+LAYOUTS = f"{', '.join(LAYOUT_NAMES)} or home<seed> (a generated home)"
+THREADS = "torch threads for acting (default 1; 0: all cores)"
+POLICY_SEED = "seed of the random policy and of the env's per-step noise (default 0)"
+
+
+def add_scenarios(sub) -> None:
+    p = sub.add_parser("scenarios", help="generate a fixed scenario set as CSV")
+    p.add_argument("--layout", default="kitchen_living", help=f"home: {LAYOUTS}")
+    p.add_argument("--placement", default="everywhere", choices=PLACEMENT_SCHEMES,
+                   help="where targets may be: every support surface, or none inside low cabinets")
+    p.add_argument("--height", type=float, default=1.65,
+                   help=f"camera height (m): any value in [{HEIGHT_RANGE[0]}, {HEIGHT_RANGE[1]}] is a valid "
+                        f"experiment; Table 1 uses {', '.join(f'{h:g}' for h in EVAL_HEIGHTS)} (default 1.65)")
+    p.add_argument("--n", type=int, default=100, help="number of scenarios (per home with --homes; default 100)")
+    p.add_argument("--homes", default=None, metavar="FIRST:STOP",
+                   help="instead of --layout: generated homes home<FIRST> ... home<STOP-1>, --n scenarios each, "
+                        "in one set (the generalisation benchmark's groups)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the set: the same seed gives the same rows")
+    p.add_argument("--out", required=True, help="the scenario CSV to write")
+
+
+def add_evaluate(sub) -> None:
+    p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
+                                                     "target), random, or frontier / frontier_head_off (the "
+                                                     "classical searcher, head moving or fixed)")
+    p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor)")
+    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier, "
+                                    "EgoSearchNoHead-v0 for frontier_head_off")
+    p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
+    p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
+    p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
+                                                        "what the camera's centre looks at, distances) to this "
+                                                        "compressed file (egosearch.runs.trace)")
+    p.add_argument("--threads", type=int, default=1, help=THREADS)
+
+
+def add_train(sub) -> None:
+    p = sub.add_parser("train", help="train a variant's search policy with SAC+CURL (resumable)")
+    p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...)")
+    p.add_argument("--profile", default="cpu", help="learner profile: smoke, cpu or paper (default: cpu)")
+    p.add_argument("--seed", type=int, default=0, help="training seed (default 0)")
+    p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
+    p.add_argument("--out-dir", required=True, help="run folder: actor.pt, curve.csv, train.csv, checkpoint; "
+                                                    "rerun with the same folder to resume")
+    p.add_argument("--work-dir", help="train (and resume) here, and copy the files to --out-dir only once the run "
+                                      "is complete (the DAG does: a killed job never leaves a partial output)")
+    p.add_argument("--max-wall-s", type=float, help="stop after this many seconds with a checkpoint written (inside "
+                                                    "a cluster's time limit); the same command resumes it")
+
+
+def add_variant(sub) -> None:
+    p = sub.add_parser("variant", help="create a variant file in ablations/ from a template, or check variants")
+    variants = p.add_subparsers(dest="what", required=True, metavar="ACTION")
+    v = variants.add_parser("new", help="write ablations/NAME.yaml, a copy of a template with name: NAME")
+    v.add_argument("name", help="the new variant's name (letters, digits, _ and -)")
+    v.add_argument("--from", dest="template", default="head_on", help="the variant to copy (default: head_on)")
+    v = variants.add_parser("check", help="check variant files, learner config included, before running them")
+    v.add_argument("names", nargs="+", help="variant names (files in ablations/) or paths of .yaml files")
+    v.add_argument("--profile", nargs="+", default=["smoke", "cpu", "paper"],
+                   help="learner profiles to check the config against (default: all three)")
+
+
+def add_fullbody(sub) -> None:
+    p = sub.add_parser("fullbody", help="full-body search (Algorithm 1 or a baseline) -> per-episode CSV")
+    p.add_argument("--setting", required=True,
+                   help="ours-M<M>-<mg>, one_step_short-<mg>, one_step_long-<mg> or noisy_search-<mg>; "
+                        "<mg>: humanoid_phase, humanoid_matching or fetch")
+    p.add_argument("--policy", default="actor",
+                   help="the planner: actor (with --weights), or oracle (privileged: knows the target) or random")
+    p.add_argument("--weights", help="actor.pt of the search policy (for --policy actor)")
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    p.add_argument("--limit", type=int, default=0, help="use the first N scenarios (0: all)")
+    p.add_argument("--T", type=int, default=20, help="planning horizon (default 20)")
+    p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
+    p.add_argument("--out", required=True, help="the per-episode CSV to write")
+    p.add_argument("--threads", type=int, default=1, help=THREADS)
+
+
+def add_bench(sub) -> None:
+    p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics), homes (building one) or learner")
+    p.add_argument("what", choices=("env", "homes", "learner", "gpu"),
+                   help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
+                        "against a training episode; learner: SAC+CURL updates/s; gpu: the learner benchmarks and "
+                        "a paper-profile training of --seconds on this machine's GPU (results/paper/gpu_check)")
+    p.add_argument("--layout", default="kitchen_living", help=f"env: the home ({LAYOUTS})")
+    p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
+    p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
+    p.add_argument("--seconds", type=float, default=150.0, help="gpu: the training's wall time (default 150)")
+    p.add_argument("--out-dir", help="gpu: the training's folder (curve.csv, train.csv, config.json, checkpoint)")
+    p.add_argument("--cuda-graph", action="store_true",
+                   help="gpu: train with the update recorded as CUDA graphs (learner.cuda_graph=true, which the "
+                        "paper profile sets anyway)")
+    p.add_argument("--baseline-seconds", type=float, default=0.0,
+                   help="gpu: also train this long with the update launched eagerly (cuda_graph false; in "
+                        "<out-dir>/baseline), for the ratio on one machine")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
+                                 "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")
+
+
+def add_video(sub) -> None:
+    p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
+    p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch")
+    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    p.add_argument("--scenario-id", type=int, default=0, help="the scenario_id of the row to search (default 0)")
+    p.add_argument("--first-success", metavar="FULLBODY_CSV",
+                   help="film the first scenario (by scenario_id) that succeeded in this full-body CSV of the same "
+                        "settings with no penetrating pose, in at least --min-steps steps (instead of --scenario-id, "
+                        "which is filmed when none did)")
+    p.add_argument("--min-steps", type=int, default=0,
+                   help="--first-success: the fewest steps of a filmed episode (default 0)")
+    p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
+    p.add_argument("--weights", help="actor.pt of the search policy")
+    p.add_argument("--M", type=int, default=5, help="steps executed per plan")
+    p.add_argument("--T", type=int, default=20, help="planning horizon")
+    p.add_argument("--seed", type=int, default=0,
+                   help="scenario k's episode is seeded with this + k, as `egosearch fullbody` seeds it (default 0)")
+    p.add_argument("--out", required=True, help=".mp4 or .gif")
+    p.add_argument("--still", required=True, help=".png of the moment the target is found")
+    p.add_argument("--threads", type=int, default=1, help=THREADS)
+
+
+
+def add_pictures(sub) -> None:
+    p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")
+    p.add_argument("--layout", default="kitchen_living", help=f"home: {LAYOUTS}")
+    p.add_argument("--out-dir", default="paper_figs/world", help="folder of the PNGs (default: paper_figs/world)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the placement examples (default 0)")
+
+
+def add_report(sub) -> None:
+    """One sub-command per report, each with its own options and ``--help``."""
+    p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
+    reports = p.add_subparsers(dest="what", required=True, metavar="REPORT")
+    profile = dict(default="cpu", help="profile: smoke, cpu or paper (default: cpu)")
+    prefix = "output path without extension, or a folder (writes {})"
+
+    r = reports.add_parser("table1", help="Table 1 (success per height and placement) from evaluation CSVs")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{layout}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .csv and .tex"))
+    r.add_argument("--variant", help="the variant of the files (default: read from their paths)")
+    r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the random searcher and the oracle "
+                                               "(.../eval/{random,oracle}/...): rows that bound the policy")
+
+    r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md and .tex"))
+
+    r = reports.add_parser("fig6", help="Figure 6 (success vs env steps) from training curves")
+    r.add_argument("files", nargs="+", help="curve.csv files: .../train/{variant}/seed{seed}/curve.csv")
+    r.add_argument("--random", nargs="*", help="evaluation CSVs of the random searcher: its level, dashed")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+
+    r = reports.add_parser("fig7", help="Figure 7 (SPL and attempts per method) from full-body CSVs")
+    r.add_argument("files", nargs="+", help="full-body CSVs: .../{setting}/seed{seed}.csv")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+    r.add_argument("--planner", default="actor", choices=("actor", "oracle"),
+                   help="which planner drove the full-body runs (oracle figures say so in a title)")
+
+    r = reports.add_parser("budget", help="the budget study: success at one cell vs env steps and core-hours")
+    r.add_argument("--run", action="append", required=True, metavar="SETTING=CURVE_CSV:EVAL_CSV",
+                   help="one training run of a setting: its curve.csv and its per-episode CSV at the cell "
+                        "(repeat per seed and setting)")
+    r.add_argument("--chosen", help="the setting the profile uses (drawn filled)")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+
+    r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell "
+                                           "and per shortest-path bin")
+    r.add_argument("--reference", nargs="+", required=True, help="the reference variant's evaluation CSVs")
+    r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
+    r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
+                                 "pooled, to <out stem>_by_length.csv) as well as printing them")
+
+    r = reports.add_parser("pathlength", help="success by shortest path ℓ and by detour, with two-level intervals")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{home}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--scenarios", nargs="+", required=True, help="the scenario sets they ran: .../scenarios/{home}/"
+                                                                 "{placement}/h{height}.csv")
+    r.add_argument("--bounds", nargs="*", help="the reference searchers' evaluation CSVs on the same scenarios "
+                                               "(.../eval/{random,frontier,oracle}/...): a line each")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .png and .pdf"))
+    r.add_argument("--out-csv", help="the numbers (default: <out-prefix>.csv)")
+
+    r = reports.add_parser("generalise", help="trained-on x evaluated-on: normalised scores per group of homes")
+    r.add_argument("files", nargs="+", help="evaluation CSVs of the policies: .../{variant}/seed{seed}/{group}/"
+                                            "{placement}/h{height}.csv")
+    r.add_argument("--bounds", nargs="+", required=True, help="the random searcher's and the oracle's evaluation "
+                                                              "CSVs on the same groups")
+    r.add_argument("--generated", help="the variant trained in generated homes (its gap to its training split)")
+    r.add_argument("--reference", help="the variant trained in the paper homes: the generated-homes variant's "
+                                       "score there is read against it")
+    r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
+                   help="what each variant trained in, for the labels")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))
+
+    r = reports.add_parser("fresh", help="the reference on its stored scenario sets against fresh sets of the same "
+                                         "cells: is a gain tuned to the stored sets?")
+    r.add_argument("--stored", nargs="+", required=True, help="evaluation CSVs on the stored sets: .../{variant}/"
+                                                              "seed{seed}/{home}/{placement}/h{height}.csv")
+    r.add_argument("--fresh", nargs="+", required=True, help="the same actors' evaluation CSVs on the fresh sets")
+    r.add_argument("--variant", default="head_on", help="the variant, for the caption (default: head_on)")
+    r.add_argument("--fresh-seed", type=int, help="the fresh sets' scenario seed, for the caption")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv and .md"))
+
+    traces = "trace files of `egosearch evaluate --traces`: .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
+    r = reports.add_parser("behaviour", help="how the policies search, from per-step traces, and the paper's "
+                                             "behaviour sentences (Section 6.3, Figure 6) read against them")
+    r.add_argument("files", nargs="+", help=traces)
+    r.add_argument("--head-on", default="head_on", help="the variant that moves its head (default: head_on)")
+    r.add_argument("--head-off", default="head_off", help="the variant without head movement (default: head_off)")
+    r.add_argument("--out-prefix", required=True,
+                   help=prefix.format("_episodes.csv, .csv, .md, _claims.csv and _claims.md"))
+
+    r = reports.add_parser("searches", help="top-down pictures of chosen searches and a gaze heatmap per cell, "
+                                            "from per-step traces")
+    r.add_argument("files", nargs="+", help=traces)
+    r.add_argument("--seed", type=int, default=0, help="the seed whose files give the pictured searches (default 0)")
+    r.add_argument("--out-dir", required=True, help="folder of the PNGs")
+
+    r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
+    r.add_argument("--out", required=True, help="the provenance JSON to write")
+    r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
+
+    r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a profile (seconds)")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--variant", help="the variant of Table 1 (default: the workflow config's reference_variant)")
+
+    r = reports.add_parser("verify", help="check every stored result file against the sha256 in its provenance")
+    r.add_argument("--profile", **profile)
+
+    r = reports.add_parser("readme", help="rewrite the generated blocks of the README and the docs pages from the "
+                                          "stored results")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--readme", help="the one page whose marked blocks are rewritten (default: README.md and every "
+                                    "docs/*.md page of the current folder)")
+    r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")

@@ -1,0 +1,62 @@
+"""The Snakemake workflow as the report reads it: its config, the variants ``all`` trains, and which
+study a recorded job belongs to and what it cost.
+
+Shared by :mod:`~egosearch.report.readme`, :mod:`~egosearch.report.gpu` and :mod:`~egosearch.report.speed`;
+it imports none of them (yaml and the stdlib only).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+GENERATED_GROUPS = ("generated_train", "generated_heldout")
+"""The generalisation benchmark's groups of generated homes (rules/common.smk's layouts)."""
+REPORTS_OUTSIDE_ALL = {"budget": "other", "fresh": "other", "behaviour": "other", "searches": "other",
+                       "generalise": "generalise"}
+
+
+def workflow_config() -> dict:
+    """The experiment list the Snakefile reads (``egosearch/workflow/config.yaml``)."""
+    return yaml.safe_load((Path(__file__).resolve().parent.parent / "workflow" / "config.yaml").read_text())
+
+
+def variants_of_all(config: dict | None = None) -> list[str]:
+    """The variants `snakemake all` trains, in the DAG's order (comparisons train others)."""
+    config = config or workflow_config()
+    return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
+
+
+def job_study(job: dict, config: dict | None = None) -> str:
+    """Which command a recorded job belongs to: "all", "generalise", or "other" (comparisons,
+    the budget study, the fresh-set check, the traces)."""
+    config = config or workflow_config()
+    of_all = set(variants_of_all(config))
+    generalise_only = set(config.get("generalise", {}).get("variants", [])) - of_all
+    rule, parts = job["rule"], job["job"].split("/")
+    if rule in ("fresh", "traces"):
+        return "other"
+    if rule == "report":
+        return REPORTS_OUTSIDE_ALL.get(parts[0], "all")
+    if any(part in GENERATED_GROUPS for part in parts):
+        return "generalise"
+    if rule in ("train", "eval"):
+        if parts[0] in of_all:
+            return "all"
+        return "generalise" if parts[0] in generalise_only else "other"
+    return "all"
+
+
+def job_cost_s(job: dict) -> float:
+    """What a one-thread job costs a core of its own: its CPU time where the benchmark recorded it,
+    else its wall time. A job that ran beside more jobs than cores waited for a core part of its wall
+    time (three trainings on two cores take half as long again each). A resumed training's benchmark
+    timed only its last part: its cost is scaled to the whole run by wall time (``run_wall_s``),
+    which assumes the earlier part spent its wall time on the CPU in the same proportion."""
+    cpu = job.get("cpu_s")
+    cost = float(cpu) if cpu is not None and 0 < cpu <= job["wall_s"] else float(job["wall_s"])
+    run_wall = job.get("run_wall_s")
+    if run_wall is not None and run_wall > job["wall_s"] > 0:
+        cost *= run_wall / job["wall_s"]
+    return cost
