@@ -10,10 +10,11 @@ import pytest
 import torch
 
 from egosearch.rl.actor import ActorPolicy
+from egosearch.rl.base import PooledConvEncoder, conv_sides, pool_depth
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.sac_drq import PooledConvEncoder, SacDrqAgent, conv_sides, pool_depth, random_shift
+from egosearch.rl.sac_drq import SacDrqAgent, random_shift
 from egosearch.rl.train import train
 
 TESTS = Path(__file__).parent

@@ -1,4 +1,5 @@
 """``egosearch <command>``: the entry points users and the Snakefile call.
+Imports every stage, each only when its command runs; nothing in the package imports it.
 
 One module per command (``egosearch/cli/<command>.py``, with ``run(args)``) and its parser in
 :mod:`egosearch.cli.parsers`; ``main`` imports only the command that runs.

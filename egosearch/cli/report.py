@@ -18,8 +18,7 @@ from egosearch.report.generalise import generalise_report
 from egosearch.report.provenance import check_stored, verify, write_provenance
 from egosearch.report.readme import pages, update_pages, update_readme
 from egosearch.report.searches import searches_report
-from egosearch.report.tables import BOUNDS
-from egosearch.report.workflow_jobs import variants_of_all, workflow_config
+from egosearch.report.workflow_jobs import bound_eval_files, variants_of_all, workflow_config, workflow_heights
 from egosearch.rl.config import departure_rows, load_config, table2_rows
 
 
@@ -186,8 +185,8 @@ def regenerate(profile: str, reference: str | None) -> None:
     curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
-    bounds = sorted(str(p) for b in BOUNDS for p in (results / "eval" / b).glob("seed*/*/*/h*.csv")
-                    if Path(p).parts[-3] in homes)
+    bounds = [p for p in bound_eval_files(results, config["homes"], config["placements"], workflow_heights(config))
+              if Path(p).exists()]
     # Figure 6's random level: the cells the reference is evaluated in while training (as in the DAG).
     train_env = load_variant(reference).train_env
     fig6_random = [p for p in bounds if Path(p).parts[-5] == "random" and Path(p).parts[-2] == train_env["placement"]

@@ -1,4 +1,5 @@
-"""Full-body characters for the abstract search policy (paper section 5).
+"""Full-body characters for the abstract search policy (paper section 5): motion generators and Algorithm 1.
+Imports core/, scene/, sim/ and runs/ (the policy comes in as a callable); imported by the CLI only.
 
 - :mod:`~egosearch.motion.mocap`: DeepMimic clips from pybullet_data;
 - :mod:`~egosearch.motion.humanoid` (1.65 m DeepMimic humanoid), :mod:`~egosearch.motion.fetch`;

@@ -1,7 +1,7 @@
 """The report layer: stored CSVs and JSON in; tables, figures, studies and the docs' generated blocks out.
-
 Imports numpy, pandas, scipy, matplotlib, yaml and ``egosearch.core`` only (``searches`` also ``egosearch.scene``,
-when it draws); never torch, the simulator or gymnasium. Imported by the CLI, which passes Table 2's rows in.
+when it draws); never torch, the simulator or gymnasium. Imported by the CLI (which passes Table 2's rows in)
+and the Snakefile's rules (``workflow_jobs``: the bound files in the DAG's order).
 """
 
 from egosearch.report.data import (

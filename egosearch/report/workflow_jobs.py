@@ -11,6 +11,8 @@ from pathlib import Path
 
 import yaml
 
+from egosearch.report.tables import BOUNDS
+
 GENERATED_GROUPS = ("generated_train", "generated_heldout")
 """The generalisation benchmark's groups of generated homes (rules/common.smk's layouts)."""
 REPORTS_OUTSIDE_ALL = {"budget": "other", "fresh": "other", "behaviour": "other", "searches": "other",
@@ -20,6 +22,23 @@ REPORTS_OUTSIDE_ALL = {"budget": "other", "fresh": "other", "behaviour": "other"
 def workflow_config() -> dict:
     """The experiment list the Snakefile reads (``egosearch/workflow/config.yaml``)."""
     return yaml.safe_load((Path(__file__).resolve().parent.parent / "workflow" / "config.yaml").read_text())
+
+
+BOUND_SEEDS = (0,)
+"""The seeds the reference searchers run (they learn nothing: one seed)."""
+
+
+def bound_eval_files(results: str | Path, homes, placements, heights, bounds=BOUNDS, seeds=BOUND_SEEDS) -> list[str]:
+    """The reference searchers' evaluation CSVs in the DAG's order: bound, seed, home, placement,
+    height, as Snakemake's ``expand`` lists them. The rules and ``egosearch report regenerate`` both
+    take this list, so the reports read their inputs in one order and write the same bytes."""
+    return [f"{results}/eval/{bound}/seed{seed}/{home}/{placement}/h{height}.csv" for bound in bounds
+            for seed in seeds for home in homes for placement in placements for height in heights]
+
+
+def workflow_heights(config: dict) -> list[str]:
+    """The Table 1 heights as the output paths spell them (``0.45``, not ``0.450``)."""
+    return [f"{h:g}" for h in config["heights"]]
 
 
 def variants_of_all(config: dict | None = None) -> list[str]:

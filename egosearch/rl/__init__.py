@@ -1,12 +1,20 @@
-"""The search policy's learners (paper 4.2, Table 2): SAC + CURL, and the cpu profile's SAC-DrQ.
+"""The search policy's learners (paper 4.2, Table 2), their training loop and their actor files.
+Imports core/, scene/, sim/ and runs/ (its curve evaluations); imported by variants and the CLI.
 
 - :mod:`egosearch.rl.config`: ``LearnerConfig`` (every Table 2 value and every learner's knobs),
   ``PROFILES`` (smoke / cpu / paper), ``load_config(profile, overrides)``, ``table2_rows(cfg)``;
-- :mod:`egosearch.rl.common`: what both learners build from (actor head, layers, crops,
-  observation tensors, update metrics, actor files);
-- :mod:`egosearch.rl.sac_curl`: ``SacCurlAgent`` (``act``, ``update``, ``state_dict``,
-  ``actor_state``) and its networks (the paper's learner);
-- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, the same interface with a DrQ-v2-style update;
+- :mod:`egosearch.rl.registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``)
+  and the actor file formats they write (``actor_loader``); adding a learner is one module and
+  one ``register`` line there;
+- :mod:`egosearch.rl.agent`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,
+  and ``AgentBase``, its optional hooks' defaults;
+- :mod:`egosearch.rl.common`: what every learner builds from (actor head, layers, crops,
+  observation tensors, update metrics, actor weights);
+- :mod:`egosearch.rl.base`: what the pooled-depth learners share (``PooledConvEncoder``,
+  ``pool_depth``, ``drq_arch``, ``act_with``, SAC-DrQ's actor file, ``PooledAgent``,
+  ``SacDrqBase``) and ``SacMixin`` (SAC's temperature and actor step);
+- :mod:`egosearch.rl.sac_curl`: ``SacCurlAgent`` and its networks (the paper's learner);
+- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, SAC with a DrQ-v2-style update (the cpu profile's);
 - :mod:`egosearch.rl.sac_drq_recurrent`: ``SacDrqRecurrentAgent``, SAC-DrQ with a GRU in the actor
   and another in the critic, trained on replayed sequences with burn-in (not the paper's algorithm);
 - :mod:`egosearch.rl.ppo`: ``PpoAgent``, PPO on SAC-DrQ's actor with a separate value network, trained
@@ -14,7 +22,11 @@
 - :mod:`egosearch.rl.replay`: ``ReplayBuffer`` storing each depth frame once, ``MultiReplay``
   (one ring per env, n-step returns), ``replay_gb``;
 - :mod:`egosearch.rl.train`: ``train(env_id, cfg, out_dir, env_kwargs, evaluate_fn)``
-  (resumable; its loop's steps are the methods of ``_Run``) and ``ActorPolicy`` (loads ``actor.pt``);
+  (resumable; its loop's steps are the methods of ``_Run``);
+- :mod:`egosearch.rl.run_files`: the run's files (atomic writes, CSV logs, checkpoints);
+- :mod:`egosearch.rl.actor`: ``ActorPolicy`` (loads any learner's ``actor.pt``) and ``AgentPolicy``
+  (a live agent behind the policy interface);
+- :mod:`egosearch.rl.cuda_graph`: ``GraphedUpdate`` (an update recorded as CUDA graphs);
 - :mod:`egosearch.rl.bench`: ``bench_learner()``.
 
 Nothing is imported here, so ``import egosearch.rl`` does not load torch.

@@ -11,35 +11,33 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from egosearch.rl.agent import Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
-from egosearch.rl.sac_curl import load_actor_net
+from egosearch.rl.registry import actor_loader
 from egosearch.sim.envs import ENV_IDS, env_space_dims
 
 
 class AgentPolicy:
     """The live agent behind the shared policy interface (deterministic actions)."""
 
-    def __init__(self, agent):
+    def __init__(self, agent: Agent):
         self.agent = agent
 
     def reset(self, seed: int | None = None) -> None:
-        reset_state = getattr(self.agent, "reset_policy_state", None)  # a recurrent agent's memory
-        if reset_state is not None:
-            reset_state()
+        self.agent.reset_policy_state()  # a recurrent agent's memory
 
     def act(self, obs: dict) -> np.ndarray:
         return self.agent.act(obs, deterministic=True)
 
 
 def load_any_actor_net(state: dict, device) -> torch.nn.Module:
-    """An actor file's network, SAC+CURL's, SAC-DrQ's or recurrent SAC-DrQ's (by its ``format``)."""
-    from egosearch.rl import sac_drq, sac_drq_recurrent
-
-    if isinstance(state, dict) and state.get("format") == sac_drq.ACTOR_FORMAT:
-        return sac_drq.load_drq_actor_net(state, device)
-    if isinstance(state, dict) and state.get("format") == sac_drq_recurrent.ACTOR_FORMAT:
-        return sac_drq_recurrent.load_recurrent_actor_net(state, device)
-    return load_actor_net(state, device)
+    """An actor file's network, any registered learner's: the loader its ``format`` is registered
+    with (:func:`egosearch.rl.registry.actor_loader`)."""
+    fmt = state.get("format") if isinstance(state, dict) else None
+    loader = actor_loader(fmt) if isinstance(fmt, str) else None
+    if loader is None:
+        raise AgentStateError(f"not an actor file (format={fmt!r})")
+    return loader(state, device)
 
 
 class ActorPolicy:

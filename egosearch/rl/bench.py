@@ -24,9 +24,13 @@ Keys:
 from __future__ import annotations
 
 import csv
+import dataclasses
 import os
 import platform
+import tempfile
 import time
+import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -36,8 +40,13 @@ from egosearch.rl.config import load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
-from egosearch.rl.train import torch_threads
+from egosearch.rl.train import torch_threads, train
+from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
+from egosearch.sim.home_pool import curve_homes
+
+if TYPE_CHECKING:  # the CLI resolves the variant: rl/ never imports the variants layer above it
+    from egosearch.variants import ResolvedVariant
 
 
 def _cpu_seconds_all() -> float | None:
@@ -105,9 +114,7 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
     left out. Core-seconds are this process's CPU time (user + system), so the figure holds on
     a busy machine too. Warm-up is cut to a tenth of the run so that updates weigh as in a long run
     (unless ``overrides`` set ``init_steps``: PPO has no warm-up)."""
-    import tempfile
 
-    from egosearch.rl.train import train
 
     overrides = overrides or {}
     cfg = load_config(profile, {**overrides, "total_env_steps": env_steps,
@@ -172,7 +179,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
     torch's CUDA sync debug mode; None off CUDA. The update's metrics are read back in ONE sync
     (``metric_values``); anything above 1 is a round trip inside the update. The first 6 updates
     are left out (a captured update warms up and records its graphs in them)."""
-    import warnings
+
 
     if not torch.cuda.is_available():
         return None
@@ -199,13 +206,14 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
     return round(len(syncs) / updates, 2)
 
 
-def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed: int = 0,
-              overrides: dict | None = None, baseline_seconds: float = 0.0) -> dict:
-    """The paper profile on this machine's accelerator: the learner benchmarks, then a real
-    paper-profile training of ``variant_name`` (its curve evaluations included) for ``seconds`` of
-    wall time, stopped with a checkpoint (``egosearch train --max-wall-s`` resumes it). The run's
-    curve.csv, train.csv and config.json are left in ``out_dir``. ``overrides`` change the
-    training's config; with ``baseline_seconds`` the same training with the update launched eagerly
+def gpu_check(seconds: float, out_dir: str, run: ResolvedVariant, overrides: dict | None = None,
+              baseline_seconds: float = 0.0) -> dict:
+    """The paper profile on this machine's accelerator: the learner benchmarks, then a real training
+    of ``run`` (a variant resolved at the paper profile, :func:`egosearch.variants.resolve_variant`;
+    its curve evaluations included) for ``seconds`` of wall time, stopped with a checkpoint
+    (``egosearch train --max-wall-s`` resumes it). The run's curve.csv, train.csv and config.json are
+    left in ``out_dir``; ``overrides`` are the config fields the caller resolved ``run`` with, for the
+    record. With ``baseline_seconds`` the same training with the update launched eagerly
     (``cuda_graph`` false) runs that long in ``out_dir/baseline``, so that both rates come from one
     machine."""
     result = {"learner": bench_learner(cpu_profile_run=False),
@@ -213,25 +221,19 @@ def gpu_check(seconds: float, out_dir: str, variant_name: str = "head_on", seed:
               "host_syncs_per_update_cpu_profile": host_syncs_per_update("cpu")}
     if torch.cuda.is_available():
         result["host_syncs_per_update_table2_graph"] = host_syncs_per_update("paper", overrides={"cuda_graph": True})
-    result["training"] = _timed_training(seconds, out_dir, variant_name, seed, overrides or {})
+    overrides = dict(overrides or {})
+    result["training"] = _timed_training(seconds, out_dir, run, overrides)
     if baseline_seconds > 0:
-        result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"),
-                                                      variant_name, seed, {**(overrides or {}), "cuda_graph": False})
+        eager = dataclasses.replace(run, config=dataclasses.replace(run.config, cuda_graph=False).validate())
+        result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"), eager,
+                                                      {**overrides, "cuda_graph": False})
     return result
 
 
-def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, overrides: dict) -> dict:
-    """A paper-profile training for ``seconds``, and its rates read back from its CSVs."""
-    from egosearch.rl.train import train
-    from egosearch.runs.evaluate import scenario_evaluator
-    from egosearch.sim.envs import observed_env_id
-    from egosearch.sim.home_pool import curve_homes
-    from egosearch.variants import load_variant
-
-    variant = load_variant(variant_name)
-    cfg = load_config("paper", {**variant.config, **overrides, "seed": seed})
-    env_id = observed_env_id(variant.env_id, cfg.target_memory)
-    evaluator = scenario_evaluator(env_id, curve_homes(variant.train_env), variant.train_env["placement"],
+def _timed_training(seconds: float, out_dir: str, run: ResolvedVariant, overrides: dict) -> dict:
+    """A training of ``run`` for ``seconds``, and its rates read back from its CSVs."""
+    cfg, env_id = run.config, run.env_id
+    evaluator = scenario_evaluator(env_id, curve_homes(run.train_env), run.train_env["placement"],
                                    n=cfg.eval_episodes)
     eval_s: list[float] = []
 
@@ -243,8 +245,8 @@ def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, 
 
     wall0 = time.perf_counter()
     try:
-        summary = train(env_id, cfg, out_dir, env_kwargs=variant.train_env, evaluate_fn=timed_evaluator,
-                        variant=variant.name, progress=False, max_wall_s=seconds)
+        summary = train(env_id, cfg, out_dir, env_kwargs=run.train_env, evaluate_fn=timed_evaluator,
+                        variant=run.name, progress=False, max_wall_s=seconds)
     finally:
         evaluator.close()
     wall = time.perf_counter() - wall0
@@ -254,7 +256,7 @@ def _timed_training(seconds: float, out_dir: str, variant_name: str, seed: int, 
         curve = list(csv.DictReader(f))
     rates = [(float(r["steps_per_s"]), float(r["updates_per_s"])) for r in rows[1:]]  # the first row holds warm-up
     return {
-        "variant": variant.name, "seed": seed, "overrides": dict(overrides), "cuda_graph": cfg.cuda_graph,
+        "variant": run.name, "seed": cfg.seed, "overrides": overrides, "cuda_graph": cfg.cuda_graph,
         "env_steps": summary["env_steps"], "updates": summary["updates"],
         "wall_s": round(wall, 1), "curve_rows": len(curve),
         "env_steps_per_s_overall": round(summary["env_steps"] / wall, 1),

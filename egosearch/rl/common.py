@@ -1,8 +1,11 @@
-"""Pieces every learner shares (SAC + CURL in :mod:`egosearch.rl.sac_curl`, SAC-DrQ in
-:mod:`egosearch.rl.sac_drq`): devices, layers, the actor head and its tanh-Gaussian sample, the
-crops, observation -> tensors, the metric dict an ``update`` returns, and the actor files.
+"""The lowest-level pieces every learner (SAC + CURL, SAC-DrQ, recurrent SAC-DrQ, PPO) builds from:
+devices, layers, the actor head and its tanh-Gaussian sample, the crops, observation -> tensors,
+the metric dict an ``update`` returns, agent-state checks and the actor files' weights.
 
-A learner module keeps only what makes it that learner (its encoder, critic, losses and update).
+What the pooled-depth learners share above these (their encoder and actor, SAC's set-up and steps)
+is in :mod:`egosearch.rl.base`; the interface the training loop drives is
+:class:`egosearch.rl.agent.Agent`. A learner module keeps only what makes it that learner (its
+critic, losses and update).
 The module and attribute names below are part of every checkpoint's and actor file's state_dict
 keys (``head.proj.fc.weight``, ``head.trunk.0.bias``...): renaming one breaks stored runs.
 """

@@ -27,6 +27,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any
 
+from egosearch.rl.registry import ALGORITHMS  # the registered learners' names
+
 ACTIVATIONS = ("relu", "elu", "leaky_relu", "gelu", "tanh")
 """Activation names the networks understand (Table 2 uses ReLU everywhere)."""
 
@@ -34,8 +36,6 @@ CURRICULUM_START_RADIUS = 1.0
 """Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
 CURRICULUM_END_RADIUS = 12.0
 """Radius (m) the curriculum reaches at its end: more than any home's extent."""
-ALGORITHMS = ("sac_curl", "sac_drq", "sac_drq_recurrent", "ppo")
-"""Learners :mod:`egosearch.rl.train` can run (see ``LearnerConfig.algorithm``)."""
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; a test keeps them equal)."""
 ENCODER_AUX_LOSSES = ("none", "reconstruction")

@@ -6,9 +6,11 @@ A lever for the searcher's ceiling: SAC replays each transition many times (the 
 habitat-baselines trains PointNav / ObjectNav (DD-PPO, Wijmans et al. 2020). An on-policy
 learner CHANGES THE ALGORITHM (the paper's is SAC + CURL).
 
-- The actor is SAC-DrQ's, unchanged: :class:`PooledConvEncoder` on the pooled depth + the common
-  :class:`ActorHead` (mu, log_std) and its tanh-squashed Gaussian. Its actor file IS a SAC-DrQ
-  actor file (same format, arch and keys), so evaluation runs it as tanh(mu) with no change.
+- The actor is SAC-DrQ's, unchanged (:class:`egosearch.rl.base.PooledAgent`):
+  :class:`egosearch.rl.base.PooledConvEncoder` on the pooled depth + the common
+  :class:`egosearch.rl.common.ActorHead` (mu, log_std) and its tanh-squashed Gaussian. Its actor
+  file IS a SAC-DrQ actor file (same format, arch and keys), so evaluation runs it as tanh(mu)
+  with no change.
 - The value network has its own encoder (an actor-critic with shared features would let the
   value loss move the policy's features); with ``critic_privileged_state`` it also reads the env's
   hidden ``state`` (asymmetric actor-critic, Pinto et al. 2018); the actor never does.
@@ -34,30 +36,25 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
 
+from egosearch.rl.base import PooledAgent, pooled_encoder
 from egosearch.rl.common import (
     LOG_2PI,
-    ActorHead,
     Projection,
     actor_head,
-    actor_weights,
     adam,
     check_agent_state,
     gaussian_entropy,
     metric_values,
     mlp,
-    resolve_device,
     squashed_sample,
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.sac_drq import ACTOR_FORMAT as DRQ_ACTOR_FORMAT
-from egosearch.rl.sac_drq import PooledReplay, _encoder, act_with, drq_arch
 
 AGENT_FORMAT = "egosearch-ppo-agent-v1"
 ACTION_LIMIT = 1.0 - 1e-6
@@ -103,7 +100,7 @@ class ValueNet(nn.Module):
 
     def __init__(self, arch: dict[str, Any], extra_dim: int):
         super().__init__()
-        self.encoder = _encoder(arch)
+        self.encoder = pooled_encoder(arch)
         self.proj = Projection(self.encoder.out_dim, arch["encoder_latent_dim"], arch["encoder_tanh"])
         self.head = mlp(arch["encoder_latent_dim"] + extra_dim, arch["critic_hidden_dim"], 1,
                         arch["critic_num_layers"], arch["critic_activation"])
@@ -112,23 +109,24 @@ class ValueNet(nn.Module):
         return self.head(torch.cat([self.proj(self.encoder(pooled)), extra], dim=-1)).squeeze(-1)
 
 
-class PpoAgent(PooledReplay):
+class PpoAgent(PooledAgent):
     """PPO with SAC-DrQ's actor and a separate value network (module docstring). Driven by
-    :mod:`egosearch.rl.train` like the SAC learners; ``sample_batch`` picks its rollout."""
+    :mod:`egosearch.rl.train` like the SAC learners; ``sample_batch`` picks its rollout. Its actor
+    file is SAC-DrQ's (:data:`egosearch.rl.base.DRQ_ACTOR_FORMAT`): evaluation loads it as any other."""
+
+    agent_format = AGENT_FORMAT
+    MODULES = ("encoder", "actor", "value")
+    """The networks in the agent state, in its order."""
 
     def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
                  device: str | torch.device | None = None, state_dim: int = 0):
         self.cfg = cfg.validate()
         if cfg.algorithm != "ppo":
             raise ValueError(f"PpoAgent needs algorithm ppo, not {cfg.algorithm!r}")
-        self.device = resolve_device(cfg.device) if device is None else torch.device(device)
-        self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
-        if cfg.critic_privileged_state and state_dim < 1:
-            raise ValueError("critic_privileged_state needs the env's privileged state (state_dim >= 1)")
-        self.state_dim = int(state_dim) if cfg.critic_privileged_state else 0
+        self.set_inputs(device, action_dim, mask_dim, proprio_dim, state_dim)
         arch = self.arch()
-        self.encoder = _encoder(arch)
-        self.actor: ActorHead = actor_head(self.encoder.out_dim, arch)
+        self.encoder = pooled_encoder(arch)
+        self.actor = actor_head(self.encoder.out_dim, arch)
         self.value = ValueNet(arch, arch["extra_dim"] + self.state_dim)
         for net in (self.encoder, self.actor, self.value):
             net.apply(weight_init)
@@ -157,14 +155,6 @@ class PpoAgent(PooledReplay):
     def alpha(self) -> float:
         """The entropy bonus's weight: SAC's temperature's counterpart in the logs."""
         return float(self.cfg.entropy_coef)
-
-    # ---- acting --------------------------------------------------------------------------
-    def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
-        """Actions (B, A) in [-1, 1] for a stacked batch of observations (one forward pass)."""
-        return act_with(self.encoder, self.actor, obs, self.device, self.cfg.image_size, deterministic)
-
-    def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
-        return self.act_batch(obs, deterministic)[0]
 
     # ---- updating ------------------------------------------------------------------------
     def sample_batch(self, replay: MultiReplay) -> dict[str, torch.Tensor]:
@@ -241,27 +231,9 @@ class PpoAgent(PooledReplay):
         return metric_values(out, self.device)
 
     # ---- persistence -----------------------------------------------------------------------
-    def arch(self) -> dict[str, Any]:
-        """SAC-DrQ's arch dict: the actor file is read by :func:`egosearch.rl.sac_drq.load_drq_actor_net`."""
-        return drq_arch(self.cfg, self.action_dim, self.mask_dim, self.proprio_dim, self.state_dim)
-
     def state_dict(self) -> dict[str, Any]:
-        return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),
-                "actor": self.actor.state_dict(), "value": self.value.state_dict(),
-                "optimisers": {k: opt.state_dict() for k, opt in self.optimisers.items()},
-                "num_updates": self.num_updates}
+        return self.agent_state(self.MODULES)
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         check_agent_state(state, AGENT_FORMAT, "PPO", self.arch())
-        for name in ("encoder", "actor", "value"):
-            getattr(self, name).load_state_dict(state[name])
-        for k, opt in self.optimisers.items():
-            opt.load_state_dict(state["optimisers"][k])
-        self.num_updates = int(state["num_updates"])
-
-    def actor_state(self, metadata: dict[str, Any] | None = None,
-                    storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
-        """A SAC-DrQ actor file (encoder + actor head, float16): evaluation loads it as any other."""
-        weights = actor_weights({"encoder": self.encoder, "head": self.actor}, storage_dtype)
-        return {"format": DRQ_ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights,
-                "metadata": dict(metadata or {})}
+        self.restore(state, self.MODULES)

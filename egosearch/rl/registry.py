@@ -1,28 +1,117 @@
-"""The learners by name: ``cfg.algorithm`` -> the agent the training loop builds."""
+"""The learners by name: ``cfg.algorithm`` -> the agent the training loop builds, and an actor file's
+``format`` -> the function that loads its network.
+
+:data:`LEARNERS` holds one :class:`Learner` per algorithm name; :data:`ALGORITHMS` (its live names)
+is what ``LearnerConfig.validate`` accepts. Adding a learner is one module with its agent class (an
+:class:`egosearch.rl.agent.Agent`, most simply a subclass of :class:`egosearch.rl.agent.AgentBase`)
+and one :func:`register` line below. Agents and loaders may be named ``"module:attribute"``, imported
+on first use: this module imports neither torch nor a learner (:mod:`egosearch.rl.config` imports it).
+"""
 
 from __future__ import annotations
 
-from egosearch.rl.config import LearnerConfig
-from egosearch.rl.sac_curl import SacCurlAgent
+import importlib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
-ALGORITHM_NAMES = {"sac_curl": "SAC+CURL", "sac_drq": "SAC-DrQ", "sac_drq_recurrent": "recurrent SAC-DrQ",
-                    "ppo": "PPO"}
+if TYPE_CHECKING:
+    from egosearch.rl.agent import Agent
+    from egosearch.rl.config import LearnerConfig
+
+
+def _resolve(ref: str | Callable) -> Callable:
+    """A ``"module:attribute"`` reference -> the attribute (imported now); anything else as it is."""
+    if not isinstance(ref, str):
+        return ref
+    module, _, attribute = ref.partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+@dataclass(frozen=True)
+class Learner:
+    """One registered learner.
+
+    ``name``: its ``cfg.algorithm``; ``display_name``: how the training loop names it;
+    ``agent``: its agent class or factory (or ``"module:Class"``), called as
+    ``agent(cfg, action_dim, mask_dim, proprio_dim, device=device[, state_dim=state_dim])``;
+    ``actor_formats``: the ``format`` of each actor file it writes -> the function
+    ``(state, device) -> nn.Module`` (or ``"module:function"``) that loads that file's network;
+    ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size)."""
+
+    name: str
+    display_name: str
+    agent: str | Callable[..., Agent]
+    actor_formats: Mapping[str, str | Callable[..., Any]] = field(default_factory=dict)
+    takes_state_dim: bool = True
+
+    def agent_factory(self) -> Callable[..., Agent]:
+        return _resolve(self.agent)
+
+    def make(self, cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
+             state_dim: int = 0) -> Agent:
+        factory = self.agent_factory()
+        if self.takes_state_dim:
+            return factory(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
+        return factory(cfg, action_dim, mask_dim, proprio_dim, device=device)
+
+
+LEARNERS: dict[str, Learner] = {}
+"""Every registered learner by algorithm name, in registration order."""
+ALGORITHMS = LEARNERS.keys()
+"""The registered algorithm names (a live view of :data:`LEARNERS`)."""
+
+
+def register(name: str, display_name: str, agent: str | Callable[..., Agent],
+             actor_formats: Mapping[str, str | Callable[..., Any]] | None = None, *,
+             takes_state_dim: bool = True, replace: bool = False) -> Learner:
+    """Register a learner under algorithm ``name`` (see :class:`Learner` for the arguments); a name
+    already taken needs ``replace``, and an actor format another learner loads differently is refused."""
+    if name in LEARNERS and not replace:
+        raise ValueError(f"algorithm {name!r} is registered already ({LEARNERS[name].display_name})")
+    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim)
+    for other in LEARNERS.values():
+        for fmt, loader in learner.actor_formats.items():
+            if other.name != name and fmt in other.actor_formats and other.actor_formats[fmt] != loader:
+                raise ValueError(f"actor format {fmt!r} is loaded differently by algorithm {other.name!r}")
+    LEARNERS[name] = learner
+    return learner
+
+
+def learner(algorithm: str) -> Learner:
+    """The learner registered as ``algorithm``."""
+    try:
+        return LEARNERS[algorithm]
+    except KeyError:
+        raise ValueError(f"unknown algorithm {algorithm!r}; registered: {', '.join(LEARNERS)}") from None
 
 
 def make_agent(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
-               state_dim: int = 0):
-    """The learner ``cfg.algorithm`` names (both share act / update / state_dict / actor_state);
-    ``state_dim``: size of the env's privileged state (``critic_privileged_state``)."""
-    if cfg.algorithm == "ppo":
-        from egosearch.rl.ppo import PpoAgent
+               state_dim: int = 0) -> Agent:
+    """The agent of the learner ``cfg.algorithm`` names; ``state_dim``: size of the env's privileged
+    state (``critic_privileged_state``), for the learners that take it."""
+    return learner(cfg.algorithm).make(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
 
-        return PpoAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    if cfg.algorithm == "sac_drq_recurrent":
-        from egosearch.rl.sac_drq_recurrent import SacDrqRecurrentAgent
 
-        return SacDrqRecurrentAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    if cfg.algorithm == "sac_drq":
-        from egosearch.rl.sac_drq import SacDrqAgent
+def actor_formats() -> dict[str, str | Callable[..., Any]]:
+    """Every registered actor file ``format`` -> the function that loads its network."""
+    return {fmt: loader for entry in LEARNERS.values() for fmt, loader in entry.actor_formats.items()}
 
-        return SacDrqAgent(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-    return SacCurlAgent(cfg, action_dim, mask_dim, proprio_dim, device=device)
+
+def actor_loader(fmt: str) -> Callable[..., Any] | None:
+    """The function ``(state, device) -> nn.Module`` that loads an actor file of format ``fmt``
+    (None for a format no registered learner writes)."""
+    loader = actor_formats().get(fmt)
+    return None if loader is None else _resolve(loader)
+
+
+# ---- the learners -------------------------------------------------------------------------------
+
+register("sac_curl", "SAC+CURL", "egosearch.rl.sac_curl:SacCurlAgent",
+         {"egosearch-sac-curl-actor-v1": "egosearch.rl.sac_curl:load_actor_net"}, takes_state_dim=False)
+register("sac_drq", "SAC-DrQ", "egosearch.rl.sac_drq:SacDrqAgent",
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"})
+register("sac_drq_recurrent", "recurrent SAC-DrQ", "egosearch.rl.sac_drq_recurrent:SacDrqRecurrentAgent",
+         {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"})
+register("ppo", "PPO", "egosearch.rl.ppo:PpoAgent",
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"})

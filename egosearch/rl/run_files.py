@@ -197,7 +197,7 @@ def load_checkpoint(path: Path) -> dict:
         raise CheckpointError(f"cannot read checkpoint {path} ({describe_error(err)}); delete it to "
                               "start over") from None
     if not isinstance(state, dict) or state.get("format") != CHECKPOINT_FORMAT:
-        raise CheckpointError(f"{path} is not a SAC+CURL training checkpoint")
+        raise CheckpointError(f"{path} is not an egosearch training checkpoint")
     return state
 
 

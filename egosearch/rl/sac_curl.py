@@ -46,6 +46,8 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from egosearch.rl.agent import AgentBase
+from egosearch.rl.base import SacMixin
 from egosearch.rl.common import (
     ActorHead,
     AgentStateError,
@@ -156,8 +158,10 @@ _ARCH_FIELDS = ("frame_history", "image_size", "crop_size", "encoder_num_layers"
 
 # ---- the agent ----------------------------------------------------------------------------
 
-class SacCurlAgent:
-    """SAC + CURL learner. ``act`` for one observation, ``update`` for one batch."""
+class SacCurlAgent(SacMixin, AgentBase):
+    """SAC + CURL learner, an :class:`egosearch.rl.agent.Agent`: ``act`` for one observation (a batch
+    of them acts one by one), ``update`` for one batch of transitions (the replay stores the env's
+    observations as they are)."""
 
     def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30,
                  proprio_dim: int = 4, impl: str = "fast", device: str | torch.device | None = None):
@@ -232,10 +236,6 @@ class SacCurlAgent:
         self._compiled = True
 
     # ---- acting --------------------------------------------------------------------------
-    @property
-    def alpha(self) -> float:
-        return float(self.log_alpha.detach().exp())
-
     def _to_float(self, depth_u8: torch.Tensor) -> torch.Tensor:
         if self.channels_last:
             return depth_u8.to(torch.float32, memory_format=torch.channels_last)
@@ -369,15 +369,7 @@ class SacCurlAgent:
             mu, log_std = self.actor(h_actor, extra)
             pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
             aq1, aq2 = critic.q(state, pi)
-            actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
-            actor_params = [p for g in self.actor_opt.param_groups for p in g["params"]]
-            for p, g in zip(actor_params, torch.autograd.grad(actor_loss, actor_params)):
-                p.grad = g
-            self.actor_opt.step()
-            alpha_loss = (self.log_alpha.exp() * (-log_pi - self.target_entropy).detach()).mean()
-            self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
-            self.alpha_opt.step()
-            out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
+            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out)
             out["entropy"] = gaussian_entropy(log_std)
 
         # -- Polyak averaging of the target critic and key encoder --------------------------

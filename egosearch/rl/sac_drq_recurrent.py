@@ -12,11 +12,12 @@ R2D2 (Kapturowski et al. 2019): replay of contiguous sequences, whose first ``bu
 only warm the hidden state up (no gradient) before the ``sequence_length`` steps that carry the
 losses, with zero initial states (R2D2's "zero start state" plus burn-in).
 
-What it keeps from SAC-DrQ: ONE conv encoder (:class:`PooledConvEncoder`) trained by the critic
+What it keeps from SAC-DrQ: ONE conv encoder (:class:`egosearch.rl.base.PooledConvEncoder`) trained by the critic
 loss only, read detached by the actor; random-shift augmentation (one shift per sequence, so
 that the memory sees a steady camera); pooled uint8 frames in the replay; n-step returns;
 twin Q-heads with a Polyak target (here the target also holds a copy of the critic's GRU);
-the optional privileged critic (the state enters the Q-heads, not the GRU).
+the optional privileged critic (the state enters the Q-heads, not the GRU). Its set-up, actor and
+temperature step, Polyak step and agent state are SAC-DrQ's (:class:`egosearch.rl.base.SacDrqBase`).
 
 Per step, a network's GRU reads [projected conv features, mask, proprio] and its head reads
 [GRU output, projected conv features, mask, proprio] (the current observation stays one layer
@@ -36,8 +37,6 @@ left out of the critic loss: ``loss_mask``).
 
 from __future__ import annotations
 
-import copy
-import math
 from typing import Any
 
 import numpy as np
@@ -45,29 +44,24 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from egosearch.rl.base import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
 from egosearch.rl.common import (
     Projection,
-    actor_weights,
-    adam,
     check_agent_state,
     crop_at,
     gaussian_entropy,
     load_actor_weights,
-    metric_values,
     mlp,
     obs_to_tensors,
-    resolve_device,
     squashed_sample,
-    weight_init,
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
-from egosearch.rl.sac_drq import _ARCH_FIELDS as _DRQ_ARCH_FIELDS
-from egosearch.rl.sac_drq import PooledConvEncoder, PooledReplay, _encoder, drq_arch
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-drq-recurrent-actor-v1"
-_ARCH_FIELDS = (*_DRQ_ARCH_FIELDS, "recurrent_hidden_dim")
+ARCH_FIELDS = (*DRQ_ARCH_FIELDS, "recurrent_hidden_dim")
+"""The config fields in the arch dict: SAC-DrQ's and the GRUs' size."""
 
 
 def sequences_per_batch(cfg: LearnerConfig) -> int:
@@ -165,7 +159,7 @@ class RecurrentDrqActorNet(nn.Module):
     def __init__(self, arch: dict[str, Any]):
         super().__init__()
         self.arch = dict(arch)
-        self.encoder = _encoder(arch)
+        self.encoder = pooled_encoder(arch)
         self.head = RecurrentActorHead(self.encoder.out_dim, arch)
 
     def forward(self, depth: torch.Tensor, extra: torch.Tensor, h: torch.Tensor | None = None):
@@ -267,47 +261,29 @@ def shift_sequences(x: torch.Tensor, pad: int) -> torch.Tensor:
 
 # ---- the agent ------------------------------------------------------------------------------
 
-class SacDrqRecurrentAgent(PooledReplay):
-    """Recurrent SAC-DrQ (module docstring). Same driving interface as :class:`SacDrqAgent`, plus
-    ``sample_batch(replay)`` (sequences instead of transitions), ``reset_state(env_index)`` (an
-    env's episode ended) and ``reset_policy_state()`` (an evaluation episode starts)."""
+class SacDrqRecurrentAgent(SacDrqBase):
+    """Recurrent SAC-DrQ (module docstring). An :class:`egosearch.rl.agent.Agent` with a memory
+    (``recurrent``): ``sample_batch(replay)`` draws sequences instead of transitions,
+    ``reset_state(env_index)`` forgets an env's ended episode and ``reset_policy_state()`` the
+    evaluation episode's."""
+
+    recurrent = True
+    agent_format = AGENT_FORMAT
+    actor_format = ACTOR_FORMAT
+    arch_fields = ARCH_FIELDS
 
     def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
                  device: str | torch.device | None = None, state_dim: int = 0):
-        self.cfg = cfg.validate()
-        self.device = resolve_device(cfg.device) if device is None else torch.device(device)
-        self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
-        if cfg.critic_privileged_state and state_dim < 1:
-            raise ValueError("critic_privileged_state needs the env's privileged state (state_dim >= 1)")
-        self.state_dim = int(state_dim) if cfg.critic_privileged_state else 0
-        arch = self.arch()
-        self.encoder: PooledConvEncoder = _encoder(arch)
-        self.critic = RecurrentCritic(self.encoder.out_dim, cfg, arch["extra_dim"], self.state_dim, self.action_dim)
-        self.actor = RecurrentActorHead(self.encoder.out_dim, arch)
-        for net in (self.encoder, self.critic, self.actor):
-            net.apply(weight_init)
-            net.to(self.device)
-        if cfg.channels_last:
-            self.encoder.use_channels_last()
-        self.critic_target = copy.deepcopy(self.critic)
-        for p in self.critic_target.parameters():
-            p.requires_grad_(False)
-        self.log_alpha = torch.tensor(math.log(cfg.init_temperature), device=self.device, requires_grad=True)
-        self.target_entropy = -float(self.action_dim)
-        self.num_updates = 0
-        self.critic_opt = adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
-                                {"params": self.encoder.parameters(), "lr": cfg.encoder_lr}],
-                               cfg.critic_lr, (cfg.critic_beta1, cfg.critic_beta2))
-        self.actor_opt = adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
-        self.alpha_opt = adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
-        self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
+        super().__init__(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
         # acting states, never checkpointed: train.py cuts every episode at a checkpoint
         self._h: torch.Tensor | None = None  # (num envs, H) of the training envs
         self._eval_h: torch.Tensor | None = None  # the single evaluation episode's
 
-    @property
-    def alpha(self) -> float:
-        return float(self.log_alpha.detach().exp())
+    def make_critic(self, arch: dict[str, Any]) -> RecurrentCritic:
+        return RecurrentCritic(self.encoder.out_dim, self.cfg, arch["extra_dim"], self.state_dim, self.action_dim)
+
+    def make_actor(self, arch: dict[str, Any]) -> RecurrentActorHead:
+        return RecurrentActorHead(self.encoder.out_dim, arch)
 
     # ---- acting --------------------------------------------------------------------------
     def reset_state(self, env_index: int | None = None) -> None:
@@ -419,52 +395,16 @@ class SacDrqRecurrentAgent(PooledReplay):
             # its Q-heads and projection are the stepped ones
             xc_now = self.critic.inputs(feats_d[:, train], extra[:, train])
             aq1, aq2 = self.critic.q(mem_c[:, train].detach(), xc_now, st, pi)
-            actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
-            self.actor_opt.zero_grad(set_to_none=True)
-            actor_params = list(self.actor.parameters())
-            for p, g in zip(actor_params, torch.autograd.grad(actor_loss, actor_params)):
-                p.grad = g
-            self.actor_opt.step()
-            alpha_loss = (self.log_alpha.exp() * (-log_pi - self.target_entropy).detach()).mean()
-            self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
-            self.alpha_opt.step()
-            out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
+            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out)
             out["entropy"] = gaussian_entropy(log_std.reshape(-1, log_std.shape[-1]))
 
-        if self.num_updates % cfg.critic_target_update_freq == 0:
-            with torch.no_grad():
-                torch._foreach_lerp_(list(self.critic_target.parameters()), list(self.critic.parameters()),
-                                     cfg.critic_tau)
-        out["alpha"] = self.log_alpha.detach().exp()
-        return metric_values(out, self.device)
+        return self.finish_update(out)
 
     # ---- persistence -----------------------------------------------------------------------
-    def arch(self) -> dict[str, Any]:
-        return drq_arch(self.cfg, self.action_dim, self.mask_dim, self.proprio_dim, self.state_dim, _ARCH_FIELDS)
-
-    def state_dict(self) -> dict[str, Any]:
-        return {"format": AGENT_FORMAT, "arch": self.arch(), "encoder": self.encoder.state_dict(),
-                "critic": self.critic.state_dict(), "critic_target": self.critic_target.state_dict(),
-                "actor": self.actor.state_dict(), "log_alpha": self.log_alpha.detach().clone(),
-                "optimisers": {k: opt.state_dict() for k, opt in self.optimisers.items()},
-                "num_updates": self.num_updates}
-
     def load_state_dict(self, state: dict[str, Any]) -> None:
         check_agent_state(state, AGENT_FORMAT, "recurrent SAC-DrQ", self.arch())
-        for name in ("encoder", "critic", "critic_target", "actor"):
-            getattr(self, name).load_state_dict(state[name])
-        with torch.no_grad():
-            self.log_alpha.copy_(state["log_alpha"])
-        for k, opt in self.optimisers.items():
-            opt.load_state_dict(state["optimisers"][k])
-        self.num_updates = int(state["num_updates"])
+        self.restore(state, self.SAC_MODULES, ("log_alpha",))
         self._h = self._eval_h = None
-
-    def actor_state(self, metadata: dict[str, Any] | None = None,
-                    storage_dtype: torch.dtype = torch.float16) -> dict[str, Any]:
-        """Actor-only weights (encoder + recurrent head), float16 like the other actor files."""
-        weights = actor_weights({"encoder": self.encoder, "head": self.actor}, storage_dtype)
-        return {"format": ACTOR_FORMAT, "arch": self.arch(), "state_dict": weights, "metadata": dict(metadata or {})}
 
 
 def load_recurrent_actor_net(state: dict[str, Any], device: str | torch.device = "cpu") -> RecurrentDrqActorNet:

@@ -44,9 +44,10 @@ import torch
 
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
 from egosearch.rl.actor import AgentPolicy
+from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
-from egosearch.rl.registry import ALGORITHM_NAMES, make_agent
+from egosearch.rl.registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.run_files import (
     CHECKPOINT_FORMAT,
@@ -64,6 +65,10 @@ from egosearch.rl.run_files import (
     to_numpy,
     to_tensors,
 )
+from egosearch.scene.layouts import LAYOUT_NAMES
+from egosearch.sim.agent import AgentSpec
+from egosearch.sim.envs import observed_env_id
+from egosearch.sim.home_pool import HomePoolEnv
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
@@ -184,15 +189,7 @@ def torch_threads(requested: int = 0) -> int:
 
 
 def _make_env(env_id: str, env_kwargs: dict):
-    if env_id not in gymnasium.registry:
-        try:
-            import egosearch.sim.envs  # noqa: F401  (registers the EgoSearch ids)
-        except ImportError:
-            pass
     if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.sim.home_pool)
-        from egosearch.scene.layouts import LAYOUT_NAMES
-        from egosearch.sim.home_pool import HomePoolEnv
-
         if env_kwargs["layout"] == "paper_homes":
             return HomePoolEnv(env_id, home_names=LAYOUT_NAMES, **env_kwargs)
         return HomePoolEnv(env_id, **env_kwargs)
@@ -217,8 +214,6 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     lent for minutes); the summary then has ``"stopped": True`` and no actor is written. The next
     call resumes from that checkpoint.
     """
-    from egosearch.sim.envs import observed_env_id
-
     cfg = cfg.validate()
     env_id = observed_env_id(env_id, cfg.target_memory)
     env_kwargs = dict(env_kwargs or {})
@@ -265,8 +260,6 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
     privileged state when the critic reads it (``critic_privileged_state``). The paper's values are
     the env's defaults, so they are not passed (envs without the options still train)."""
-    from egosearch.sim.agent import AgentSpec
-
     aids: dict = {}
     if cfg.train_distance_reward != "distance":
         aids["distance_reward"] = cfg.train_distance_reward
@@ -278,10 +271,10 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     return {**aids, **env_kwargs}
 
 
-def _act_batch(agent, observations: list[dict]) -> list[np.ndarray]:
+def _act_batch(agent: Agent, observations: list[dict]) -> list[np.ndarray]:
     # a recurrent agent's act() is the evaluation episode's: training envs always go through act_batch
-    if (len(observations) == 1 and not hasattr(agent, "reset_state")) or not hasattr(agent, "act_batch"):
-        return [agent.act(o, deterministic=False) for o in observations]
+    if len(observations) == 1 and not agent.recurrent:
+        return [agent.act(observations[0], deterministic=False)]
     stacked = {k: np.stack([o[k] for o in observations]) for k in observations[0]}
     return list(agent.act_batch(stacked, deterministic=False))
 
@@ -358,10 +351,9 @@ class _Run:
         state_dim = _privileged_state_dim(envs[0], env_id, cfg)
         for i, e in enumerate(envs):
             e.action_space.seed(cfg.seed + 7 * i)
-        self.agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, self.device, state_dim)
-        self.to_replay = getattr(self.agent, "replay_obs", lambda o: o)
-        self.replay = MultiReplay(cfg.num_envs, cfg.replay_capacity,
-                                  getattr(self.agent, "replay_image_size", cfg.image_size), cfg.frame_history,
+        self.agent: Agent = make_agent(cfg, action_dim, mask_dim, proprio_dim, self.device, state_dim)
+        self.to_replay = self.agent.replay_obs
+        self.replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, self.agent.replay_image_size, cfg.frame_history,
                                   mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
                                   device=self.device, seed=cfg.seed, state_dim=state_dim)
         self.curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
@@ -418,7 +410,7 @@ class _Run:
             bar = tqdm(total=cfg.total_env_steps, initial=self.step, unit="step", dynamic_ncols=True,
                        mininterval=1.0, desc=f"{self.variant} seed {cfg.seed}")
             self.say = bar.write
-        self.say(f"{ALGORITHM_NAMES[cfg.algorithm]} {self.variant} on {self.env_id} -> {self.out_dir} | device "
+        self.say(f"{learner(cfg.algorithm).display_name} {self.variant} on {self.env_id} -> {self.out_dir} | device "
                  f"{self.device}, {torch.get_num_threads()} torch threads, {cfg.num_envs} env(s) | "
                  f"{'resuming at step ' + str(self.step) if self.step else 'fresh start'}")
         self.say("config: " + json.dumps(cfg.to_dict(), sort_keys=True))
@@ -487,10 +479,8 @@ class _Run:
             self.reset_agent_state(i)
 
     def reset_agent_state(self, env_index: int) -> None:
-        """A recurrent agent forgets env ``env_index``'s episode (memoryless agents have no such hook)."""
-        reset_state = getattr(self.agent, "reset_state", None)
-        if reset_state is not None:
-            reset_state(env_index)
+        """A recurrent agent forgets env ``env_index``'s episode (a memoryless agent's hook does nothing)."""
+        self.agent.reset_state(env_index)
 
     # ---- updating -------------------------------------------------------------------------
     def update(self, before: int) -> None:
@@ -506,9 +496,8 @@ class _Run:
             self.means["train"].add(metrics)
 
     def sample(self) -> dict:
-        """An update's batch: transitions, or the agent's own draw (a recurrent agent's sequences)."""
-        sample_batch = getattr(self.agent, "sample_batch", None)
-        return self.replay.sample(self.cfg.batch_size) if sample_batch is None else sample_batch(self.replay)
+        """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout)."""
+        return self.agent.sample_batch(self.replay)
 
     # ---- logging and evaluating -----------------------------------------------------------
     def log_train(self, bar=None) -> None:

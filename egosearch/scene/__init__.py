@@ -1,4 +1,5 @@
-"""Homes as plain data: parts, layouts, target objects and their placement."""
+"""Homes as plain data: parts, layouts, target objects and their placement (no engine, no renderer).
+Imports numpy and trimesh only; every other stage may import it."""
 
 from egosearch.scene.layouts import LAYOUT_NAMES, get_scene, random_home
 from egosearch.scene.objects import TARGET_OBJECTS, get_object

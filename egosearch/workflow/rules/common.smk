@@ -6,6 +6,9 @@
 # (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
 from pathlib import Path
 
+from egosearch.report.tables import BOUNDS
+from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
+
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"
 
@@ -14,7 +17,7 @@ PROF = config["profiles"][PROFILE]
 LAYOUT = config["layout"]  # the full-body runs', the budget cell's and the pictures' home
 HOMES = config["homes"]  # Table 1's homes
 SEEDS = PROF["seeds"]
-HEIGHTS = [f"{h:g}" for h in config["heights"]]
+HEIGHTS = workflow_heights(config)
 PLACEMENTS = config["placements"]
 FULLBODY = PROF["fullbody"]
 REF = config["reference_variant"]
@@ -107,16 +110,13 @@ def compare_candidate(wildcards):
 # The floor, the classical searcher and the ceiling of Table 1, on the very scenario sets the policies
 # are evaluated on.
 # Their CSVs sit beside the variants' (eval/random, eval/frontier, ...): a variant may not take those names.
-BOUNDS = ["random", "frontier", "frontier_head_off", "oracle"]
-# One seed: the oracle is deterministic, and the random searcher's spread over 100 scenarios per
-# cell is far wider than its spread over seeds.
-BOUND_SEEDS = [0]
+# BOUNDS: random, frontier, frontier_head_off, oracle. One seed (BOUND_SEEDS): the oracle is
+# deterministic, and the random searcher's spread over 100 scenarios per cell is far wider than its
+# spread over seeds. bound_eval_files is the order `egosearch report regenerate` reads them in too.
 
 
 def bound_files(bounds=BOUNDS, placements=None, homes=None):
-    return expand(f"{RESULTS}/eval/{{bound}}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
-                  bound=bounds, seed=BOUND_SEEDS, home=homes or HOMES, placement=placements or PLACEMENTS,
-                  height=HEIGHTS)
+    return bound_eval_files(RESULTS, homes or HOMES, placements or PLACEMENTS, HEIGHTS, bounds, BOUND_SEEDS)
 
 
 def fig6_random_files():

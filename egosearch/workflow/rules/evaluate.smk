@@ -20,7 +20,7 @@ rule evaluate:
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
-# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in common.smk), not variants.
+# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in egosearch.report.tables), not variants.
 ruleorder: bound > evaluate
 
 

@@ -1,0 +1,120 @@
+"""The package's layout as docs/layout.md draws it: a few modules at the top, subpackages by stage,
+imports that run one way (no circles, no arrow back up a stage), shared pieces public."""
+
+import ast
+from pathlib import Path
+
+import egosearch
+
+PACKAGE = Path(egosearch.__file__).resolve().parent
+
+LAYERS = {
+    "core": set(),
+    "scene": set(),
+    "sim": {"core", "scene"},
+    "searchers": {"core", "scene", "sim"},
+    "runs": {"core", "scene", "sim", "searchers"},
+    "rl": {"core", "scene", "sim", "searchers", "runs"},
+    "motion": {"core", "scene", "sim", "searchers", "runs"},
+    "report": {"core", "scene"},
+    "variants": {"core", "scene", "sim", "rl"},
+    "workflow": {"core", "scene", "variants", "report"},
+    "cli": {"core", "scene", "sim", "searchers", "runs", "rl", "motion", "report", "variants", "workflow"},
+}
+"""Each stage and the stages it may import: the pipeline's order (scene -> sim -> searchers -> runs ->
+rl -> motion), the report layer apart (files in, files out), variants, the workflow and the CLI on top."""
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _runtime_imports(path: Path) -> list[tuple[str, str, bool]]:
+    """(imported egosearch module, imported name or '', inside a function) of every import that runs:
+    ``if TYPE_CHECKING:`` blocks are left out."""
+    tree = ast.parse(path.read_text())
+    skipped = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
+               and getattr(node.test, "id", "") == "TYPE_CHECKING" for n in ast.walk(node)}
+    local = {id(n) for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+             for n in ast.walk(node)}
+    out = []
+    for node in ast.walk(tree):
+        if id(node) in skipped:
+            continue
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("egosearch"):
+            out += [(node.module, a.name, id(node) in local) for a in node.names]
+        elif isinstance(node, ast.Import):
+            out += [(a.name, "", id(node) in local) for a in node.names if a.name.startswith("egosearch")]
+    return out
+
+
+def _modules() -> dict[str, Path]:
+    return {_module_name(p): p for p in PACKAGE.rglob("*.py")}
+
+
+def _stage(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "(root)"
+
+
+def _target(imported: str, name: str, modules: dict) -> str:
+    full = f"{imported}.{name}"
+    return full if full in modules else imported
+
+
+def test_the_top_of_the_package_holds_few_modules_and_every_subpackage_says_what_it_holds():
+    top = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert len(top) <= 8, top
+    for init in PACKAGE.glob("*/__init__.py"):
+        doc = ast.get_docstring(ast.parse(init.read_text()))
+        assert doc and "import" in doc.splitlines()[1].lower(), f"{init}: its docstring's 2nd line says who imports it"
+    assert set(LAYERS) >= {p.parent.name for p in PACKAGE.glob("*/__init__.py")} | {"variants"}
+
+
+def test_each_stage_imports_only_the_stages_below_it():
+    modules = _modules()
+    wrong = []
+    for name, path in modules.items():
+        stage = _stage(name)
+        for imported, item, _ in _runtime_imports(path):
+            other = _stage(_target(imported, item, modules))
+            if other not in (stage, "(root)") and other not in LAYERS[stage]:
+                wrong.append(f"{name} -> {imported}")
+    assert not wrong, wrong
+
+
+def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Every circle a depth-first walk of ``graph`` meets, as the path that closes it."""
+    state: dict[str, int] = {}
+    found: list[list[str]] = []
+
+    def visit(node: str, stack: list[str]) -> None:
+        state[node] = 1
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                found.append(stack[stack.index(nxt):] + [nxt])
+            elif nxt not in state:
+                visit(nxt, stack + [nxt])
+        state[node] = 2
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [node])
+    return found
+
+
+def test_no_import_circles():
+    assert find_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
+    modules = _modules()
+    graph = {name: {_target(i, n, modules) for i, n, _ in _runtime_imports(path)} & set(modules) - {name}
+             for name, path in modules.items()}
+    assert not find_cycles(graph)
+
+
+def test_no_module_imports_another_modules_private_names():
+    modules = _modules()
+    private = [f"{name} imports {imported}.{item}" for name, path in modules.items()
+               for imported, item, _ in _runtime_imports(path)
+               if item.startswith("_") and not item.startswith("__") and imported != name]
+    assert not private, private
