@@ -218,6 +218,24 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
 
 
 @needs_stored_run
+def test_regenerate_writes_the_bytes_the_dag_stored(tmp_path, monkeypatch):
+    """Every file `egosearch report regenerate` writes equals, byte for byte, the one the DAG stored:
+    tables, figures (PNG and PDF) and the path-length CSVs, whose rows follow the order in which the
+    DAG hands the reference searchers' files over (one ordering function serves both)."""
+    results = tmp_path / "results" / "cpu"
+    copy_stored_cpu_results(results)
+    shutil.rmtree(results / "pathlength")  # what regenerate writes must be written, not left from the copy
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    written = sorted(p for folder in (tmp_path / "paper_figs" / "cpu", results / "pathlength")
+                     for p in folder.rglob("*") if p.is_file())
+    assert len(written) >= 20 and any(p.suffix == ".pdf" for p in written)
+    differ = [str(p.relative_to(tmp_path)) for p in written
+              if p.read_bytes() != (REPO / p.relative_to(tmp_path)).read_bytes()]
+    assert differ == []
+
+
+@needs_stored_run
 def test_regenerate_twice_gives_byte_identical_files(tmp_path, monkeypatch):
     """A second regenerate rewrites every output with the same bytes (PDFs included: no date stamped)."""
     copy_stored_cpu_results(tmp_path / "results" / "cpu")

@@ -118,7 +118,7 @@ def _same_results(old: dict, new: dict) -> bool:
     """Whether ``new`` records what ``old`` does: the same stored files (sha256), jobs and profile,
     and no new note. A regeneration that rewrites identical files must not rewrite the record: a new
     commit and date in a committed file would say the results changed when none did."""
-    if new.get("note") and new["note"] != old.get("note"):
+    if new.get("note", "") != old.get("note", ""):
         return False
     keep = {key: value for key, value in old.items() if key not in (*WHEN_AND_WHERE, "note")}
     return keep == {key: value for key, value in new.items() if key not in (*WHEN_AND_WHERE, "note")}
@@ -132,11 +132,64 @@ def _read_record(path: Path) -> dict | None:
     return record if isinstance(record, dict) else None
 
 
+def this_machine() -> dict:
+    """The machine a job ran on, as each job of a record names it: CPU model, vector unit, cores."""
+    return {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()}
+
+
+def _job_key(job: dict) -> tuple[str, str]:
+    return job["rule"], job["job"]
+
+
+def attach_machines(jobs: list[dict], results: Path, previous: dict | None) -> None:
+    """Give each job the machine it ran on, where that is known: a training's from its ``done.json``
+    (the trainer records it); a job the previous record already held, with the same wall time, keeps
+    the machine that record gave it (it has not run since); a job that is new since then ran in the
+    workflow run that is writing this record, on this machine (under a cluster executor: the node
+    that runs the provenance job, which may not be the job's). Otherwise ``None``: jobs recorded
+    before records named machines are not guessed."""
+    before = {_job_key(j): j for j in (previous or {}).get("jobs", [])}
+    here = this_machine()
+    for job in jobs:
+        old = before.get(_job_key(job))
+        machine = None
+        if job["rule"] == "train":
+            try:
+                done = json.loads((Path(results) / "train" / job["job"] / "done.json").read_text(encoding="utf-8"))
+                # trainings recorded before the vector unit was: None there, not a guess
+                machine = {k: done["machine"].get(k) for k in ("cpu", "vector_unit", "cores")}
+            except (OSError, ValueError, KeyError, TypeError):
+                machine = None
+        if machine is None and old is not None and old.get("wall_s") == job["wall_s"]:
+            machine = old.get("machine")
+        elif machine is None and old is None:
+            machine = here
+        job["machine"] = machine
+
+
+def machines_of(jobs: list[dict]) -> list[dict]:
+    """Every machine the jobs name, with how many jobs and how many summed wall seconds each ran (most
+    first), and one entry ``{"cpu": None, ...}`` for the jobs that name none."""
+    groups: dict[str, dict] = {}
+    for job in jobs:
+        machine = job.get("machine") or {"cpu": None, "vector_unit": None, "cores": None}
+        key = json.dumps(machine, sort_keys=True)
+        entry = groups.setdefault(key, {**machine, "jobs": 0, "wall_s": 0.0})
+        entry["jobs"] += 1
+        entry["wall_s"] = round(entry["wall_s"] + float(job.get("run_wall_s", job["wall_s"])), 1)
+    return sorted(groups.values(), key=lambda m: (m["cpu"] is None, -m["wall_s"]))
+
+
 def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> dict:
     """Write the record of ``results`` to ``out`` and return it; when ``out`` already records the same
-    stored files (see :func:`_same_results`) it is left as it is and that record is returned."""
+    stored files (see :func:`_same_results`) it is left as it is and that record is returned. The
+    previous record's ``note`` is kept unless a new one is given: a rewrite keeps what it does not
+    recompute."""
     results = Path(results)
+    out = Path(out)
+    previous = _read_record(out) if out.is_file() else None
     jobs = rule_times(results / "benchmarks")
+    attach_machines(jobs, results, previous)
     per_rule: dict[str, float] = {}
     for job in jobs:
         per_rule[job["rule"]] = round(per_rule.get(job["rule"], 0.0) + job["wall_s"], 1)
@@ -146,19 +199,20 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
         "commit": _git("rev-parse", "HEAD"),
         "commit_dirty": bool(status) if status != "unknown" else None,
         "date_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+        # where this record was written; each job names its own machine, and "machines" lists them all
         "machine": {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count(),
                     "platform": platform.platform(),
                     "python": platform.python_version(), "torch": _version("torch"),
                     "pybullet": _version("pybullet"), "snakemake": _version("snakemake")},
+        "machines": machines_of(jobs),
         "wall_s_per_rule_summed": per_rule,
         "wall_s_all_jobs_summed": round(sum(per_rule.values()), 1),
         "jobs": jobs,
         "files": record_files(results),
     }
+    note = note or (previous or {}).get("note", "")
     if note:
         record["note"] = note
-    out = Path(out)
-    previous = _read_record(out) if out.is_file() else None
     if previous is not None and _same_results(previous, record):
         os.utime(out)  # bytes kept, time renewed: the workflow sees the record as newer than what it checked
         return previous
