@@ -45,6 +45,15 @@ rule all:
         provenance_file(),
 
 
+onstart:
+    # The cost of `all` before its first job: the whole DAG from scratch, simulated on these cores
+    # (egosearch estimate all; on this machine once it has been calibrated).
+    if "all" in workflow.dag_settings.targets and PROFILE != "smoke":
+        from egosearch.cli.estimate import print_before_a_run
+
+        print_before_a_run(PROFILE, workflow.cores)
+
+
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other
 # snakemake runs here, then --rerun-incomplete (profiles/default) reruns the killed jobs.
 if workflow.is_main_process:

@@ -85,6 +85,10 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
         where = f" at line {mark.line + 1}" if mark is not None else ""
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         raise VariantError(f"{path}: not valid YAML{where} ({problem})") from None
+    except UnicodeDecodeError:
+        raise VariantError(f"{path}: not a text file; a variant is a YAML file with name, env_id, train_env") from None
+    if data is None:
+        raise VariantError(f"{path}: empty file; a variant needs name, env_id, train_env")
     schema = json.loads(SCHEMA_PATH.read_text())
     try:
         jsonschema.validate(data, schema)

@@ -1,6 +1,7 @@
 """Bad input as a new user types it: each is exactly one line naming what is wrong, before any
 work starts, and never a traceback. The cases are the README's bad-input table."""
 
+import re
 import shutil
 import subprocess
 import sys
@@ -456,3 +457,517 @@ def test_the_sizes_an_actor_is_checked_against_are_the_envs():
             "action": env.action_space.shape[0], "mask": space["mask"].shape[0], "proprio": space["proprio"].shape[0]}
     finally:
         env.close()
+
+
+# --------------------------------------------------------------------------- issue 35: the table of bad inputs
+# Each bad input as a user typed it: (id, what it did before the fix, argv, the one line now). "before" is
+# one of BEFORE_KINDS: clear (one line naming the option or file, before any work), cryptic (one line
+# naming neither, or given only after work had started), traceback, silent (ran on: wrong results, an
+# option ignored, or a file overwritten, without a word). {t} is the cases' folder (fixture `bad`).
+# Expected lines that name how a file is known to be stored (git, or a provenance record where there
+# is no git) are regular expressions.
+BEFORE_KINDS = ("clear", "cryptic", "traceback", "silent")
+S3 = "{t}/s3.csv"
+EV = "{t}/eval/{v}/seed0/{home}/everywhere/h1.05.csv"
+ev = lambda v, home="kitchen_living": EV.replace("{v}", v).replace("{home}", home)  # noqa: E731
+TRACES = ["{t}/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz",
+          "{t}/traces/head_off/seed0/kitchen_living/everywhere/h1.65.npz"]
+GEN = [ev("head_on", "generated_heldout"), "--bounds", ev("random", "generated_heldout"),
+       ev("oracle", "generated_heldout")]
+CURVE, CELL = "{t}/train/head_on/seed0/curve.csv", "{t}/eval/head_on/seed0/kitchen_living/no_low_cabinets/h1.05.csv"
+EMPTY_EVAL = "{t}/emptyeval/cand/seed0/kitchen_living/everywhere/h1.05.csv"
+CHECKPOINT = ("egosearch train: error: --out-dir: {t}/run/done.json belongs to variant='head_on' "
+              "env_id='EgoSearchMemory-v0', not variant={variant} env_id={env}; use another out_dir")
+STORED = r"\((tracked by git|listed in the results' provenance\.json)[^)]*\)"
+
+ISSUE_CASES = [
+    # -- the issue's own cases (items 1 to 3 and 5)
+    ("fullbody_limit_negative", "silent",
+     ["fullbody", "--setting", "ours-M5-fetch", "--policy", "oracle", "--scenarios", S3, "--limit", "-1", "--out",
+      "{t}/o.csv"],
+     "egosearch fullbody: error: --limit=-1: the number of scenarios to use (0: all) must be >= 0"),
+    ("target_z_25m", "silent", ["evaluate", "--scenarios", "{t}/zhigh.csv", "--policy", "oracle", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: {t}/zhigh.csv:3: target_z=25 is outside the home kitchen_living, whose height "
+     "range is [0, 2.6] m (target_z: the height of the surface it rests on)"),
+    ("shortest_path_edited", "silent",
+     ["evaluate", "--scenarios", "{t}/ell.csv", "--policy", "oracle", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: {t}/ell.csv:4: shortest_path=0.3 is shorter than the straight line from the start "
+     "to where the target is within reach (2.49 m); ℓ is >= that"),
+    ("scenarios_n_huge", "silent", ["scenarios", "--n", "1000000000000", "--out", "{t}/s.csv"],
+     "egosearch scenarios: error: --n=1000000000000: at most 10000 scenarios in one set (minutes at ~40 "
+     "scenarios/s; a Table 1 cell has 200)"),
+    ("scenarios_homes_huge", "silent", ["scenarios", "--homes", "0:100000000", "--out", "{t}/s.csv"],
+     "egosearch scenarios: error: --homes=0:100000000: 100000000 homes; at most 1000 in one set"),
+    ("scenarios_n_times_homes", "silent", ["scenarios", "--homes", "0:500", "--n", "100", "--out", "{t}/s.csv"],
+     "egosearch scenarios: error: --n=100 per home x --homes=0:500 (500 homes) is 50000 scenarios; at most 10000 "
+     "in one set"),
+    ("weights_with_oracle", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "oracle", "--weights", "{t}/x.pt", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: --weights={t}/x.pt is only read with --policy actor, not --policy oracle: drop one "
+     "of them"),
+    ("compare_smoke_candidate_cpu_reference", "silent",
+     ["report", "compare", "--reference", "{t}/prof/results/cpu/eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+      "--candidate", "{t}/prof/results/cpu/eval/cand/seed0/kitchen_living/everywhere/h1.05.csv"],
+     "egosearch report: error: --candidate: {t}/prof/results/cpu/eval/cand/seed0/kitchen_living/everywhere/h1.05.csv "
+     "was evaluated from an actor trained at the smoke learner profile "
+     "({t}/prof/results/cpu/train/cand/seed0/config.json), the reference's at cpu: compare variants trained at one "
+     "profile"),
+    ("evaluate_threads_negative", "traceback",
+     ["evaluate", "--scenarios", S3, "--policy", "oracle", "--threads", "-3", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: --threads=-3: a number of threads (0: all cores) must be >= 0"),
+    ("train_into_another_variants_run", "traceback", ["train", "--variant", "head_off", "--out-dir", "{t}/run"],
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
+    ("train_into_a_run_of_another_profile", "traceback",
+     ["train", "--variant", "head_on", "--profile", "smoke", "--out-dir", "{t}/run"],
+     CHECKPOINT.format(t="{t}", variant="'head_on'", env="'EgoSearch-v0'")),
+    ("train_into_a_run_of_another_seed", "traceback", ["train", "--variant", "head_on", "--seed", "5", "--out-dir",
+                                                       "{t}/run"],
+     "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: seed=0 "
+     "(now 5); use another out_dir"),
+    ("train_work_dir_beside_another_run", "silent",
+     ["train", "--variant", "head_off", "--work-dir", "{t}/partial", "--out-dir", "{t}/run"],
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
+    ("scenarios_seed_negative", "cryptic", ["scenarios", "--seed", "-7", "--out", "{t}/s.csv"],
+     "egosearch scenarios: error: --seed=-7: a seed must be >= 0"),
+    ("binary_scenario_csv", "cryptic", ["evaluate", "--scenarios", "{t}/bin.csv", "--policy", "oracle", "--out",
+                                        "{t}/o.csv"],
+     "egosearch evaluate: error: {t}/bin.csv: not a text CSV file (byte 0x80 is not UTF-8 text); a scenario file "
+     "is written by `egosearch scenarios`"),
+    ("evaluate_seed_negative", "traceback",
+     ["evaluate", "--scenarios", S3, "--policy", "oracle", "--seed", "-1", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: --seed=-1: a seed must be >= 0"),
+    ("empty_variant_yaml", "cryptic", ["variant", "check", "{t}/empty.yaml"],
+     "egosearch variant: error: {t}/empty.yaml: empty file; a variant needs name, env_id, train_env"),
+    ("compare_empty_candidate", "cryptic", ["report", "compare", "--reference", ev("head_on"), "--candidate",
+                                            EMPTY_EVAL],
+     f"egosearch report: error: --candidate: {EMPTY_EVAL} is empty; a CSV file has a header line and rows"),
+    ("compare_other_scenarios_same_ids", "silent",  # the CSV was written, then ℓ refused: the file stayed
+     ["report", "compare", "--reference", "{t}/cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv", "--candidate",
+      "{t}/cmp/cand/seed0/kitchen_living/everywhere/h1.05.csv", "--out", "{t}/c.csv"],
+     "egosearch report: error: compare: scenario 0 of kitchen_living/everywhere/h1.05.csv has ℓ 8.9812 in the "
+     "reference and 9.9812 in the candidate: not the same scenarios"),
+    ("video_out_txt", "cryptic", ["video", "--scenarios", S3, "--policy", "oracle", "--out", "{t}/x.txt", "--still",
+                                  "{t}/x.png"],
+     "egosearch video: error: --out={t}/x.txt: the video must end in .mp4 or .gif"),
+    ("video_still_jpg", "silent", ["video", "--scenarios", S3, "--policy", "oracle", "--out", "{t}/x.gif", "--still",
+                                   "{t}/x.jpg"],
+     "egosearch video: error: --still={t}/x.jpg: the still must end in .png"),
+    ("bench_frames_negative", "cryptic", ["bench", "env", "--frames", "-1"],
+     "egosearch bench: error: --frames=-1: the number of sensor frames to time must be >= 1"),
+    ("fullbody_M0", "cryptic", ["fullbody", "--setting", "ours-M0-fetch", "--policy", "oracle", "--scenarios", S3,
+                                "--out", "{t}/o.csv"],
+     "egosearch fullbody: error: --setting=ours-M0-fetch: M=0; M is the number of steps executed per plan, >= 1"),
+    ("fullbody_T_negative", "cryptic", ["fullbody", "--setting", "ours-M5-fetch", "--policy", "oracle", "--scenarios",
+                                        S3, "--T", "-1", "--out", "{t}/o.csv"],
+     "egosearch fullbody: error: --T=-1: the planning horizon must be >= 1"),
+    ("fullbody_M_above_T", "cryptic", ["fullbody", "--setting", "ours-M25-fetch", "--policy", "oracle", "--scenarios",
+                                       S3, "--out", "{t}/o.csv"],
+     "egosearch fullbody: error: --setting=ours-M25-fetch with --T=20: ours executes M=25 steps of each plan, more "
+     "than the plan's T=20; allowed: M <= T"),
+    ("evaluate_out_is_its_scenarios", "silent",
+     ["evaluate", "--scenarios", "{t}/s3copy.csv", "--policy", "oracle", "--out", "{t}/s3copy.csv"],
+     "egosearch evaluate: error: --out={t}/s3copy.csv is also an input (--scenarios): a command never writes over "
+     "its own input; choose another output path"),
+    ("bench_gpu_without_cuda", "silent", ["bench", "gpu", "--seconds", "5", "--out-dir", "{t}/gpu"],
+     "egosearch bench: error: bench gpu needs a CUDA GPU, and torch {torch} sees none on this machine; "
+     "`bench learner` times the learners on the CPU"),
+    # -- stored results (item 1): run from the checkout's root, whose results/ and paper_figs/ are stored
+    ("evaluate_out_stored", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "oracle", "--out",
+      "results/cpu/eval/oracle/seed0/kitchen_living/everywhere/h1.05.csv"],
+     re.compile(r"egosearch evaluate: error: --out=results/cpu/eval/oracle/seed0/kitchen_living/everywhere/h1\.05\.csv "
+                rf"is a stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
+    ("pictures_default_folder_stored", "silent", ["pictures"],
+     re.compile(r"egosearch pictures: error: --out-dir=paper_figs/world holds stored results "
+                r"\(paper_figs/world/kitchen_living_placements\.png, [^)]*\), which this command may overwrite; pass "
+                r"--force to overwrite them, or write elsewhere")),
+    ("bench_out_stored", "silent", ["bench", "learner", "--out", "results/cpu/bench/learner.json"],
+     re.compile(rf"egosearch bench: error: --out=results/cpu/bench/learner\.json is a stored result {STORED}; pass "
+                r"--force to overwrite it, or write elsewhere")),
+    ("table1_prefix_stored", "silent",
+     ["report", "table1", ev("head_on"), "--out-prefix", "paper_figs/cpu/table1"],
+     re.compile(r"egosearch report: error: --out-prefix=paper_figs/cpu/table1 writes paper_figs/cpu/table1\.csv, which "
+                rf"is a stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
+    ("provenance_out_stored", "silent", ["report", "provenance", "--out", "results/cpu/provenance.json"],
+     re.compile(rf"egosearch report: error: --out=results/cpu/provenance\.json is a stored result {STORED}; pass "
+                r"--force to overwrite it, or write elsewhere")),
+    ("train_out_dir_stored", "traceback",
+     ["train", "--variant", "head_on", "--out-dir", "results/cpu/train/head_on/seed0"],
+     re.compile(r"egosearch train: error: --out-dir=results/cpu/train/head_on/seed0 holds stored results "
+                r"\(results/cpu/train/head_on/seed0/[a-z_]+\.[a-z]+, [^)]*\), which this command may overwrite; pass "
+                r"--force to overwrite them, or write elsewhere")),
+]
+
+# The 33 new bad inputs tried in the recently added commands (issue 35, item 5).
+NEW_CASES = [
+    ("generalise_trained_on_without_equals", "silent", ["report", "generalise", *GEN, "--trained-on", "head_on",
+                                                        "--out-prefix", "{t}/g"],
+     "egosearch report: error: --trained-on 'head_on': expected VARIANT=HOMES (e.g. head_on=paper_homes)"),
+    ("generalise_generated_not_a_policy", "silent", ["report", "generalise", *GEN, "--generated", "nope",
+                                                     "--out-prefix", "{t}/g"],
+     "egosearch report: error: --generated='nope' is none of the files' variants (head_on): its rows would be left "
+     "out without a word"),
+    ("generalise_reference_not_a_policy", "silent", ["report", "generalise", *GEN, "--generated", "head_on",
+                                                     "--reference", "nope", "--out-prefix", "{t}/g"],
+     "egosearch report: error: --reference='nope' is none of the files' variants (head_on): its rows would be left "
+     "out without a word"),
+    ("generalise_empty_policy_csv", "cryptic", ["report", "generalise", EMPTY_EVAL, *GEN[1:], "--out-prefix", "{t}/g"],
+     f"egosearch report: error: the input files: {EMPTY_EVAL} is empty; a CSV file has a header line and rows"),
+    ("generalise_prefix_overwrites_an_input", "silent",
+     ["report", "generalise", "{t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05.csv", *GEN[1:],
+      "--out-prefix", "{t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05"],
+     "egosearch report: error: --out-prefix={t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05 writes "
+     "{t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05.csv, which is also an input (the input files): a "
+     "command never writes over its own input; choose another output path"),
+    ("behaviour_head_on_not_traced", "silent", ["report", "behaviour", *TRACES, "--head-on", "nope", "--out-prefix",
+                                                "{t}/b"],
+     "egosearch report: error: --head-on='nope' has no trace file among the files (their variants: head_on, "
+     "head_off)"),
+    ("behaviour_head_on_is_head_off", "silent", ["report", "behaviour", *TRACES, "--head-off", "head_on",
+                                                 "--out-prefix", "{t}/b"],
+     "egosearch report: error: --head-on and --head-off are both 'head_on': the claims compare two variants"),
+    ("behaviour_csv_named_npz", "cryptic",
+     ["report", "behaviour", "{t}/badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", TRACES[1],
+      "--out-prefix", "{t}/b"],
+     "egosearch report: error: the input files: {t}/badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz is "
+     "not an .npz file (numpy's zip format); a trace file is written by `egosearch evaluate --traces`"),
+    ("behaviour_empty_npz", "traceback",
+     ["report", "behaviour", "{t}/zerotraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", TRACES[1],
+      "--out-prefix", "{t}/b"],
+     "egosearch report: error: the input files: {t}/zerotraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz is "
+     "empty; a trace file is written by `egosearch evaluate --traces`"),
+    ("searches_seed_without_files", "silent", ["report", "searches", *TRACES, "--seed", "5", "--out-dir", "{t}/srch"],
+     "egosearch report: error: --seed=5: no trace file of seed 5 among the files (their seeds: 0), so no search "
+     "would be pictured"),
+    ("searches_seed_negative", "silent", ["report", "searches", *TRACES, "--seed", "-1", "--out-dir", "{t}/srch"],
+     "egosearch report: error: --seed=-1: a seed must be >= 0"),
+    ("searches_unknown_home", "cryptic",
+     ["report", "searches", "{t}/mansion/head_on/seed0/mansion/everywhere/h1.65.npz", "--out-dir", "{t}/srch"],
+     "egosearch report: error: {t}/mansion/head_on/seed0/mansion/everywhere/h1.65.npz: the home 'mansion' of its "
+     "path is unknown; allowed: kitchen_living, bedroom_bath, studio or home<seed>"),
+    ("searches_csv_named_npz", "cryptic",
+     ["report", "searches", "{t}/badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", "--out-dir",
+      "{t}/srch"],
+     "egosearch report: error: the input files: {t}/badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz is "
+     "not an .npz file (numpy's zip format); a trace file is written by `egosearch evaluate --traces`"),
+    ("fresh_seed_negative", "silent", ["report", "fresh", "--stored", ev("head_on"), "--fresh",
+                                       "{t}/fresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv", "--fresh-seed",
+                                       "-3", "--out-prefix", "{t}/f"],
+     "egosearch report: error: --fresh-seed=-3: a scenario seed must be >= 0"),
+    ("fresh_prefix_with_a_dot", "silent", ["report", "fresh", "--stored", ev("head_on"), "--fresh",
+                                           "{t}/fresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+                                           "--out-prefix", "{t}/fresh.v2"],
+     "egosearch report: error: --out-prefix={t}/fresh.v2: fresh would write {t}/fresh.csv (it replaces what follows "
+     "a dot in the name); use a prefix without a dot in its name"),
+    ("fresh_same_files_both_sides", "silent", ["report", "fresh", "--stored", ev("head_on"), "--fresh", ev("head_on"),
+                                               "--out-prefix", "{t}/f"],
+     f"egosearch report: error: {ev('head_on')} is both a --stored and a --fresh file: the check reads evaluations "
+     "on two different scenario sets"),
+    ("fresh_empty_csv", "cryptic", ["report", "fresh", "--stored", ev("head_on"), "--fresh",
+                                    "{t}/emptyfresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+                                    "--out-prefix", "{t}/f"],
+     "egosearch report: error: --fresh: {t}/emptyfresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv is empty; "
+     "a CSV file has a header line and rows"),
+    ("bench_gpu_cuda_graph_without_cuda", "silent", ["bench", "gpu", "--cuda-graph", "--seconds", "5", "--out-dir",
+                                                     "{t}/gpu"],
+     "egosearch bench: error: bench gpu needs a CUDA GPU, and torch {torch} sees none on this machine; "
+     "`bench learner` times the learners on the CPU"),
+    ("bench_learner_with_a_gpu_option", "silent", ["bench", "learner", "--seconds", "5"],
+     "egosearch bench: error: --seconds is read by `bench gpu` only, not by `bench learner`"),
+    ("bench_env_frames_zero", "traceback", ["bench", "env", "--frames", "0", "--steps", "10"],
+     "egosearch bench: error: --frames=0: the number of sensor frames to time must be >= 1"),
+    ("bench_env_steps_negative", "cryptic", ["bench", "env", "--frames", "10", "--steps", "-5"],
+     "egosearch bench: error: --steps=-5: the number of env steps to time must be >= 1"),
+    ("variant_check_unknown_profile", "cryptic", ["variant", "check", "head_on", "--profile", "fast"],
+     "egosearch variant: error: --profile='fast'; allowed: smoke, cpu, paper"),
+    ("variant_check_binary_yaml", "cryptic", ["variant", "check", "{t}/bin.yaml"],
+     "egosearch variant: error: {t}/bin.yaml: not a text file; a variant is a YAML file with name, env_id, "
+     "train_env"),
+    ("variant_new_from_unknown", "clear", ["variant", "new", "tmp_bad_input_x", "--from", "nope"],
+     f"egosearch variant: error: --from: variant='nope' is unknown; allowed: {ALLOWED} (files in ablations)"),
+    ("variant_new_from_empty_file", "cryptic", ["variant", "new", "tmp_bad_input_y", "--from", "{t}/empty.yaml"],
+     "egosearch variant: error: --from: {t}/empty.yaml: empty file; a variant needs name, env_id, train_env"),
+    ("traces_same_file_as_out", "silent", ["evaluate", "--scenarios", S3, "--policy", "oracle", "--out",
+                                           "{t}/same.npz", "--traces", "{t}/same.npz"],
+     "egosearch evaluate: error: --traces={t}/same.npz is also written by --out: give each output its own path"),
+    ("traces_not_npz", "clear", ["evaluate", "--scenarios", S3, "--policy", "oracle", "--out", "{t}/o.csv",
+                                 "--traces", "{t}/t.csv"],
+     "egosearch evaluate: error: --traces={t}/t.csv: a trace file must end in .npz"),
+    ("budget_chosen_not_a_setting", "silent", ["report", "budget", "--run", f"head_on={CURVE}:{CELL}", "--chosen",
+                                               "nope", "--out-prefix", "{t}/u"],
+     "egosearch report: error: --chosen='nope' is none of the --run settings (head_on)"),
+    ("budget_empty_eval", "cryptic", ["report", "budget", "--run", f"head_on={CURVE}:{EMPTY_EVAL}", "--out-prefix",
+                                      "{t}/u"],
+     f"egosearch report: error: --run: {EMPTY_EVAL} is empty; a CSV file has a header line and rows"),
+    ("budget_same_run_twice", "clear", ["report", "budget", "--run", f"head_on={CURVE}:{CELL}", "--run",
+                                        f"head_on={CURVE}:{CELL}", "--out-prefix", "{t}/u"],
+     f"egosearch report: error: --run 'head_on={CURVE}:{CELL}': that run is given twice; each --run is one seed's "
+     "run"),
+    ("pathlength_out_csv_is_an_input", "silent",
+     ["report", "pathlength", "{t}/pl_in/head_on/seed0/kitchen_living/everywhere/h1.05.csv", "--scenarios",
+      "{t}/scen/kitchen_living/everywhere/h1.05.csv", "--out-prefix", "{t}/p", "--out-csv",
+      "{t}/pl_in/head_on/seed0/kitchen_living/everywhere/h1.05.csv"],
+     "egosearch report: error: --out-csv={t}/pl_in/head_on/seed0/kitchen_living/everywhere/h1.05.csv is also an "
+     "input (the input files): a command never writes over its own input; choose another output path"),
+    ("pathlength_binary_scenarios", "cryptic",
+     ["report", "pathlength", ev("head_on"), "--scenarios", "{t}/binscen/kitchen_living/everywhere/h1.05.csv",
+      "--out-prefix", "{t}/p"],
+     "egosearch report: error: --scenarios: {t}/binscen/kitchen_living/everywhere/h1.05.csv is not a text CSV file "
+     "(byte 128 is not UTF-8)"),
+    ("pathlength_empty_eval", "cryptic", ["report", "pathlength", EMPTY_EVAL, "--scenarios",
+                                          "{t}/scen/kitchen_living/everywhere/h1.05.csv", "--out-prefix", "{t}/p"],
+     f"egosearch report: error: the input files: {EMPTY_EVAL} is empty; a CSV file has a header line and rows"),
+]
+
+# Every case of the bad-input tables, the README's: the ones above and the older tables (all one
+# clear line before this issue: their tests passed).
+OLDER_CASES = 17 + 11 + 18 + 13 + 3  # BAD_VARIANT_FILES, BAD_CONFIGS, the CLI, output paths, nonsense scenarios
+COUNTS_BEFORE = {"clear": OLDER_CASES + 3, "cryptic": 9 + 12, "traceback": 6 + 2, "silent": 18 + 16}
+COUNTS_AFTER = {"clear": OLDER_CASES + len(ISSUE_CASES) + len(NEW_CASES), "cryptic": 0, "traceback": 0, "silent": 0}
+
+
+def test_the_tables_counts_before_and_after():
+    before = {kind: OLDER_CASES * (kind == "clear") for kind in BEFORE_KINDS}
+    for _, kind, _, _ in ISSUE_CASES + NEW_CASES:
+        before[kind] += 1
+    assert before == COUNTS_BEFORE
+    assert len(NEW_CASES) >= 30 and len({c[0] for c in ISSUE_CASES + NEW_CASES}) == len(ISSUE_CASES + NEW_CASES)
+    assert sum(COUNTS_AFTER.values()) == sum(COUNTS_BEFORE.values())
+
+
+@pytest.fixture(scope="module")
+def bad(tmp_path_factory):
+    """The files the cases read: small copies of stored results, and spoiled ones."""
+    import csv
+    import json
+
+    import numpy as np
+
+    from egosearch.rl.config import load_config
+    from egosearch.rl.run_files import env_kwargs_key
+    from egosearch.variants import resolve_variant
+
+    t = tmp_path_factory.mktemp("bad")
+    results = REPO / "results" / "cpu"
+
+    def copy(src, dest):
+        (t / dest).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(src, t / dest)
+        return t / dest
+
+    def write(dest, data: bytes):
+        (t / dest).parent.mkdir(parents=True, exist_ok=True)
+        (t / dest).write_bytes(data)
+
+    rows = list(csv.DictReader(open(results / "scenarios/kitchen_living/everywhere/h1.05.csv")))
+
+    def scenarios(dest, spoil=None):
+        chosen = [dict(r) for r in rows[:3]] if spoil is None else spoil([dict(r) for r in rows[:3]])
+        with open(t / dest, "w", newline="") as f:
+            writer = csv.DictWriter(f, list(rows[0]))
+            writer.writeheader()
+            writer.writerows(chosen)
+
+    scenarios("s3.csv")
+    scenarios("s3copy.csv")
+    scenarios("zhigh.csv", lambda r: [r[0], {**r[1], "target_z": "25"}, r[2]])
+    scenarios("ell.csv", lambda r: [r[0], r[1], {**rows[8], "shortest_path": "0.3"}])  # ℓ 2.6298 in the stored set
+    write("bin.csv", bytes(range(256)) * 4)
+    write("empty.yaml", b"")
+    write("bin.yaml", b"\xff\xfe\x00name: x\x9c\x80")
+    write("x.pt", b"")
+    for variant in ("head_on", "head_off", "random", "oracle"):
+        for home in ("kitchen_living", "generated_heldout"):
+            src = results / "eval" / variant / "seed0" / home / "everywhere" / "h1.05.csv"
+            if src.exists():
+                copy(src, f"eval/{variant}/seed0/{home}/everywhere/h1.05.csv")
+    copy(results / "eval/head_on/seed0/kitchen_living/no_low_cabinets/h1.05.csv",
+         "eval/head_on/seed0/kitchen_living/no_low_cabinets/h1.05.csv")
+    copy(results / "eval/head_on/seed0/generated_heldout/everywhere/h1.05.csv",
+         "g_in/head_on/seed0/generated_heldout/everywhere/h1.05.csv")
+    copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+         "pl_in/head_on/seed0/kitchen_living/everywhere/h1.05.csv")
+    copy(results / "fresh/eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+         "fresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv")
+    copy(results / "scenarios/kitchen_living/everywhere/h1.05.csv", "scen/kitchen_living/everywhere/h1.05.csv")
+    copy(results / "train/head_on/seed0/curve.csv", "train/head_on/seed0/curve.csv")
+    write("binscen/kitchen_living/everywhere/h1.05.csv", bytes(range(256)) * 4)
+    write("emptyeval/cand/seed0/kitchen_living/everywhere/h1.05.csv", b"")
+    write("emptyfresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv", b"")
+    for dest in (*(p.format(t=t) for p in TRACES), "mansion/head_on/seed0/mansion/everywhere/h1.65.npz"):
+        (t / dest).parent.mkdir(parents=True, exist_ok=True)
+        np.savez(t / dest, step=np.zeros(1))
+    write("badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", b"scenario_id,step\n0,0\n")
+    write("zerotraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", b"")
+    # a finished run of head_on at the cpu profile, seed 0 (the one `train` may not be pointed at with another run)
+    resolved = resolve_variant("head_on", "cpu", {"seed": 0})
+    done = {**json.loads((results / "train/head_on/seed0/done.json").read_text()), "variant": "head_on",
+            "env_id": resolved.env_id, "env_kwargs": env_kwargs_key(resolved.train_env),
+            "config": resolved.config.to_dict()}
+    write("run/done.json", json.dumps(done).encode())
+    # the same scenario ids with other ℓ: another scenario set of the same names
+    ref = copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+               "cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv")
+    episodes = list(csv.DictReader(open(ref)))
+    for r in episodes:
+        r["shortest_path"] = f"{float(r['shortest_path']) + 1.0:.4f}"
+    (t / "cmp/cand/seed0/kitchen_living/everywhere").mkdir(parents=True)
+    with open(t / "cmp/cand/seed0/kitchen_living/everywhere/h1.05.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, list(episodes[0]))
+        writer.writeheader()
+        writer.writerows(episodes)
+    # a results folder as the DAG lays it out, whose candidate trained at the smoke profile
+    for variant, config in (("head_on", load_config("cpu").to_dict()), ("cand", load_config("smoke").to_dict())):
+        copy(ref, f"prof/results/cpu/eval/{variant}/seed0/kitchen_living/everywhere/h1.05.csv")
+        write(f"prof/results/cpu/train/{variant}/seed0/config.json",
+              json.dumps({"variant": variant, "config": config}).encode())
+    return t
+
+
+@pytest.fixture
+def nothing_runs(monkeypatch):
+    """Any episode, training step, scenario draw, benchmark or picture fails the test: each bad input
+    must be refused before it."""
+    import egosearch.cli.bench
+    import egosearch.cli.evaluate
+    import egosearch.cli.fullbody
+    import egosearch.cli.pictures
+    import egosearch.cli.scenarios
+    import egosearch.cli.video
+    import egosearch.rl.train
+
+    def work(*args, **kwargs):
+        raise AssertionError("work started before the bad input was refused")
+
+    for module, name in ((egosearch.cli.evaluate, "evaluate"), (egosearch.cli.fullbody, "evaluate_fullbody"),
+                         (egosearch.cli.video, "write_search_video"), (egosearch.cli.scenarios, "generate_scenarios"),
+                         (egosearch.cli.bench, "gpu_check"), (egosearch.cli.bench, "bench_learner"),
+                         (egosearch.cli.bench.bench, "bench_env"), (egosearch.cli.pictures, "make_pictures"),
+                         (egosearch.rl.train, "_train")):
+        monkeypatch.setattr(module, name, work)
+
+
+def _filled(value, t: Path):
+    if isinstance(value, re.Pattern):
+        return re.compile(value.pattern.replace("{t}", re.escape(str(t))))
+    built = "a CPU-only build" if not torch.version.cuda else f"built with CUDA {torch.version.cuda}"
+    return value.replace("{t}", str(t)).replace("{torch}", f"{torch.__version__} ({built})")
+
+
+@pytest.mark.parametrize("case", ISSUE_CASES + NEW_CASES, ids=[c[0] for c in ISSUE_CASES + NEW_CASES])
+def test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs):
+    name, _, argv, expected = case
+    if "cuda" in name and torch.cuda.is_available():
+        pytest.skip("this machine has CUDA: bench gpu runs")
+    monkeypatch.chdir(REPO)  # the stored results are the checkout's
+    before = sorted(p.relative_to(bad) for p in bad.rglob("*"))
+    line = cli_error(capsys, *[_filled(arg, bad) for arg in argv])
+    expected = _filled(expected, bad)
+    if isinstance(expected, re.Pattern):
+        assert expected.fullmatch(line), line
+    else:
+        assert line == expected
+    # nothing written, not even a temporary file or an empty folder
+    assert sorted(p.relative_to(bad) for p in bad.rglob("*")) == before
+    assert not (REPO / "ablations" / "tmp_bad_input_x.yaml").exists()
+
+
+def test_the_overwrite_guard_without_git_reads_the_provenance(tmp_path, monkeypatch):
+    """An unpacked archive has no git to ask: the sha256 list of results/<profile>/provenance.json
+    says what is stored, and paper_figs/ beside such a record is stored too."""
+    import json
+
+    from egosearch.core.outputs import OutputPathError, check_overwrites, stored_results
+
+    stored = tmp_path / "results/cpu/eval/x/seed0/h/everywhere/h1.05.csv"
+    new = tmp_path / "results/cpu/eval/y/seed0/h/everywhere/h1.05.csv"
+    figure = tmp_path / "paper_figs/cpu/table1.md"
+    for path in (stored, new, figure):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("x")
+    (tmp_path / "results/cpu/provenance.json").write_text(json.dumps(
+        {"files": {"eval/x/seed0/h/everywhere/h1.05.csv": {"sha256": "0", "bytes": 1}}}))
+    monkeypatch.setenv("GIT_CEILING_DIRECTORIES", str(tmp_path.parent))
+    found = stored_results([stored, new, figure, tmp_path / "results/cpu/not_yet.csv", tmp_path / "results/cpu"])
+    assert set(found) == {stored, figure, tmp_path / "results/cpu"}
+    assert found[stored][1] == "listed in the results' provenance.json"
+    with pytest.raises(OutputPathError, match="is a stored result .*pass --force"):
+        check_overwrites(files={"--out": stored})
+    check_overwrites(files={"--out": stored}, force=True)          # --force: the DAG's jobs
+    check_overwrites(files={"--out": new})                           # not in the record: a new result
+    check_overwrites(files={"--out": tmp_path / "results/cpu/not_yet.csv"})  # not there yet: never refused
+    with pytest.raises(OutputPathError, match="is also an input"):  # whatever --force says
+        check_overwrites(files={"--out": new}, inputs={"--scenarios": new}, force=True)
+
+
+def test_a_stored_result_is_what_git_tracks():
+    from egosearch.core.outputs import stored_results
+
+    tracked = REPO / "results/cpu/provenance.json"
+    untracked = REPO / "results/cpu/logs"  # a folder holding tracked logs
+    found = stored_results([tracked, untracked, REPO / "README.md", REPO / "results/cpu/nothing_here.csv"])
+    assert set(found) == {tracked, untracked}
+
+
+def test_the_dags_own_jobs_pass_force():
+    """Every command the DAG runs that writes a file passes --force, and nothing else needs it."""
+    writers = re.compile(r'"egosearch (scenarios|evaluate|train|fullbody|video|pictures|report (?!regenerate|readme|'
+                         r'verify)\w+)')
+    lines = [line for path in sorted((REPO / "egosearch/workflow/rules").glob("*.smk"))
+             for line in path.read_text().splitlines() if writers.search(line)]
+    assert len(lines) >= 20 and all("--force" in line for line in lines), [x for x in lines if "--force" not in x]
+
+
+def test_a_compare_that_fails_a_check_leaves_no_file(bad, capsys):
+    """The ℓ check runs after the cell table is computed: its CSV waits in a temporary file."""
+    out = bad / "cmp_out" / "c.csv"
+    assert cli_error(capsys, "report", "compare", "--reference",
+                     str(bad / "cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv"), "--candidate",
+                     str(bad / "cmp/cand/seed0/kitchen_living/everywhere/h1.05.csv"), "--out",
+                     str(out)).endswith("not the same scenarios")
+    assert not out.parent.exists() or not list(out.parent.iterdir())
+
+
+def test_a_compare_that_passes_writes_both_files_under_their_names(bad, capsys):
+    out = bad / "cmp_ok" / "c.csv"
+    assert main(["report", "compare", "--reference", str(bad / "cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv"),
+                 "--candidate", str(bad / "eval/head_off/seed0/kitchen_living/everywhere/h1.05.csv"), "--out",
+                 str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"wrote {out}\n" in printed and f"wrote {out.parent / 'c_by_length.csv'}\n" in printed
+    assert ".tmp" not in printed
+    assert sorted(p.name for p in out.parent.iterdir()) == ["c.csv", "c_by_length.csv"]
+
+
+def test_a_smoke_actor_gets_a_note_naming_its_profile(capsys):
+    """Evaluated beside the cpu results, a smoke actor's rows would pass for a poor variant's."""
+    import json
+    from types import SimpleNamespace
+
+    from egosearch.cli.acting import note_profile
+    from egosearch.cli.checks import learner_profile_of
+    from egosearch.rl.config import load_config
+
+    note_profile("smoke.pt", SimpleNamespace(config=load_config("smoke").to_dict(), variant="head_on"))
+    assert capsys.readouterr().err == ("note: smoke.pt was trained at the smoke learner profile (its config is the "
+                                       "smoke profile's), not at cpu: do not read its results beside the cpu "
+                                       "profile's\n")
+    # every stored run reads as the profile of the folder it is stored in
+    for config in sorted(REPO.glob("results/*/train/*/seed*/config.json")):
+        record = json.loads(config.read_text())
+        assert learner_profile_of(record["config"], record.get("variant"))[0] == config.parts[-5], config
+
+
+def test_help_names_every_layout_the_commands_take(capsys):
+    from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
+
+    for argv in (["scenarios", "--help"], ["pictures", "--help"], ["bench", "--help"]):
+        with pytest.raises(SystemExit):
+            main(argv)
+        out = " ".join(capsys.readouterr().out.split())
+        assert all(name in out for name in (*LAYOUT_NAMES, *EASY_LAYOUTS, "home<seed>")), argv
+    for argv in (["train", "--help"], ["bench", "--help"]):
+        with pytest.raises(SystemExit):
+            main(argv)
+        out = " ".join(capsys.readouterr().out.split())
+        assert "SAC-DrQ at cpu" in out, argv

@@ -128,19 +128,60 @@ def test_verdicts_follow_the_side_of_the_interval():
         ("head_on", "success", 0.8, 0.7, 0.9),
     ])
     got = claims_frame(summary)
-    verdicts, details = list(got["verdict"]), list(got["detail"])
-    assert verdicts == ["holds", "does not hold", "does not hold", "not testable here", "not testable here"]
+    assert list(got["sign"]) == ["holds", "not shown", "opposite", "not testable here", "not testable here"]
+    # Section 6.3 states no number; Figure 6 does, but there is no head-off side to measure it on.
+    assert list(got["size"]) == ["no size in the paper"] * 3 + ["not testable here", "no size in the paper"]
+    assert list(got["verdict"]) == ["sign holds, no size in the paper", "sign not shown, no size in the paper",
+                                    "sign opposite, no size in the paper", "not testable here", "not testable here"]
+    details = list(got["detail"])
     assert "includes 0" in details[1] and "other side" in details[2] and "head_off" in details[3]
     summary = pd.concat([summary, _summary([("head_on - head_off", "success", 0.15, 0.05, 0.25),
                                             ("head_on - head_off", "body_turn_per_step", 0.01, -0.02, 0.04)])])
     got = claims_frame(summary)
-    assert list(got["verdict"])[3:] == ["holds", "does not hold"]
+    assert list(got["verdict"])[3:] == ["sign holds, size reproduced", "sign not shown, no size in the paper"]
+    assert got["paper_size"][3] == pytest.approx(0.20) and math.isnan(got["paper_size"][4])
     assert "+0.20 is inside" in got["detail"][3]
+
+
+def _success_claim(value, lo, hi, head_off_rate=0.5):
+    summary = _summary([("head_on - head_off", "success", value, lo, hi),
+                        ("head_off", "success", head_off_rate, head_off_rate - 0.03, head_off_rate + 0.03)])
+    return claims_frame(summary).iloc[3]
+
+
+def test_the_size_is_read_apart_from_the_sign():
+    # Excludes 0 but not the paper's +0.20: the direction is reproduced, the amount is not.
+    row = _success_claim(0.05, 0.02, 0.08)
+    assert (row["sign"], row["size"]) == ("holds", "size not reproduced")
+    assert row["verdict"] == "sign holds, size not reproduced" and "+0.20 is outside" in row["detail"]
+    # The interval holds +0.20: both reproduced.
+    row = _success_claim(0.18, 0.12, 0.24)
+    assert row["verdict"] == "sign holds, size reproduced"
+    # Straddles 0: the sign is not shown, whatever the size; +0.20 inside says only "not ruled out".
+    row = _success_claim(0.10, -0.02, 0.22)
+    assert (row["sign"], row["size"]) == ("not shown", "size reproduced") and "not ruled out" in row["detail"]
+    assert _success_claim(0.02, -0.02, 0.06)["verdict"] == "sign not shown, size not reproduced"
+    # Wholly below 0: opposite, and the paper's size cannot be inside.
+    assert _success_claim(-0.06, -0.09, -0.03)["verdict"] == "sign opposite, size not reproduced"
+    # "20% higher" read as a share of head off's own rate: 0.2 x 0.4 = +0.08, inside [0.02, 0.09].
+    row = _success_claim(0.05, 0.02, 0.09, head_off_rate=0.4)
+    assert row["size"] == "size not reproduced" and "+0.080: inside it" in row["detail"]
+
+
+def test_sign_and_size_verdicts_by_hand():
+    from egosearch.report.behaviour import sign_verdict, size_verdict
+    assert sign_verdict(0.01, 0.2, +1) == "holds" and sign_verdict(-0.2, -0.01, -1) == "holds"
+    assert sign_verdict(-0.01, 0.2, +1) == "not shown" and sign_verdict(0.0, 0.2, +1) == "not shown"
+    assert sign_verdict(-0.2, -0.01, +1) == "opposite" and sign_verdict(0.01, 0.2, -1) == "opposite"
+    assert size_verdict(0.1, 0.3, 0.2) == "size reproduced" and size_verdict(0.2, 0.3, 0.2) == "size reproduced"
+    assert size_verdict(0.01, 0.19, 0.2) == "size not reproduced" and size_verdict(0.1, 0.3, None) == \
+        "no size in the paper"
 
 
 def test_an_empty_measure_is_not_testable():
     got = claims_frame(_summary([("head_on", "speed_near_minus_elsewhere", math.nan, math.nan, math.nan)]))
     assert got["verdict"][0] == "not testable here" and "no step" in got["detail"][0]
+    assert got["sign"][0] == "not testable here"
 
 
 def _write_trace(path, episodes, head=True):
@@ -172,7 +213,8 @@ def test_trace_files_to_claims_and_the_readme_block(tmp_path):
     block = block_claims(root, "cpu")
     assert "moves slower" not in block and "move slower around cabinets" in block
     # identical traces on both sides: the success gain is exactly 0, which is no gain
-    assert "| **does not hold**" in block.split("20% higher")[1].split("\n")[0]
+    assert "| **sign not shown, size not reproduced**" in block.split("20% higher")[1].split("\n")[0]
+    assert "| +0.20 |" in block and "| none stated |" in block
     with pytest.raises(ValueError, match="a second trace"):
         behaviour_episodes(paths + paths[:1])
 

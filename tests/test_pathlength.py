@@ -178,8 +178,11 @@ def _side(root: Path, variant: str, success_short, success_long, seeds=(0, 1)) -
 
 def test_compare_by_length_hand_worked(tmp_path):
     """The candidate finds every short target the reference misses and ties on the long ones: +1 on
-    the 4 short scenarios (both cells), interval [1, 1], exact sign-flip p = 2/2^4; 0 and p = 1 on the
-    2 long ones. Holm over the 4 rows: 4 x 0.125 = 0.5, not significant."""
+    the 4 short scenarios (both cells), interval [1, 1]; 0 and p = 1 on the 2 long ones. The p-value is
+    read off the interval's own draws: none reaches 0, so p is its floor, one draw's share (1/1000).
+    Holm over the 4 rows: 4 x 0.001 for the first, 3 x 0.001 (raised to the running max) for the
+    second: significant; the long rows stay at 1. (A bootstrap sees no spread the 4 scenarios do not
+    show: the stored bins hold 29 or more.)"""
     ref = _side(tmp_path, "head_on", 0, 1)
     cand = _side(tmp_path, "head_off", 1, 1)
     df = compare_by_length(ref, cand, tmp_path / "cmp_by_length.csv", n_resamples=1000)
@@ -189,10 +192,10 @@ def test_compare_by_length_hand_worked(tmp_path):
     short, long_ = df.iloc[0], df.iloc[2]
     assert (short.reference, short.candidate, short.difference) == (0.0, 1.0, 1.0)
     assert (short.ci_low, short.ci_high, short.n_scenarios) == (1.0, 1.0, 4)
-    assert short.p_uncorrected == pytest.approx(2 / 16)
+    assert short.p_uncorrected == pytest.approx(1 / 1000)
     assert (long_.difference, long_.ci_low, long_.ci_high, long_.p_uncorrected, long_.n_scenarios) == (0, 0, 0, 1, 2)
-    assert df["p_holm"].tolist() == pytest.approx([0.5, 0.5, 1.0, 1.0])
-    assert not df["significant_holm"].any()
+    assert df["p_holm"].tolist() == pytest.approx([0.004, 0.004, 1.0, 1.0])
+    assert df["significant_holm"].tolist() == [True, True, False, False]
     assert pd.read_csv(tmp_path / "cmp_by_length.csv").shape == df.shape
 
 

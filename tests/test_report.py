@@ -204,11 +204,17 @@ def test_compare_planted_difference():
 
 def test_compare_identical_copy():
     rng = np.random.default_rng(5)
+    one = cell_frame(rng.random(100) < 0.6)
+    for metric in ("success", "spl"):
+        res = compare_cells(one, one.copy(), metric)
+        assert (res["difference"], res["ci_low"], res["ci_high"], res["p_uncorrected"]) == (0.0, 0.0, 0.0, 1.0)
+    # Two seeds that disagree: the copy's seeds are other training runs to the bootstrap, so the
+    # interval is as wide as the seeds' spread, around 0, and p is far from significant.
     ref = pd.concat([cell_frame(rng.random(100) < 0.6, seed=s) for s in range(2)], ignore_index=True)
     for metric in ("success", "spl"):
         res = compare_cells(ref, ref.copy(), metric)
-        assert res["difference"] == 0.0 and res["ci_low"] == 0.0 and res["ci_high"] == 0.0
-        assert res["p_uncorrected"] == pytest.approx(1.0)
+        assert res["difference"] == 0.0 and res["ci_low"] < 0 < res["ci_high"]
+        assert res["p_uncorrected"] > 0.5
 
 
 def test_compare_noise_not_significant_and_seed_averaging():
@@ -236,23 +242,95 @@ def _paired(values, metric, seeds=(0,)):
                      ignore_index=True)
 
 
-def test_compare_exact_two_sided_permutation_p_value_by_hand():
-    # 4 scenarios: exact enumeration of the 2^4 sign flips of d = (0.6, 0.3, -0.2, 0.05), sum 0.75.
-    # |sum| >= 0.75 for + + + +, + + + -, + + - + (1.15, 1.05, 0.75: the observed one counts) and
-    # their three mirrors: p = 6/16.
-    ref = _paired([0.2, 0.3, 0.5, 0.1], "spl")
-    cand = _paired([0.8, 0.6, 0.3, 0.15], "spl")
-    assert compare_cells(ref, cand, "spl")["p_uncorrected"] == pytest.approx(6 / 16, abs=1e-12)
-    # 5 scenarios, the candidate succeeds in every one the reference fails: only all + and
-    # all - reach |sum| = 5: p = 2/32 (a one-sided test would say 1/32).
-    res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success"), "success")
-    assert res["p_uncorrected"] == pytest.approx(2 / 32, abs=1e-12)
-    # d = (1, 1, 1, 1, -1), sum 3: sums >= 3 need at most one minus sign (1 + 5 patterns): p = 12/32.
-    res = compare_cells(_paired([0, 0, 0, 0, 1], "success"), _paired([1, 1, 1, 1, 0], "success"), "success")
-    assert res["p_uncorrected"] == pytest.approx(12 / 32, abs=1e-12)
-    # Seeds are averaged per scenario first: two candidate seeds agreeing give the same p.
-    res = compare_cells(_paired([0] * 5, "success"), _paired([1] * 5, "success", seeds=(0, 1)), "success")
-    assert res["p_uncorrected"] == pytest.approx(2 / 32, abs=1e-12)
+def _old_sign_flip_p(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str, n_resamples: int = 10_000) -> float:
+    """The p-value compare_cells gave before it read p from its bootstrap: a two-sided sign-flip test over
+    scenarios on the seed-averaged differences (the seeds' disagreement never enters it)."""
+    from scipy import stats as sstats
+    r = reference.groupby("scenario_id")[metric].mean().to_numpy()
+    c = candidate.groupby("scenario_id")[metric].mean().to_numpy()
+    res = sstats.permutation_test((c, r), lambda x, y, axis: np.mean(x - y, axis=axis), permutation_type="samples",
+                                  vectorized=True, n_resamples=n_resamples, alternative="two-sided",
+                                  rng=np.random.default_rng(0))
+    return float(res.pvalue)
+
+
+def test_compare_seeds_disagree_while_scenarios_agree_is_not_significant():
+    """The candidate's seed 0 is far better than the reference on every scenario, its seed 1 far worse,
+    so that every seed-averaged difference is a little above 0: the scenarios agree, the seeds do not.
+    The old sign-flip test over scenarios saw only the seed averages and called it significant; the
+    two-level bootstrap resamples the candidate's seeds too and does not."""
+    n = 100
+    rng = np.random.default_rng(3)
+    ref = _paired(np.full(n, 0.5), "spl", seeds=(0, 1))
+    up, down = 0.8 + rng.uniform(0, 0.02, n), 0.2 + rng.uniform(0, 0.02, n)
+    cand = pd.concat([_paired(up, "spl", seeds=(0,)), _paired(down, "spl", seeds=(1,))], ignore_index=True)
+    seed_averaged = (up + down) / 2 - 0.5
+    assert (seed_averaged > 0).all()                      # every scenario agrees on the sign
+    old_p = _old_sign_flip_p(ref, cand, "spl")
+    assert old_p < 0.001                                  # 1/10001: the old test called it significant
+    res = compare_cells(ref, cand, "spl")
+    assert res["difference"] == pytest.approx(seed_averaged.mean())
+    assert res["ci_low"] < 0 < res["ci_high"] and res["p_uncorrected"] > 0.3
+    assert res["detectable_80"] > 0.5                     # the seeds' spread: no small difference is detectable
+    # The same candidate with the seeds agreeing (each seed the average) is significant under both tests.
+    agree = _paired((up + down) / 2, "spl", seeds=(0, 1))
+    assert compare_cells(ref, agree, "spl")["p_uncorrected"] < 0.001 and _old_sign_flip_p(ref, agree, "spl") < 0.001
+
+
+def test_percentile_p_value_by_hand():
+    from egosearch.report.stats import percentile_p_value, quantile_interval
+    # 100 draws -4.5, -3.5, ..., 94.5: 5 at or below 0; numpy's linear quantile crosses 0 at position
+    # 4.5 of 99, so the interval excludes 0 for every alpha above 2 * 4.5 / 99.
+    draws = np.arange(100) - 4.5
+    assert percentile_p_value(draws) == pytest.approx(9 / 99)
+    assert quantile_interval(draws, 1 - 9 / 99)[0] == pytest.approx(0.0, abs=1e-12)
+    assert percentile_p_value(-draws) == pytest.approx(9 / 99)   # two-sided: the mirror gives the same p
+    assert percentile_p_value(np.arange(1.0, 101.0)) == pytest.approx(1 / 100)   # none on the far side: the floor
+    assert percentile_p_value(np.zeros(50)) == 1.0
+    assert percentile_p_value(np.r_[-np.ones(50), np.ones(50)]) == 1.0
+    assert math.isnan(percentile_p_value(np.array([np.nan])))
+
+
+def test_p_below_005_exactly_when_the_95_interval_excludes_0():
+    from egosearch.report.stats import percentile_p_value, quantile_interval
+    rng = np.random.default_rng(7)
+    for i in range(3000):
+        n = int(rng.choice([21, 100, 999, 10_000]))
+        centre = rng.normal(0, 0.04)
+        draws = (rng.normal(centre, 0.02, n) if i % 3 == 0 else np.round(rng.normal(centre, 0.02, n), 2)
+                 if i % 3 == 1 else rng.integers(-2, 6, n) / 8.0)  # ties and draws exactly at 0 too
+        lo, hi = quantile_interval(draws, 0.95)
+        assert (percentile_p_value(draws) < 0.05) == (lo > 0 or hi < 0), (i, lo, hi, percentile_p_value(draws))
+
+
+def test_compare_p_and_interval_agree_on_cells():
+    rng = np.random.default_rng(2)
+    for i in range(30):
+        ref = pd.concat([cell_frame(rng.random(60) < 0.5, seed=s) for s in range(3)], ignore_index=True)
+        cand = pd.concat([cell_frame(rng.random(60) < 0.5 + 0.01 * i, seed=s) for s in range(2)],
+                         ignore_index=True)
+        res = compare_cells(ref, cand, "success", n_resamples=2000)
+        assert (res["p_uncorrected"] < 0.05) == (res["ci_low"] > 0 or res["ci_high"] < 0)
+
+
+def test_compare_one_seed_each_resamples_the_scenarios_only():
+    # One seed a side: the draws are the ordinary paired bootstrap over scenarios (no seed level).
+    from egosearch.report.stats import paired_two_level_draws
+    rng = np.random.default_rng(4)
+    r, c = rng.random(80), rng.random(80) + 0.1
+    draws = paired_two_level_draws(r[:, None], c[:, None], n_resamples=500, seed=0)
+    idx = np.random.default_rng(0).integers(0, 80, (500, 80))  # the scenario draws, first from the stream
+    by_hand = c[idx].mean(axis=1) - r[idx].mean(axis=1)
+    assert draws == pytest.approx(by_hand)
+    res = compare_cells(_paired(r, "spl"), _paired(c, "spl"), "spl", n_resamples=500)
+    assert (res["n_seeds_ref"], res["n_seeds_cand"]) == (1, 1)
+    assert (res["ci_low"], res["ci_high"]) == pytest.approx(tuple(np.quantile(by_hand, [0.025, 0.975])))
+
+
+def test_compare_one_scenario_gives_no_interval_and_no_test():
+    res = compare_cells(_paired([0], "success"), _paired([1], "success"), "success")
+    assert res["difference"] == 1.0 and math.isnan(res["ci_low"]) and math.isnan(res["ci_high"])
+    assert res["p_uncorrected"] == 1.0
 
 
 def test_holm():
@@ -406,6 +484,8 @@ def test_compare_report(tmp_path):
     assert (succ["difference"] < -0.15).all() and succ["significant_holm"].all()
     assert (df["p_holm"] >= df["p_uncorrected"]).all()
     assert (df["significant_holm"] == (df["p_holm"] < 0.05)).all() and "significant" not in df.columns
+    holds_0 = (df["ci_low"] <= 0) & (df["ci_high"] >= 0)
+    assert not (df["significant_holm"] & holds_0).any()
     assert pd.read_csv(tmp_path / "cmp.csv").shape == df.shape
     text = format_compare(df, "head_on", "head_off")
     assert "*" in text and "everywhere" in text and len(text.splitlines()) == 12 + 3

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import os
+import sys
+from pathlib import Path
+
 import torch
 
+from egosearch.cli.checks import at_least, learner_profile_of
+from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers.frontier import FrontierPolicy
@@ -14,13 +20,24 @@ def set_acting_threads(threads: int) -> None:
     """Acting is batch-1 inference, and extra torch threads spin against other jobs: beside two
     training runs, a 2-thread actor ran full-body episodes 14x slower than a 1-thread one.
     Snakemake sets OMP_NUM_THREADS itself; this is the default for hand-run commands."""
+    check_threads(threads)
     torch.set_num_threads(torch_threads(threads))
 
 
-def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None):
+def check_threads(threads: int) -> None:
+    # torch refuses a negative count with a traceback
+    at_least("--threads", threads, 0, "a number of threads (0: all cores)")
+
+
+def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
     """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
     trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
-    here, before any episode."""
+    here, before any episode, and so are weights given to a policy that has none; an actor trained at
+    another learner profile than the results ``out`` is written beside gets a note."""
+    if weights and kind in ("oracle", "random", "frontier", "frontier_head_off"):
+        # the oracle, random and frontier searchers would run and the weights be ignored without a word
+        raise ValueError(f"--weights={weights} is only read with --policy actor, not --policy {kind}: drop one of "
+                         "them")
     if kind == "oracle":
         return OraclePolicy, env_id or "EgoSearch-v0"
     if kind == "random":
@@ -33,5 +50,32 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         actor = ActorPolicy(weights)
         env_id = env_id or actor.trained_env_id() or "EgoSearch-v0"
         actor.check_env(env_id)
+        note_profile(weights, actor, reference_profile(out))
         return (lambda env: actor), env_id
     raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, actor")
+
+
+STORED_PROFILE = "cpu"
+"""The learner profile of the stored results (Table 1, compare, Figure 7)."""
+
+
+def reference_profile(out: str | None) -> str:
+    """The learner profile of the results an output is read beside: the one of the
+    ``results/<profile>/`` folder it is written into (the DAG's jobs), else the stored results'."""
+    parts = Path(os.path.abspath(out)).parts if out else ()
+    profiles = workflow_config()["profiles"]
+    for folder, profile in zip(parts[-3::-1], parts[-2::-1]):  # the innermost results/<profile>/ first
+        if folder == "results" and profile in profiles:
+            return profiles[profile]["learner"]
+    return STORED_PROFILE
+
+
+def note_profile(weights: str, actor: ActorPolicy, reference: str = STORED_PROFILE) -> None:
+    """One note line when the actor was not trained at the ``reference`` learner profile: a smoke
+    actor's rows look like any other's, and beside the cpu results they would pass for a poor variant."""
+    if not isinstance(actor.config, dict):
+        return
+    profile, how = learner_profile_of(actor.config, actor.variant)
+    if profile not in (None, reference):
+        print(f"note: {weights} was trained at the {profile} learner profile ({how}), not at {reference}: do not "
+              f"read its results beside the {reference} profile's", file=sys.stderr)

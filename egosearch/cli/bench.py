@@ -6,23 +6,45 @@ import json
 import sys
 from pathlib import Path
 
-from egosearch.core.outputs import check_outputs
+import torch
+
+from egosearch.cli.checks import at_least
+from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.bench import bench_learner, gpu_check
+from egosearch.scene.layouts import get_scene
 from egosearch.sim import bench
 from egosearch.variants import resolve_variant
 
 GPU_CHECK_VARIANT = "head_on"
 """The variant whose paper-profile training ``bench gpu`` times (seed 0)."""
 
+DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds": 150.0, "baseline_seconds": 0.0}
+"""Each benchmark's option defaults (the parser leaves them None, so that an option given to a
+benchmark that does not read it is told apart from one left alone)."""
+READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "out_dir": "gpu",
+           "cuda_graph": "gpu", "baseline_seconds": "gpu"}
+"""The benchmark that reads each of the options that only one of them reads."""
+
 
 def run(args) -> None:
     check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
-    if args.what == "gpu" and not args.out_dir:
-        raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
-    if args.what == "gpu" and not args.seconds > 0:
-        raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
-    if not args.baseline_seconds >= 0:
-        raise ValueError(f"--baseline-seconds must be a number >= 0, got {args.baseline_seconds}")
+    check_overwrites(files={"--out": args.out}, dirs={"--out-dir": args.out_dir}, force=args.force)
+    for name, what in READ_BY.items():
+        if getattr(args, name) not in (None, False) and args.what != what:
+            # an option the benchmark never reads would leave a record that seems to say it was used
+            raise ValueError(f"--{name.replace('_', '-')} is read by `bench {what}` only, not by `bench {args.what}`")
+    for name, value in DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
+    if args.what == "gpu":
+        check_gpu_options(args)
+    if args.what == "env":
+        at_least("--frames", args.frames, 1, "the number of sensor frames to time")
+        at_least("--steps", args.steps, 1, "the number of env steps to time")
+        try:
+            get_scene(args.layout)
+        except ValueError as err:
+            raise ValueError(f"--layout: {err}") from None
 
     def measure() -> dict:
         if args.what == "env":
@@ -52,3 +74,18 @@ def run(args) -> None:
     else:
         for key, value in result.items():
             print(f"{key:>28}: {value}")
+
+
+def check_gpu_options(args) -> None:
+    if not args.out_dir:
+        raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
+    if not args.seconds > 0:
+        raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
+    if not args.baseline_seconds >= 0:
+        raise ValueError(f"--baseline-seconds must be a number >= 0, got {args.baseline_seconds}")
+    if not torch.cuda.is_available():
+        # on the CPU it would time the paper profile there, record cuda_graph True, and could replace
+        # the stored GPU record with the numbers of a machine that has none
+        built = f"built with CUDA {torch.version.cuda}" if torch.version.cuda else "a CPU-only build"
+        raise ValueError(f"bench gpu needs a CUDA GPU, and torch {torch.__version__} ({built}) sees none on this "
+                         "machine; `bench learner` times the learners on the CPU")

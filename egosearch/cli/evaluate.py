@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from egosearch.cli.acting import policy_factory, set_acting_threads
-from egosearch.core.outputs import check_outputs
+from egosearch.cli.acting import check_threads, policy_factory, set_acting_threads
+from egosearch.cli.checks import check_seed, check_suffix
+from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.runs.evaluate import evaluate, write_episodes
 from egosearch.runs.metrics import spl
 from egosearch.runs.trace import TraceRecorder
@@ -13,16 +14,18 @@ from egosearch.sim.scenarios import read_scenarios
 
 def run(args) -> None:
     check_outputs(files={"--out": args.out, "--traces": args.traces})
-    set_acting_threads(args.threads)
+    check_overwrites(files={"--out": args.out, "--traces": args.traces},
+                     inputs={"--scenarios": args.scenarios, "--weights": args.weights}, force=args.force)
+    check_suffix("--traces", args.traces, (".npz",), "a trace file")
+    check_seed("--seed", args.seed)
+    check_threads(args.threads)
     if args.env_id and args.env_id not in ENV_IDS:
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
-    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id)
+    set_acting_threads(args.threads)
+    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,
+                                           out=args.out)
     scenarios = read_scenarios(args.scenarios)
-    recorder = None
-    if args.traces:
-        if not args.traces.endswith(".npz"):
-            raise ValueError(f"--traces={args.traces!r}: a trace file must end in .npz")
-        recorder = TraceRecorder()
+    recorder = TraceRecorder() if args.traces else None
     rows = evaluate(env_id, make_policy, scenarios, seed=args.seed, progress=True,
                     desc=f"evaluate {args.policy} on {env_id}", recorder=recorder)
     write_episodes(args.out, rows)
@@ -32,3 +35,4 @@ def run(args) -> None:
     value = spl([r["success"] for r in rows], [r["shortest_path"] for r in rows],
                 [r["path_length"] for r in rows])
     print(f"{args.policy}: success {rate:.3f}  SPL {value:.3f}  over {len(rows)} episodes -> {args.out}")
+

@@ -6,13 +6,25 @@ body lives in ``egosearch/cli/<command>.py``, imported only when that command ru
 
 from __future__ import annotations
 
-from egosearch.scene.layouts import LAYOUT_NAMES
+from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
 from egosearch.sim.agent import EVAL_HEIGHTS, HEIGHT_RANGE
 
-LAYOUTS = f"{', '.join(LAYOUT_NAMES)} or home<seed> (a generated home)"
+LAYOUTS = (f"{', '.join(LAYOUT_NAMES)} (the paper's homes), {', '.join(EASY_LAYOUTS)} (a small home for tests) "
+           "or home<seed> (a generated home)")
 THREADS = "torch threads for acting (default 1; 0: all cores)"
-POLICY_SEED = "seed of the random policy and of the env's per-step noise (default 0)"
+MAX_SCENARIOS = 10_000
+"""Most scenarios in one set: about 4 minutes at the ~40 scenarios/s of a paper home (a Table 1 cell has 200)."""
+MAX_HOMES = 1_000
+"""Most generated homes in one set (each is built once: about a second)."""
+POLICY_SEED = "seed of the random policy and of the env's per-step noise, >= 0 (default 0)"
+FORCE = ("overwrite stored results (files git tracks under results/ or paper_figs/): the DAG's own jobs pass it; "
+         "without it such a file is refused")
+LEARNERS = "the profile's learner (SAC-DrQ at cpu, SAC+CURL at smoke and paper)"
+
+
+def add_force(p) -> None:
+    p.add_argument("--force", action="store_true", help=FORCE)
 
 
 def add_scenarios(sub) -> None:
@@ -23,12 +35,15 @@ def add_scenarios(sub) -> None:
     p.add_argument("--height", type=float, default=1.65,
                    help=f"camera height (m): any value in [{HEIGHT_RANGE[0]}, {HEIGHT_RANGE[1]}] is a valid "
                         f"experiment; Table 1 uses {', '.join(f'{h:g}' for h in EVAL_HEIGHTS)} (default 1.65)")
-    p.add_argument("--n", type=int, default=100, help="number of scenarios (per home with --homes; default 100)")
+    p.add_argument("--n", type=int, default=100,
+                   help=f"number of scenarios, 1 to {MAX_SCENARIOS} (per home with --homes; default 100)")
     p.add_argument("--homes", default=None, metavar="FIRST:STOP",
                    help="instead of --layout: generated homes home<FIRST> ... home<STOP-1>, --n scenarios each, "
-                        "in one set (the generalisation benchmark's groups)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the set: the same seed gives the same rows")
+                        f"in one set (the generalisation benchmark's groups); at most {MAX_HOMES} homes and "
+                        f"{MAX_SCENARIOS} scenarios in all")
+    p.add_argument("--seed", type=int, default=0, help="seed of the set, >= 0: the same seed gives the same rows")
     p.add_argument("--out", required=True, help="the scenario CSV to write")
+    add_force(p)
 
 
 def add_evaluate(sub) -> None:
@@ -37,7 +52,7 @@ def add_evaluate(sub) -> None:
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
                                                      "target), random, or frontier / frontier_head_off (the "
                                                      "classical searcher, head moving or fixed)")
-    p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor)")
+    p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier, "
                                     "EgoSearchNoHead-v0 for frontier_head_off")
     p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
@@ -46,20 +61,23 @@ def add_evaluate(sub) -> None:
                                                         "what the camera's centre looks at, distances) to this "
                                                         "compressed file (egosearch.runs.trace)")
     p.add_argument("--threads", type=int, default=1, help=THREADS)
+    add_force(p)
 
 
 def add_train(sub) -> None:
-    p = sub.add_parser("train", help="train a variant's search policy with SAC+CURL (resumable)")
+    about = f"train a variant's search policy with {LEARNERS} (resumable)"
+    p = sub.add_parser("train", help=about, description=about)
     p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...)")
     p.add_argument("--profile", default="cpu", help="learner profile: smoke, cpu or paper (default: cpu)")
     p.add_argument("--seed", type=int, default=0, help="training seed (default 0)")
-    p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores)")
+    p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores; default 0)")
     p.add_argument("--out-dir", required=True, help="run folder: actor.pt, curve.csv, train.csv, checkpoint; "
                                                     "rerun with the same folder to resume")
     p.add_argument("--work-dir", help="train (and resume) here, and copy the files to --out-dir only once the run "
                                       "is complete (the DAG does: a killed job never leaves a partial output)")
     p.add_argument("--max-wall-s", type=float, help="stop after this many seconds with a checkpoint written (inside "
                                                     "a cluster's time limit); the same command resumes it")
+    add_force(p)
 
 
 def add_variant(sub) -> None:
@@ -83,38 +101,43 @@ def add_fullbody(sub) -> None:
                    help="the planner: actor (with --weights), or oracle (privileged: knows the target) or random")
     p.add_argument("--weights", help="actor.pt of the search policy (for --policy actor)")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
-    p.add_argument("--limit", type=int, default=0, help="use the first N scenarios (0: all)")
-    p.add_argument("--T", type=int, default=20, help="planning horizon (default 20)")
+    p.add_argument("--limit", type=int, default=0, help="use the first N scenarios, N >= 0 (0: all)")
+    p.add_argument("--T", type=int, default=20, help="planning horizon, >= 1 and >= M (default 20)")
     p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
     p.add_argument("--out", required=True, help="the per-episode CSV to write")
     p.add_argument("--threads", type=int, default=1, help=THREADS)
+    add_force(p)
 
 
 def add_bench(sub) -> None:
-    p = sub.add_parser("bench", help="speed benchmarks: env (sensor + physics), homes (building one) or learner")
+    about = "speed benchmarks: env (sensor + physics), homes (building one), learner or gpu (needs CUDA)"
+    p = sub.add_parser("bench", help=about, description=about)
     p.add_argument("what", choices=("env", "homes", "learner", "gpu"),
                    help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
-                        "against a training episode; learner: SAC+CURL updates/s; gpu: the learner benchmarks and "
-                        "a paper-profile training of --seconds on this machine's GPU (results/paper/gpu_check)")
-    p.add_argument("--layout", default="kitchen_living", help=f"env: the home ({LAYOUTS})")
-    p.add_argument("--frames", type=int, default=3000, help="env: sensor frames to time (default 3000)")
-    p.add_argument("--steps", type=int, default=3000, help="env: env steps to time (default 3000)")
-    p.add_argument("--seconds", type=float, default=150.0, help="gpu: the training's wall time (default 150)")
+                        f"against a training episode; learner: updates/s of {LEARNERS}, and of SAC+CURL at Table "
+                        "2's sizes; gpu (needs CUDA): the learner benchmarks and a paper-profile training of "
+                        "--seconds on this machine's GPU (results/paper/gpu_check)")
+    p.add_argument("--layout", help=f"env: the home ({LAYOUTS}; default kitchen_living)")
+    p.add_argument("--frames", type=int, help="env: sensor frames to time, >= 1 (default 3000)")
+    p.add_argument("--steps", type=int, help="env: env steps to time, >= 1 (default 3000)")
+    p.add_argument("--seconds", type=float, help="gpu: the training's wall time, > 0 (default 150)")
     p.add_argument("--out-dir", help="gpu: the training's folder (curve.csv, train.csv, config.json, checkpoint)")
     p.add_argument("--cuda-graph", action="store_true",
                    help="gpu: train with the update recorded as CUDA graphs (learner.cuda_graph=true, which the "
                         "paper profile sets anyway)")
-    p.add_argument("--baseline-seconds", type=float, default=0.0,
+    p.add_argument("--baseline-seconds", type=float,
                    help="gpu: also train this long with the update launched eagerly (cuda_graph false; in "
-                        "<out-dir>/baseline), for the ratio on one machine")
+                        "<out-dir>/baseline), for the ratio on one machine; default 0: none")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
                                  "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")
+    add_force(p)
 
 
 def add_video(sub) -> None:
     p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
-    p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch")
+    p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch "
+                                                                 "(default humanoid_phase)")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--scenario-id", type=int, default=0, help="the scenario_id of the row to search (default 0)")
     p.add_argument("--first-success", metavar="FULLBODY_CSV",
@@ -122,24 +145,26 @@ def add_video(sub) -> None:
                         "settings with no penetrating pose, in at least --min-steps steps (instead of --scenario-id, "
                         "which is filmed when none did)")
     p.add_argument("--min-steps", type=int, default=0,
-                   help="--first-success: the fewest steps of a filmed episode (default 0)")
+                   help="--first-success: the fewest steps of a filmed episode, >= 0 (default 0)")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle or random")
-    p.add_argument("--weights", help="actor.pt of the search policy")
-    p.add_argument("--M", type=int, default=5, help="steps executed per plan")
-    p.add_argument("--T", type=int, default=20, help="planning horizon")
+    p.add_argument("--weights", help="actor.pt of the search policy (for --policy actor only)")
+    p.add_argument("--M", type=int, default=5, help="steps executed per plan, 1 to T (default 5)")
+    p.add_argument("--T", type=int, default=20, help="planning horizon, >= 1 (default 20)")
     p.add_argument("--seed", type=int, default=0,
-                   help="scenario k's episode is seeded with this + k, as `egosearch fullbody` seeds it (default 0)")
-    p.add_argument("--out", required=True, help=".mp4 or .gif")
-    p.add_argument("--still", required=True, help=".png of the moment the target is found")
+                   help="scenario k's episode is seeded with this + k, as `egosearch fullbody` seeds it (>= 0; "
+                        "default 0)")
+    p.add_argument("--out", required=True, help="the video: a .mp4 or .gif file")
+    p.add_argument("--still", required=True, help="a .png of the moment the target is found")
     p.add_argument("--threads", type=int, default=1, help=THREADS)
-
+    add_force(p)
 
 
 def add_pictures(sub) -> None:
     p = sub.add_parser("pictures", help="top-down map, placement examples, first/third-person frame")
     p.add_argument("--layout", default="kitchen_living", help=f"home: {LAYOUTS}")
     p.add_argument("--out-dir", default="paper_figs/world", help="folder of the PNGs (default: paper_figs/world)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the placement examples (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the placement examples, >= 0 (default 0)")
+    add_force(p)
 
 
 def add_report(sub) -> None:
@@ -156,28 +181,33 @@ def add_report(sub) -> None:
     r.add_argument("--variant", help="the variant of the files (default: read from their paths)")
     r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the random searcher and the oracle "
                                                "(.../eval/{random,oracle}/...): rows that bound the policy")
+    add_force(r)
 
     r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")
     r.add_argument("--profile", **profile)
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md and .tex"))
+    add_force(r)
 
     r = reports.add_parser("fig6", help="Figure 6 (success vs env steps) from training curves")
     r.add_argument("files", nargs="+", help="curve.csv files: .../train/{variant}/seed{seed}/curve.csv")
     r.add_argument("--random", nargs="*", help="evaluation CSVs of the random searcher: its level, dashed")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+    add_force(r)
 
     r = reports.add_parser("fig7", help="Figure 7 (SPL and attempts per method) from full-body CSVs")
     r.add_argument("files", nargs="+", help="full-body CSVs: .../{setting}/seed{seed}.csv")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
     r.add_argument("--planner", default="actor", choices=("actor", "oracle"),
                    help="which planner drove the full-body runs (oracle figures say so in a title)")
+    add_force(r)
 
     r = reports.add_parser("budget", help="the budget study: success at one cell vs env steps and core-hours")
     r.add_argument("--run", action="append", required=True, metavar="SETTING=CURVE_CSV:EVAL_CSV",
                    help="one training run of a setting: its curve.csv and its per-episode CSV at the cell "
                         "(repeat per seed and setting)")
-    r.add_argument("--chosen", help="the setting the profile uses (drawn filled)")
+    r.add_argument("--chosen", help="the setting the profile uses (drawn filled): one of the --run settings")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
+    add_force(r)
 
     r = reports.add_parser("compare", help="a candidate variant vs the reference: difference, 95%% CI, p per cell "
                                            "and per shortest-path bin")
@@ -185,6 +215,7 @@ def add_report(sub) -> None:
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
     r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
                                  "pooled, to <out stem>_by_length.csv) as well as printing them")
+    add_force(r)
 
     r = reports.add_parser("pathlength", help="success by shortest path ℓ and by detour, with two-level intervals")
     r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{home}/"
@@ -195,18 +226,21 @@ def add_report(sub) -> None:
                                                "(.../eval/{random,frontier,oracle}/...): a line each")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .png and .pdf"))
     r.add_argument("--out-csv", help="the numbers (default: <out-prefix>.csv)")
+    add_force(r)
 
     r = reports.add_parser("generalise", help="trained-on x evaluated-on: normalised scores per group of homes")
     r.add_argument("files", nargs="+", help="evaluation CSVs of the policies: .../{variant}/seed{seed}/{group}/"
                                             "{placement}/h{height}.csv")
     r.add_argument("--bounds", nargs="+", required=True, help="the random searcher's and the oracle's evaluation "
                                                               "CSVs on the same groups")
-    r.add_argument("--generated", help="the variant trained in generated homes (its gap to its training split)")
+    r.add_argument("--generated", help="the variant trained in generated homes (its gap to its training split); "
+                                       "one of the files' variants")
     r.add_argument("--reference", help="the variant trained in the paper homes: the generated-homes variant's "
-                                       "score there is read against it")
+                                       "score there is read against it (one of the files' variants; needs --generated)")
     r.add_argument("--trained-on", nargs="*", default=[], metavar="VARIANT=HOMES",
-                   help="what each variant trained in, for the labels")
+                   help="what each of the files' variants trained in, for the labels")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md and .png"))
+    add_force(r)
 
     r = reports.add_parser("fresh", help="the reference on its stored scenario sets against fresh sets of the same "
                                          "cells: is a gain tuned to the stored sets?")
@@ -214,29 +248,37 @@ def add_report(sub) -> None:
                                                               "seed{seed}/{home}/{placement}/h{height}.csv")
     r.add_argument("--fresh", nargs="+", required=True, help="the same actors' evaluation CSVs on the fresh sets")
     r.add_argument("--variant", default="head_on", help="the variant, for the caption (default: head_on)")
-    r.add_argument("--fresh-seed", type=int, help="the fresh sets' scenario seed, for the caption")
-    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv and .md"))
+    r.add_argument("--fresh-seed", type=int, help="the fresh sets' scenario seed (>= 0), for the caption")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv and .md") + "; no dot in its name")
+    add_force(r)
 
     traces = "trace files of `egosearch evaluate --traces`: .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
+
     r = reports.add_parser("behaviour", help="how the policies search, from per-step traces, and the paper's "
                                              "behaviour sentences (Section 6.3, Figure 6) read against them")
     r.add_argument("files", nargs="+", help=traces)
-    r.add_argument("--head-on", default="head_on", help="the variant that moves its head (default: head_on)")
-    r.add_argument("--head-off", default="head_off", help="the variant without head movement (default: head_off)")
+    r.add_argument("--head-on", default="head_on", help="the variant that moves its head, one of the files' "
+                                                        "(default: head_on)")
+    r.add_argument("--head-off", default="head_off", help="the variant without head movement, another of the "
+                                                          "files' (default: head_off)")
     r.add_argument("--out-prefix", required=True,
                    help=prefix.format("_episodes.csv, .csv, .md, _claims.csv and _claims.md"))
+    add_force(r)
 
     r = reports.add_parser("searches", help="top-down pictures of chosen searches and a gaze heatmap per cell, "
                                             "from per-step traces")
     r.add_argument("files", nargs="+", help=traces)
-    r.add_argument("--seed", type=int, default=0, help="the seed whose files give the pictured searches (default 0)")
+    r.add_argument("--seed", type=int, default=0, help="the seed whose files give the pictured searches: one of "
+                                                        "the files' seeds (default 0)")
     r.add_argument("--out-dir", required=True, help="folder of the PNGs")
+    add_force(r)
 
     r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
     r.add_argument("--profile", **profile)
     r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
     r.add_argument("--out", required=True, help="the provenance JSON to write")
     r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
+    add_force(r)
 
     r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a profile (seconds)")
     r.add_argument("--profile", **profile)

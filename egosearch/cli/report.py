@@ -6,33 +6,228 @@ One report per function; :data:`REPORTS` maps each ``REPORT`` name to it.
 
 from __future__ import annotations
 
+import contextlib
+import io
+import os
+import re
 import sys
 from pathlib import Path
 
-from egosearch.core.outputs import check_outputs
+from egosearch.cli.checks import at_least, check_npz_files, check_text_files
+from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report import cli as report
-from egosearch.report.behaviour import behaviour_report
+from egosearch.report.behaviour import behaviour_report, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
+from egosearch.report.data import parse_eval_path
 from egosearch.report.fresh import fresh_report
 from egosearch.report.generalise import generalise_report
+from egosearch.report.pathlength import by_length_path
 from egosearch.report.provenance import check_stored, verify, write_provenance
 from egosearch.report.readme import pages, update_pages, update_readme
 from egosearch.report.searches import searches_report
 from egosearch.report.workflow_jobs import bound_eval_files, variants_of_all, workflow_config, workflow_heights
 from egosearch.rl.config import departure_rows, load_config, table2_rows
+from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 
 
 def run(args) -> None:
     check_report_outputs(args)
+    check_report_inputs(args)
     REPORTS[args.what](args)
+
+
+PREFIX_FILES = {"table1": ("table1", (".csv", ".md", ".tex")), "table2": ("table2", (".md", ".tex")),
+                "fig6": ("fig6", (".png", ".pdf", ".csv")), "fig7": ("fig7", (".png", ".pdf", ".csv")),
+                "budget": ("budget", (".csv", ".png", ".pdf")), "pathlength": ("pathlength", (".md", ".png", ".pdf")),
+                "generalise": ("generalise", (".csv", ".md", ".png")), "fresh": ("fresh", (".csv", ".md")),
+                "behaviour": ("behaviour", ("_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md"))}
+"""Per report with ``--out-prefix``: the name it takes in a folder given as the prefix, and what it
+adds to the prefix for each file it writes (as the report modules name them)."""
+
+
+def prefix_files(what: str, out_prefix: str, out_csv: str | None = None) -> list[Path]:
+    """The files ``egosearch report <what> --out-prefix <out_prefix>`` writes (pathlength's numbers
+    only when ``out_csv``, its ``--out-csv``, does not take them elsewhere)."""
+    default, endings = PREFIX_FILES[what]
+    path = Path(out_prefix)
+    base = path / default if (out_prefix.endswith(("/", os.sep)) or path.is_dir()) else path
+    if what == "fresh":  # fresh names its files with with_suffix, which replaces a dotted tail
+        return [base.with_suffix(ending) for ending in endings]
+    files = [base.with_name(base.name + ending) for ending in endings]
+    if what == "pathlength" and not out_csv:
+        files.append(base.with_name(base.name + ".csv"))
+    return files
+
+
+def report_inputs(args) -> dict[str, list[str]]:
+    """``{option: the files it names}`` of the reports that read files."""
+    if args.what == "budget":
+        return {"--run": [f for spec in args.run for f in spec.partition("=")[2].split(":") if f]}
+    names = {"files": "the input files", "bounds": "--bounds", "random": "--random", "reference": "--reference",
+             "candidate": "--candidate", "scenarios": "--scenarios", "stored": "--stored", "fresh": "--fresh"}
+    out = {}
+    for name, option in names.items():
+        value = getattr(args, name, None)
+        if isinstance(value, list):
+            out[option] = value
+    return out
 
 
 def check_report_outputs(args) -> None:
     """Every path a report writes, checked before it reads anything."""
+    out_prefix = getattr(args, "out_prefix", None)
     check_outputs(files={"--out": getattr(args, "out", None), "--out-csv": getattr(args, "out_csv", None),
                          "--readme": None if args.what != "readme" or args.check else args.readme},
                   dirs={"--out-dir": getattr(args, "out_dir", None)},
-                  prefixes={"--out-prefix": getattr(args, "out_prefix", None)})
+                  prefixes={"--out-prefix": out_prefix})
+    if args.what in ("regenerate", "readme", "verify"):
+        # regenerate and readme rewrite the stored tables, figures and pages by design: they are the DAG's
+        # jobs run by hand (regenerate writes what `snakemake all` would), so no stored file is refused
+        return
+    out = getattr(args, "out", None)
+    files = {"--out": [out, by_length_path(out)] if args.what == "compare" and out else out}
+    if args.what == "pathlength" and args.out_csv:
+        files["--out-csv"] = args.out_csv
+    written = [] if out_prefix is None else prefix_files(args.what, out_prefix, getattr(args, "out_csv", None))
+    check_overwrites(files=files, prefixes={"--out-prefix": (out_prefix, written)},
+                     dirs={"--out-dir": getattr(args, "out_dir", None)}, inputs=report_inputs(args),
+                     force=args.force)
+
+
+def check_report_inputs(args) -> None:
+    """The input files are files of their kind, and every option names something they hold: a report
+    otherwise fails half-way with pandas' or numpy's words, or draws an empty row without a word."""
+    if args.what in ("behaviour", "searches"):
+        check_npz_files("the input files", args.files)
+    else:
+        for option, paths in report_inputs(args).items():
+            check_text_files(option, paths)
+    INPUT_CHECKS.get(args.what, lambda _: None)(args)
+
+
+def _variants(paths: list[str], parse) -> list[str]:
+    return list(dict.fromkeys(parse(path)["variant"] for path in paths))
+
+
+def _check_generalise(args) -> None:
+    variants = _variants(args.files, parse_eval_path)
+    shown = ", ".join(variants)
+    for item in args.trained_on:
+        variant, sep, homes = item.partition("=")
+        if not (sep and variant and homes):
+            raise ValueError(f"--trained-on {item!r}: expected VARIANT=HOMES (e.g. head_on=paper_homes)")
+        if variant not in variants:
+            raise ValueError(f"--trained-on {item!r}: {variant!r} is none of the files' variants ({shown})")
+    for option, value in (("--generated", args.generated), ("--reference", args.reference)):
+        if value is not None and value not in variants:
+            raise ValueError(f"{option}={value!r} is none of the files' variants ({shown}): its rows would be "
+                             "left out without a word")
+    if args.reference is not None and args.generated is None:
+        raise ValueError("--reference is read only with --generated (the variant read against it)")
+
+
+def _check_behaviour(args) -> None:
+    variants = _variants(args.files, parse_trace_path)
+    if args.head_on == args.head_off:
+        raise ValueError(f"--head-on and --head-off are both {args.head_on!r}: the claims compare two variants")
+    for option, value in (("--head-on", args.head_on), ("--head-off", args.head_off)):
+        if value not in variants:
+            raise ValueError(f"{option}={value!r} has no trace file among the files (their variants: "
+                             f"{', '.join(variants)})")
+
+
+def _check_searches(args) -> None:
+    at_least("--seed", args.seed, 0, "a seed")
+    where = [parse_trace_path(path) for path in args.files]
+    seeds = sorted({w["seed"] for w in where})
+    if args.seed not in seeds:
+        raise ValueError(f"--seed={args.seed}: no trace file of seed {args.seed} among the files (their seeds: "
+                         f"{', '.join(map(str, seeds))}), so no search would be pictured")
+    for path, w in zip(args.files, where, strict=True):
+        if not (w["layout"] in (*LAYOUT_NAMES, *EASY_LAYOUTS) or re.fullmatch(r"home\d+", w["layout"])):
+            raise ValueError(f"{path}: the home {w['layout']!r} of its path is unknown; allowed: "
+                             f"{', '.join((*LAYOUT_NAMES, *EASY_LAYOUTS))} or home<seed>")
+
+
+def _check_fresh(args) -> None:
+    at_least("--fresh-seed", args.fresh_seed, 0, "a scenario seed")
+    stored = {Path(p).resolve(): p for p in args.stored}
+    both = [p for p in args.fresh if Path(p).resolve() in stored]
+    if both:
+        raise ValueError(f"{both[0]} is both a --stored and a --fresh file: the check reads evaluations on two "
+                         "different scenario sets")
+    written = prefix_files("fresh", args.out_prefix)
+    wanted = Path(args.out_prefix)
+    if written[0].parent == wanted.parent and written[0].stem != wanted.name:
+        raise ValueError(f"--out-prefix={args.out_prefix}: fresh would write {written[0]} (it replaces what "
+                         "follows a dot in the name); use a prefix without a dot in its name")
+
+
+def _check_budget(args) -> None:
+    settings, seen = [], set()
+    for spec in args.run:
+        setting, sep, files = spec.partition("=")
+        curve, sep2, evals = files.partition(":")
+        if not (sep and sep2 and setting and curve and evals):
+            raise ValueError(f"--run {spec!r}: expected SETTING=CURVE_CSV:EVAL_CSV")
+        key = (Path(curve).resolve(), Path(evals).resolve())
+        if key in seen:
+            raise ValueError(f"--run {spec!r}: that run is given twice; each --run is one seed's run")
+        seen.add(key)
+        settings.append(setting)
+    if args.chosen is not None and args.chosen not in settings:
+        raise ValueError(f"--chosen={args.chosen!r} is none of the --run settings "
+                         f"({', '.join(dict.fromkeys(settings))})")
+
+
+def _check_compare(args) -> None:
+    """A candidate whose actors trained at another learner profile than the reference's (a smoke run
+    in a cpu results folder) is refused: its rows would read as a worse variant. The profile is read
+    from each actor's ``config.json``, found beside the evaluation as the DAG lays them out."""
+    sides = {option: actor_profiles(files) for option, files in (("--reference", args.reference),
+                                                                 ("--candidate", args.candidate))}
+    for file, (profile, config) in sides["--candidate"].items():
+        reference = {p for p, _ in sides["--reference"].values()} - {profile}
+        if reference:
+            raise ValueError(f"--candidate: {file} was evaluated from an actor trained at the {profile} learner "
+                             f"profile ({config}), the reference's at {', '.join(sorted(reference))}: compare "
+                             "variants trained at one profile")
+
+
+def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
+    """``{evaluation file: (its actor's learner profile, the actor's config.json)}`` for the files
+    whose actor's run folder, ``<results>/train/<variant>/seed<N>/``, is there to tell it."""
+    # local: reading a run's profile loads the variants layer (gymnasium's registry)
+    import json
+
+    from egosearch.cli.checks import learner_profile_of
+
+    out, known = {}, {}
+    for file in files:
+        try:
+            where = parse_eval_path(file)
+        except ValueError:
+            continue
+        parts = Path(file).parts
+        if len(parts) < 7 or parts[-6] != "eval":
+            continue
+        config = Path(*parts[:-6], "train", where["variant"], f"seed{where['seed']}", "config.json")
+        if config not in known:
+            try:
+                record = json.loads(config.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                known[config] = None
+            else:
+                profile, _ = (learner_profile_of(record["config"], record.get("variant"))
+                              if isinstance(record, dict) and isinstance(record.get("config"), dict) else (None, ""))
+                known[config] = profile
+        if known[config] is not None:
+            out[file] = (known[config], config)
+    return out
+
+
+INPUT_CHECKS = {"generalise": _check_generalise, "behaviour": _check_behaviour, "searches": _check_searches,
+                "fresh": _check_fresh, "budget": _check_budget, "compare": _check_compare}
 
 
 def curves_by_variant(paths: list[str]) -> dict[str, list[str]]:
@@ -100,8 +295,27 @@ def _pathlength(args) -> None:
 
 
 def _compare(args) -> None:
-    report.cmd_compare(args.reference, args.candidate, args.out, reference_name="reference",
-                       candidate_name="candidate")
+    if args.out is None:
+        report.cmd_compare(args.reference, args.candidate, None, reference_name="reference",
+                           candidate_name="candidate")
+        return
+    # The comparison writes its CSV before the ℓ split checks that both sides ran the same scenarios:
+    # both go to temporary files, moved into place only when every check passed, and what it prints
+    # waits with them, so that a refused comparison is one line and leaves no file.
+    out, by_length = Path(args.out), by_length_path(args.out)
+    tmp = out.with_name(f".tmp{os.getpid()}.{out.name}")
+    tmp_by_length = by_length_path(tmp)
+    printed = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(printed):
+            report.cmd_compare(args.reference, args.candidate, tmp, reference_name="reference",
+                               candidate_name="candidate")
+        os.replace(tmp, out)
+        os.replace(tmp_by_length, by_length)
+    finally:
+        for path in (tmp, tmp_by_length):
+            path.unlink(missing_ok=True)
+    print(printed.getvalue().replace(str(tmp_by_length), str(by_length)).replace(str(tmp), str(out)), end="")
 
 
 def _behaviour(args) -> None:

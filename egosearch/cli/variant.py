@@ -3,15 +3,24 @@
 from __future__ import annotations
 
 from egosearch.core.outputs import check_outputs
-from egosearch.variants import ABLATIONS_DIR, check_learner_config, load_variant, new_variant
+from egosearch.rl.config import PROFILES
+from egosearch.variants import ABLATIONS_DIR, VariantError, check_learner_config, load_variant, new_variant
 
 
 def run(args) -> None:
     if args.what == "new":
         check_outputs(dirs={"the variants folder": ABLATIONS_DIR})
+        try:
+            load_variant(args.template)
+        except VariantError as err:
+            raise ValueError(f"--from: {err}") from None
         path = new_variant(args.name, template=args.template)
         print(f"wrote {path}: edit it, then `snakemake --cores 2 compare --config variant={args.name}`")
         return
+    for profile in args.profile:
+        # else the profile's error reads as a fault of the first variant file
+        if profile not in PROFILES:
+            raise ValueError(f"--profile={profile!r}; allowed: {', '.join(PROFILES)}")
     for name in args.names:
         variant = load_variant(name)
         for profile in args.profile:

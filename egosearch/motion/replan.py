@@ -107,6 +107,17 @@ def parse_setting(setting: str) -> tuple[str, int | None, str]:
     return method, m, mg
 
 
+def check_plan(method: Method, M: int | None, T: int) -> int:
+    """``M`` (the method's default when None), once it and ``T`` are known to make a plan."""
+    if M is None:
+        M = method.default_M or DEFAULT_M
+    if M < 1 or T < 1:
+        raise ValueError(f"M={M} and T={T} must be >= 1")
+    if method.kind == "replan" and M > T:
+        raise ValueError(f"M={M} > T={T}: Algorithm 1 executes a prefix of the plan")
+    return M
+
+
 def make_motion_generator(name: str, world=None) -> MotionGenerator:
     if name not in MOTION_GENERATORS:
         raise ValueError(f"motion generator {name!r} is unknown; allowed: {', '.join(MOTION_GENERATORS)}")
@@ -205,12 +216,7 @@ def run_fullbody_episode(env, policy, mg: MotionGenerator, scenario: Scenario, T
     abstract ``state`` set from it, ``visible``, the ``plan`` it came from and the ``obs`` the policy
     got there), the start first."""
     meth = get_method(method) if isinstance(method, str) else method
-    if M is None:
-        M = meth.default_M or DEFAULT_M
-    if M < 1 or T < 1:
-        raise ValueError(f"M={M} and T={T} must be >= 1")
-    if meth.kind == "replan" and M > T:
-        raise ValueError(f"M={M} > T={T}: Algorithm 1 executes a prefix of the plan")
+    M = check_plan(meth, M, T)
     u = env.unwrapped
     env.reset(seed=seed, options={"scenario": scenario})
     if meth.noisy:
@@ -283,6 +289,7 @@ def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], metho
     """``make_policy(env)`` realised by motion generator ``mg_name`` with ``method`` on every scenario.
     ``M=None`` takes the method's default (the one-step baselines execute their whole line)."""
     meth = get_method(method)
+    check_plan(meth, M, T)  # before the first episode, not in it
     if mg_name not in MOTION_GENERATORS:
         raise ValueError(f"motion generator {mg_name!r} is unknown; allowed: {', '.join(MOTION_GENERATORS)}")
     rows, env, key, policy, mg, counter = [], None, None, None, None, None

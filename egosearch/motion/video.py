@@ -251,6 +251,10 @@ def write_gif(path: Path, frames: list[np.ndarray], max_bytes: int = GIF_MAX_BYT
     return k
 
 
+VIDEO_SUFFIXES = (".mp4", ".gif")
+"""The formats :func:`write_search_video` writes a film in."""
+
+
 def write_search_video(layout: str, character: str, policy, scenario, out_path: str | os.PathLike,
                        still_path: str | os.PathLike | None = None, method: str = "ours", M: int = 5,
                        T: int = 20, seed: int = 0, env_id: str = "EgoSearch-v0",
@@ -271,6 +275,11 @@ def write_search_video(layout: str, character: str, policy, scenario, out_path: 
 
     if character not in CHARACTERS:
         raise ValueError(f"character={character!r}; allowed: {', '.join(CHARACTERS)}")
+    # imageio picks its writer by the suffix, and fails on an unknown one only after the search ran
+    if not os.fspath(out_path).lower().endswith(VIDEO_SUFFIXES):
+        raise ValueError(f"{os.fspath(out_path)}: a video is written as {' or '.join(VIDEO_SUFFIXES)}")
+    if still_path is not None and not os.fspath(still_path).lower().endswith(".png"):
+        raise ValueError(f"{os.fspath(still_path)}: the still is written as .png")
     if scenario.layout != layout:
         raise ValueError(f"scenario {scenario.scenario_id} is in {scenario.layout!r}, not {layout!r}")
     env = make_env(env_id, scenario)

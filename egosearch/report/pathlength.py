@@ -315,8 +315,8 @@ def compare_by_length(reference_files: Mapping | Iterable[PathLike], candidate_f
     Each side: ``{cell: [paths]}`` (as ``compare_report`` takes) or a flat list of one variant's evaluation
     CSVs. A scenario is ``(scenario set, id)``, so cells and homes stay apart inside a bin. Per bin
     :func:`~egosearch.report.stats.compare_cells` on the bin's scenarios: seed-averaged difference, paired
-    two-level bootstrap interval (the bin's scenarios, then each side's seeds), sign-flip p-value; Holm
-    over this table's rows. Bins without scenarios are left out. Columns :data:`BY_LENGTH_COLUMNS`;
+    two-level bootstrap interval (the bin's scenarios, then each side's seeds) and the p-value read from
+    the same draws; Holm over this table's rows. Bins without scenarios are left out. Columns :data:`BY_LENGTH_COLUMNS`;
     written to ``out_csv`` when given. ValueError when the two sides disagree on a scenario's ℓ."""
     ref, cand = _pooled(reference_files), _pooled(candidate_files)
     keys = ["scenario_set", "scenario_id"]

@@ -84,6 +84,11 @@ def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+def _machine_words(m: dict) -> str:
+    return (f"{m.get('cpu') or '?'}" + (f" ({m['vector_unit']})" if m.get("vector_unit") else "")
+            + f", {m.get('cores') or '?'} cores")
+
+
 def block_provenance(root: Path, profile: str) -> str:
     path = root / "results" / profile / "provenance.json"
     if not path.exists():
@@ -97,22 +102,42 @@ def block_provenance(root: Path, profile: str) -> str:
     for job in record["jobs"]:
         summed[job_study(job, config)] += job_cost_s(job)
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
-             f"{record['date_utc'][:16].replace('T', ' ')} UTC; {machine.get('cpu', '?')}"
-             + (f" ({machine['vector_unit']})" if machine.get("vector_unit") else "") + ", "
-             f"{machine.get('cores', '?')} cores, torch {machine.get('torch', '?')}.",
+             f"{record['date_utc'][:16].replace('T', ' ')} UTC on {_machine_words(machine)}, "
+             f"torch {machine.get('torch', '?')}.",
              f"- {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed: "
-             + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + ".",
-             # Every cpu-profile job is one thread, so `--cores N` runs N at a time: the summed
-             # time over N is what `snakemake --cores N all` takes from a fresh clone, give or take
-             # the tail where fewer than N jobs are ready.
-             f"- Estimated wall time of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed "
-             f"time / {cores}, one-thread jobs, each at its CPU time where recorded, on the machine that ran it, "
-             "a resumed training's scaled to its whole run): "
-             f"{summed['all'] / cores / 3600:.2f} h"
-             + (f"; of `snakemake --cores {cores} generalise` after it: {summed['generalise'] / cores / 3600:.2f} h"
-                if summed["generalise"] > 0 else "")
-             + (f"; the other {summed['other'] / 3600:.2f} h of jobs are comparisons and studies outside both "
-                "(compare, budget, fresh, the traces)." if summed["other"] > 0 else ".")]
+             + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + "."]
+    machines = record.get("machines")
+    if machines:
+        known = [m for m in machines if m.get("cpu")]
+        unknown = sum(m["jobs"] for m in machines if not m.get("cpu"))
+        lines.append("- The jobs ran on: " + "; ".join(
+            f"{_machine_words(m)} ({m['jobs']} jobs, {m['wall_s'] / 3600:.1f} h)" for m in known)
+            + (f"; {unknown} jobs name no machine (recorded before jobs did)" if unknown else "") + ".")
+    estimate_path = root / "results" / profile / "bench" / "estimate_all.json"
+    if estimate_path.exists():
+        e = json.loads(estimate_path.read_text(encoding="utf-8"))
+        rates = sorted(e.get("recorded_training_rates", {}).values())
+        lines.append(
+            f"- `snakemake --cores {e['cores']} all` from a fresh clone, its DAG's schedule simulated on "
+            f"{e['cores']} cores (`egosearch estimate all`): **{e['hours_as_recorded']:.1f} h** as the stored run "
+            "recorded each job"
+            + (f"; {e['hours_at_slowest_recorded_rate']:.1f} h with every training at the slowest recorded rate "
+               f"({e['slowest_recorded_rate']:.0f} env steps per CPU-second; the stored trainings ran at "
+               f"{rates[0]:.0f} to {rates[-1]:.0f})" if e.get("hours_at_slowest_recorded_rate") else "")
+            + (f"; {e['hours_here']:.1f} h on a machine whose learner benchmark gives {e['bench_rate']:.0f} "
+               f"({e['rate_source']})" if e.get("hours_here") else "")
+            + f". The jobs' CPU time / {e['cores']}, the lower bound this page used to give: "
+            f"{e['hours_cpu_over_cores']:.1f} h. `egosearch estimate all --cores N` calibrates for your machine "
+            f"in a minute (from `{estimate_path.relative_to(root)}`).")
+    else:
+        lines.append(
+            f"- Lower bound of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed CPU time / "
+            f"{cores}, as if they packed perfectly): {summed['all'] / cores / 3600:.2f} h; "
+            f"`egosearch estimate all --cores {cores}` simulates the schedule.")
+    if summed["generalise"] > 0 or summed["other"] > 0:
+        lines.append(f"- Outside `all`: `snakemake --cores {cores} generalise` {summed['generalise'] / 3600:.2f} h of "
+                     f"job CPU time; comparisons and studies (compare, budget, fresh, the traces) "
+                     f"{summed['other'] / 3600:.2f} h.")
     if record.get("note"):
         lines.append(f"- Note kept in the record: {record['note']}")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
@@ -150,7 +175,14 @@ def block_compare(root: Path, profile: str) -> str:
         candidate, reference = path.stem.split("_vs_", 1)
         df = pd.read_csv(path)
         where = f" in {', '.join(sorted(set(df['homes'])))}" if "homes" in df.columns else ""
-        lines = [f"`{candidate}` vs `{reference}`{where} (difference = {candidate} - {reference}; from "
+        seeds = ""
+        if {"n_seeds_ref", "n_seeds_cand"} <= set(df.columns):
+            n_cand, n_ref = int(df["n_seeds_cand"].max()), int(df["n_seeds_ref"].max())
+            seeds = f"; {n_cand} seeds each" if n_cand == n_ref else f"; {n_cand} seed(s) against {n_ref}"
+            if n_cand == n_ref == 1:
+                seeds = ("; one seed each, so the interval and p resample the scenarios only and do not count how "
+                         "much another training seed would differ")
+        lines = [f"`{candidate}` vs `{reference}`{where} (difference = {candidate} - {reference}{seeds}; from "
                  f"`{path.relative_to(root)}`):", "",
                  "| height | placement | metric | reference | candidate | difference (95% CI) | p (one cell) "
                  "| p (Holm) |",
@@ -164,7 +196,8 @@ def block_compare(root: Path, profile: str) -> str:
             lines += ["", by_length]
         parts.append("\n".join(lines) + "\n")
     note = ("\\* Holm-adjusted p < 0.05 (over every row of its file). CI: paired two-level bootstrap (scenarios, "
-            "then seeds); p (one cell): paired sign-flip test over scenarios, uncorrected.")
+            "then each side's seeds); p (one cell): the same bootstrap's draws read as a two-sided test, uncorrected "
+            "(p < 0.05 exactly when the 95% CI excludes 0; Holm only raises p, so a starred row's CI excludes 0).")
     return "\n".join(parts) + "\n" + note + "\n"
 
 
@@ -182,9 +215,12 @@ def block_power(root: Path, profile: str) -> str:
         lo, hi = int(succ["n_scenarios"].min()), int(succ["n_scenarios"].max())
         homes = ", ".join(sorted(set(succ["homes"])))
         smallest, largest = _fmt(succ["detectable_80"].min()), _fmt(succ["detectable_80"].max())
+        one_seed = (succ["n_seeds_ref"] == 1).all() and (succ["n_seeds_cand"] == 1).all()
         lines.append(f"- `{path.stem}`: {lo if lo == hi else f'{lo}–{hi}'} scenarios per cell ({homes}); a success "
                      f"difference of {smallest if smallest == largest else f'{smallest}–{largest}'} is "
-                     f"detected with 80% power (`{path.relative_to(root)}`).")
+                     "detected with 80% power"
+                     + (" by the scenarios alone (one seed a side: another seed's difference is not counted)"
+                        if one_seed else "") + f" (`{path.relative_to(root)}`).")
     return "\n".join(lines) + "\n" if lines else "*No stored comparison yet.*\n"
 
 

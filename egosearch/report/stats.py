@@ -6,7 +6,9 @@
   a bootstrap that resamples scenarios, then seeds, so that the scenario is the unit that repeats;
 - :func:`bootstrap_ci`: bootstrap interval of a statistic over a few per-seed values.
 - :func:`compare_cells`: candidate vs reference on one evaluation cell (same scenarios), paired
-  by scenario: difference, two-level paired bootstrap CI and sign-flip permutation p-value.
+  by scenario: difference, and the two-level paired bootstrap's interval and p-value, both read
+  from one set of resampled differences (:func:`percentile_p_value`), so that p < 0.05 exactly
+  when the 95% interval excludes 0.
 
 Why not a Wilson interval over every episode of a cell: 3 seeds x 100 scenarios are not 300
 independent trials. A scenario that is hard for one seed is hard for the others, so the pooled
@@ -132,11 +134,12 @@ def two_level_ci(m: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_
     return mean, float(lo), float(hi)
 
 
-def paired_two_level_ci(ref: np.ndarray, cand: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_000,
-                        seed: int = 0) -> tuple[float, float]:
-    """Interval of mean(cand) - mean(ref) over the same scenarios (rows), each side with its own seeds
-    (columns): one draw of scenarios serves both sides (the pairing), the seeds are drawn per side
-    (they are different training runs)."""
+def paired_two_level_draws(ref: np.ndarray, cand: np.ndarray, n_resamples: int = 10_000,
+                           seed: int = 0) -> np.ndarray:
+    """``n_resamples`` bootstrap draws of mean(cand) - mean(ref) over the same scenarios (rows), each side
+    with its own seeds (columns): one draw of scenarios serves both sides (the pairing), the seeds are
+    drawn per side (they are different training runs). A side with one seed has no seed level: its
+    draws resample the scenarios only."""
     ref, cand = np.asarray(ref, float), np.asarray(cand, float)
     if ref.shape[0] != cand.shape[0]:
         raise ValueError("paired_two_level_ci: the two sides have different numbers of scenarios")
@@ -149,9 +152,45 @@ def paired_two_level_ci(ref: np.ndarray, cand: np.ndarray, confidence: float = 0
         rows = rng.integers(0, n_s, (b, n_s))
         diffs[start:start + b] = (_two_level_means(cand, rows, rng.integers(0, cand.shape[1], (b, cand.shape[1])))
                                   - _two_level_means(ref, rows, rng.integers(0, ref.shape[1], (b, ref.shape[1]))))
-    alpha = (1 - confidence) / 2
-    lo, hi = np.quantile(diffs, [alpha, 1 - alpha])
-    return float(lo), float(hi)
+    return diffs
+
+
+def paired_two_level_ci(ref: np.ndarray, cand: np.ndarray, confidence: float = 0.95, n_resamples: int = 10_000,
+                        seed: int = 0) -> tuple[float, float]:
+    """Percentile interval of :func:`paired_two_level_draws`."""
+    return quantile_interval(paired_two_level_draws(ref, cand, n_resamples, seed), confidence)
+
+
+def _zero_crossing(x: np.ndarray) -> float:
+    """For sorted ``x``: the largest ``a`` in [0, 1] with ``np.quantile(x, a) <= 0`` (linear interpolation,
+    numpy's default); 0 when even the smallest draw is above 0."""
+    n = x.size
+    k = int(np.searchsorted(x, 0.0, side="right"))  # draws <= 0
+    if k == 0:
+        return 0.0
+    if k == n or n == 1:
+        return 1.0
+    t = (k - 1) + (-x[k - 1]) / (x[k] - x[k - 1])  # where the interpolated quantile crosses 0
+    return min(1.0, t / (n - 1))
+
+
+def percentile_p_value(draws: np.ndarray) -> float:
+    """Two-sided bootstrap p-value of "the difference is 0" read from the same draws as the percentile
+    interval: the smallest ``alpha`` at which the central ``1 - alpha`` percentile interval of
+    :func:`quantile_interval` excludes 0.
+
+    So p < 0.05 exactly when the 95% interval excludes 0, and p is about twice the share of draws on
+    the far side of 0 (``2 * min(share <= 0, share >= 0)``, capped at 1). This is the test that a
+    percentile interval implies (Efron & Tibshirani 1993, *An Introduction to the Bootstrap*, §15.4
+    on the relation of tests to confidence intervals, and ch. 16 on bootstrap tests). It is floored at
+    one draw's share, ``1 / len(draws)``: fewer draws than that on the far side are not resolved
+    (with 20 draws or fewer the floor is 0.05 or more and the equivalence at 0.05 fails). ``nan`` without a
+    finite draw."""
+    x = np.sort(np.asarray(draws, float)[np.isfinite(draws)])
+    if x.size == 0:
+        return math.nan
+    p = min(1.0, 2 * _zero_crossing(x), 2 * _zero_crossing(-x[::-1]))
+    return float(max(p, 1.0 / x.size))
 
 
 def shared_seed_difference_ci(stored: np.ndarray, fresh: np.ndarray, confidence: float = 0.95,
@@ -181,11 +220,19 @@ def shared_seed_difference_ci(stored: np.ndarray, fresh: np.ndarray, confidence:
 def detectable_difference(sd_paired: float, n_scenarios: int, alpha: float = 0.05, power: float = 0.8) -> float:
     """Smallest true mean difference a paired two-sided test at level ``alpha`` detects with probability
     ``power`` over ``n_scenarios`` scenarios whose seed-averaged paired differences have standard
-    deviation ``sd_paired``: ``(z_{1-alpha/2} + z_power) * sd / sqrt(n)`` (normal approximation)."""
+    deviation ``sd_paired``: ``(z_{1-alpha/2} + z_power) * sd / sqrt(n)`` (normal approximation).
+    It counts the scenarios' spread only; :func:`detectable_from_se` takes a standard error that
+    counts the seeds too."""
     if n_scenarios < 1:
         raise ValueError(f"n_scenarios={n_scenarios}: must be >= 1")
+    return detectable_from_se(sd_paired / math.sqrt(n_scenarios), alpha, power)
+
+
+def detectable_from_se(standard_error: float, alpha: float = 0.05, power: float = 0.8) -> float:
+    """Smallest true difference a two-sided test at level ``alpha`` whose estimate has this standard
+    error detects with probability ``power``: ``(z_{1-alpha/2} + z_power) * se`` (normal approximation)."""
     z = stats.norm.ppf(1 - alpha / 2) + stats.norm.ppf(power)
-    return float(z * sd_paired / math.sqrt(n_scenarios))
+    return float(z * standard_error)
 
 
 def _per_scenario(df: pd.DataFrame, metric: str, side: str) -> tuple[pd.Series, int]:
@@ -209,27 +256,36 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     ``scenario_set``, which file the scenario came from; see ``data.read_episodes``). Both sides
     must cover exactly the same scenarios (ValueError otherwise).
 
-    Method (the scenario is the unit that repeats):
+    Method (the scenario is the unit that repeats, and each side's seeds are its training runs):
 
     1. per side and scenario ``s``, average the metric over the seeds that side has for ``s``:
        ``r_s``, ``c_s``; ``reference = mean_s r_s``, ``candidate = mean_s c_s`` (equal to the pooled
        episode mean when every seed covers every scenario); ``difference = mean_s (c_s - r_s)``.
-    2. CI: a two-level paired bootstrap (:func:`paired_two_level_ci`): resample the scenarios with
-       replacement (one draw for both sides: the pairing), then each side's seeds with replacement
-       (different training runs), and take the difference of the means; percentile interval,
-       ``rng=default_rng(seed)``. Where a side's seeds do not all cover every scenario, the seeds are
-       averaged per scenario first and only the scenarios are resampled. All-equal differences give
-       the point interval ``(d, d)``.
-    3. p-value: two-sided paired permutation (sign-flip) test over scenarios on the seed-averaged
-       differences: under H0 the labels reference/candidate are exchangeable within a scenario, so
-       each ``d_s`` keeps or flips its sign at random; statistic = mean ``d_s``;
-       ``scipy.stats.permutation_test`` with ``permutation_type="samples"``, ``n_resamples`` random
-       flips (exact enumeration when ``2**n_scenarios <= n_resamples``), ``rng=default_rng(seed)``.
-       Identical sides give p = 1. It is per cell and UNCORRECTED; ``compare_report`` adds Holm's
-       adjustment over every row, and only that decides significance.
+    2. Draws: a two-level paired bootstrap (:func:`paired_two_level_draws`, ``n_resamples`` draws,
+       ``rng=default_rng(seed)``): resample the scenarios with replacement (one draw for both sides:
+       the pairing), then each side's seeds with replacement (different training runs), and take the
+       difference of the means (Davison & Hinkley 1997, *Bootstrap Methods and their Application*,
+       §3.8 on resampling hierarchical data; Agarwal et al. 2021, "Deep reinforcement learning at the
+       edge of the statistical precipice", on resampling runs and tasks). A side with ONE seed has no
+       seed level: a one-seed-against-one-seed screen resamples the scenarios only, and its interval
+       and p do not count how much another training seed would differ. Where a side's seeds do not all
+       cover every scenario, the seeds are averaged per scenario first and only the scenarios are
+       resampled.
+    3. CI: the percentile interval of the draws (:func:`quantile_interval`).
+    4. p-value: :func:`percentile_p_value` of the SAME draws: the smallest level at which their
+       percentile interval excludes 0 (two-sided; about twice the share of draws on the far side of
+       0). So p < 0.05 exactly when the 95% interval excludes 0, and a difference that the seeds do
+       not agree on is not called significant because the scenarios do (the sign-flip test over
+       seed-averaged scenarios that this replaces did). It is per cell and UNCORRECTED;
+       ``compare_report`` adds Holm's adjustment over every row, and only that decides significance
+       (Holm only raises p, so a Holm-significant row's interval always excludes 0).
 
-    4. ``detectable_80``: the difference this cell could detect, :func:`detectable_difference` of the
-       seed-averaged paired differences' SD over its scenarios (80% power, p < 0.05 uncorrected).
+       Draws that are all equal (no variation at either level, e.g. identical sides with one seed)
+       give the point interval ``(d, d)`` and p = 1 when d = 0. With fewer than 2 scenarios there is
+       nothing to resample at the scenario level: interval ``(nan, nan)``, p = 1.
+    5. ``detectable_80``: the difference this cell's test detects with 80% power at p < 0.05
+       uncorrected, from the draws' standard deviation (:func:`detectable_from_se`; normal
+       approximation), so that it counts the seeds' spread as the test does.
 
     Returns ``{reference, candidate, difference, ci_low, ci_high, p_uncorrected, n_scenarios,
     n_seeds_ref, n_seeds_cand, detectable_80}``.
@@ -247,26 +303,28 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     r, c = ref.to_numpy(), cand.to_numpy()
     d = c - r
     diff = float(d.mean())
-    if d.size < 2 or np.all(d == d[0]):
-        lo = hi = diff
+    if d.size < 2:
+        lo = hi = detectable = math.nan
+        p = 1.0
     else:
         try:
             ref_m, _ = scenario_seed_matrix(reference, metric)
             cand_m, _ = scenario_seed_matrix(candidate, metric)
         except ValueError:  # a seed lacks a scenario: resample the seed-averaged scenarios only
             ref_m, cand_m = r[:, None], c[:, None]
-        lo, hi = paired_two_level_ci(ref_m, cand_m, confidence, n_resamples, seed)
-    if np.all(d == 0):
-        p = 1.0
-    else:
-        perm = stats.permutation_test((c, r), lambda x, y, axis: np.mean(x - y, axis=axis),
-                                      permutation_type="samples", vectorized=True, n_resamples=n_resamples,
-                                      alternative="two-sided", rng=np.random.default_rng(seed))
-        p = float(min(1.0, perm.pvalue))
+        draws = paired_two_level_draws(ref_m, cand_m, n_resamples, seed)
+        # Means of equal values can differ from the value by an ulp; such draws carry no spread.
+        if np.ptp(draws) <= 1e-12 * max(1.0, abs(diff)):
+            lo = hi = diff
+            p = 1.0 if diff == 0 else percentile_p_value(np.full(draws.size, diff))
+            detectable = 0.0
+        else:
+            lo, hi = quantile_interval(draws, confidence)
+            p = percentile_p_value(draws)
+            detectable = detectable_from_se(float(draws.std(ddof=1)))
     return {"reference": float(r.mean()), "candidate": float(c.mean()), "difference": diff,
             "ci_low": lo, "ci_high": hi, "p_uncorrected": p, "n_scenarios": int(d.size),
-            "n_seeds_ref": n_ref, "n_seeds_cand": n_cand,
-            "detectable_80": detectable_difference(float(d.std(ddof=1)), d.size) if d.size > 1 else math.nan}
+            "n_seeds_ref": n_ref, "n_seeds_cand": n_cand, "detectable_80": detectable}
 
 
 def holm(p_values) -> np.ndarray:

@@ -332,10 +332,12 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
 COMPARE_COLUMNS = ("height", "placement", "metric", "reference", "candidate", "difference", "ci_low", "ci_high",
                    "p_uncorrected", "p_holm", "significant_holm", "n_scenarios", "n_seeds_ref", "n_seeds_cand",
                    "detectable_80", "homes")
-"""``p_uncorrected`` is one cell's test alone; ``significant_holm`` is ``p_holm < 0.05``, Holm's adjustment
-over every row of the file: the only column that says whether a difference is significant.
-``detectable_80``: the true difference the cell would detect with 80% power (uncorrected); ``homes``: the
-homes whose scenarios the cell pools."""
+"""``p_uncorrected`` is one cell's test alone, read from the same two-level bootstrap draws as ``ci_low`` /
+``ci_high`` (below 0.05 exactly when that interval excludes 0); ``significant_holm`` is ``p_holm < 0.05``,
+Holm's adjustment over every row of the file: the only column that says whether a difference is
+significant (never true while the interval holds 0, since Holm only raises p). ``detectable_80``: the
+true difference the cell's test would detect with 80% power (uncorrected), seeds counted; ``homes``:
+the homes whose scenarios the cell pools."""
 
 
 def _cell_name(cell) -> str:
@@ -402,6 +404,6 @@ def format_compare(df: pd.DataFrame, reference_name: str = "reference", candidat
                      f"{r.p_holm:>7.4f}{star} "
                      f"{r.n_scenarios:>4d} {r.n_seeds_ref:>2d}/{r.n_seeds_cand:<2d}")
     lines.append("* Holm-adjusted p < 0.05 over all rows (p_unc: one cell's test alone). diff = candidate - "
-                 "reference; CI: paired two-level bootstrap (scenarios, then seeds); p: paired sign-flip "
-                 "permutation test over scenarios.")
+                 "reference; CI: paired two-level bootstrap (scenarios, then each side's seeds); p: the same "
+                 "draws read as a two-sided test (p < 0.05 exactly when the 95% CI excludes 0).")
     return "\n".join(lines)

@@ -28,6 +28,7 @@ from egosearch.scene.objects import TARGET_OBJECTS, get_object, target_part
 from egosearch.scene.parts import Part, Scene
 from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
 from egosearch.sim.agent import AgentSpec, check_height
+from egosearch.sim.navgrid import DEFAULT_RESOLUTION as NAVGRID_RESOLUTION
 from egosearch.sim.navgrid import NavGrid
 
 SUCCESS_DISTANCE = 0.5
@@ -94,9 +95,20 @@ def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
     path = Path(path)
     if not path.exists():
         raise ScenarioFileError(f"{path}: no such scenario file")
-    with open(path, newline="") as f:
+    try:
+        return _read_scenarios(path)
+    except UnicodeDecodeError as err:
+        raise ScenarioFileError(f"{path}: not a text CSV file (byte 0x{err.object[err.start]:02x} is not UTF-8 "
+                                "text); a scenario file is written by `egosearch scenarios`") from None
+
+
+def _read_scenarios(path: Path) -> list[Scenario]:
+    with open(path, newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
         header = reader.fieldnames or []
+        if not header:
+            raise ScenarioFileError(f"{path}: empty file; a scenario CSV starts with the header line "
+                                    f"{','.join(COLUMNS)}")
         missing = [c for c in COLUMNS if c not in header]
         if missing:
             raise ScenarioFileError(f"{path}: missing columns {', '.join(missing)}; "
@@ -128,6 +140,12 @@ def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
             if values["shortest_path"] < 0:
                 raise ScenarioFileError(f"{path}:{line}: shortest_path={values['shortest_path']!r} is negative; "
                                         "it is the length (m) of the shortest route to a success, >= 0")
+            floor = _straight_line_bound(values)
+            if values["shortest_path"] < floor:
+                # an edited ℓ scores every success of the row against a route no body can walk
+                raise ScenarioFileError(f"{path}:{line}: shortest_path={values['shortest_path']!r} is shorter than "
+                                        f"the straight line from the start to where the target is within reach "
+                                        f"({floor:.2f} m); ℓ is >= that")
             if values["scenario_id"] in first_line:
                 raise ScenarioFileError(f"{path}:{line}: scenario_id={values['scenario_id']} repeats the id of line "
                                         f"{first_line[values['scenario_id']]}; every scenario of a file needs its "
@@ -148,6 +166,18 @@ def _check_in_home(values: dict, scene: Scene) -> None:
         if not (x0 <= x <= x1 and y0 <= y <= y1):
             raise ValueError(f"{what} ({x:g}, {y:g}) is outside the home {values['layout']}, whose floor spans "
                              f"x in [{x0:g}, {x1:g}], y in [{y0:g}, {y1:g}] m")
+    if not 0 <= values["target_z"] <= scene.wall_height:
+        raise ValueError(f"target_z={values['target_z']:g} is outside the home {values['layout']}, whose height "
+                         f"range is [0, {scene.wall_height:g}] m (target_z: the height of the surface it rests on)")
+
+
+def _straight_line_bound(values: dict) -> float:
+    """The shortest ℓ a row may hold: the straight line from the start to the target, less the reach
+    of a success (:data:`SUCCESS_DISTANCE` from the body's surface) and the grid's two half cells
+    (ℓ is measured from the start's cell to cells within reach: see :func:`shortest_path_region`)."""
+    reach = SUCCESS_DISTANCE + AgentSpec().body_radius + NAVGRID_RESOLUTION * math.sqrt(2)
+    straight = math.hypot(values["target_x"] - values["start_x"], values["target_y"] - values["start_y"])
+    return max(0.0, straight - reach)
 
 
 # -- generation ----------------------------------------------------------------------------

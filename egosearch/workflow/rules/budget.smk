@@ -18,4 +18,5 @@ rule budget:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report budget {params.runs} --chosen {params.chosen} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report budget --force {params.runs} --chosen {params.chosen} --out-prefix {params.prefix} "
+        "> {log} 2>&1"

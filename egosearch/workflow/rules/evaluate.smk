@@ -16,7 +16,7 @@ rule evaluate:
     conda:
         CONDA_ENV
     shell:
-        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
+        "egosearch evaluate --force --policy actor --weights {input.actor} --scenarios {input.scenarios} "
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
@@ -44,5 +44,5 @@ rule bound:
     conda:
         CONDA_ENV
     shell:
-        "egosearch evaluate --policy {wildcards.bound} --scenarios {input.scenarios} "
+        "egosearch evaluate --force --policy {wildcards.bound} --scenarios {input.scenarios} "
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"

@@ -47,5 +47,5 @@ rule fresh:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fresh --stored {input.stored} --fresh {input.fresh} --variant {params.variant} "
+        "egosearch report fresh --force --stored {input.stored} --fresh {input.fresh} --variant {params.variant} "
         "--fresh-seed {params.seed} --out-prefix {params.prefix} > {log} 2>&1"

@@ -19,8 +19,9 @@ rule fullbody:
     conda:
         CONDA_ENV
     shell:
-        "egosearch fullbody --setting {wildcards.setting} --weights {input.actor} --scenarios {input.scenarios} "
-        "--limit {params.limit} --T {params.T} --seed {wildcards.seed} --out {output} > {log} 2>&1"
+        "egosearch fullbody --force --setting {wildcards.setting} --weights {input.actor} "
+        "--scenarios {input.scenarios} --limit {params.limit} --T {params.T} --seed {wildcards.seed} --out {output} "
+        "> {log} 2>&1"
 
 
 rule fullbody_oracle:
@@ -44,7 +45,7 @@ rule fullbody_oracle:
     conda:
         CONDA_ENV
     shell:
-        "egosearch fullbody --policy oracle --setting {wildcards.setting} --scenarios {input.scenarios} "
+        "egosearch fullbody --force --policy oracle --setting {wildcards.setting} --scenarios {input.scenarios} "
         "--limit {params.limit} --T {params.T} --seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
@@ -73,6 +74,6 @@ rule video:
     conda:
         CONDA_ENV
     shell:
-        "egosearch video --character humanoid_phase --scenarios {input.scenarios} --first-success {input.fullbody} "
-        "--min-steps 20 "
+        "egosearch video --force --character humanoid_phase --scenarios {input.scenarios} "
+        "--first-success {input.fullbody} --min-steps 20 "
         "--weights {input.actor} --M 5 --seed {params.seed} --out {output.gif} --still {output.still} > {log} 2>&1"

@@ -22,7 +22,7 @@ rule group_scenarios:
     conda:
         CONDA_ENV
     shell:
-        "egosearch scenarios --homes {params.homes} --placement {wildcards.placement} "
+        "egosearch scenarios --force --homes {params.homes} --placement {wildcards.placement} "
         "--height {wildcards.height} --n {params.n} --seed {params.seed} --out {output} > {log} 2>&1"
 
 
@@ -51,5 +51,5 @@ rule generalise:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report generalise {input.policies} --bounds {input.bounds} --generated {params.generated} "
+        "egosearch report generalise --force {input.policies} --bounds {input.bounds} --generated {params.generated} "
         "--reference {params.reference} --trained-on {params.trained_on} --out-prefix {params.prefix} > {log} 2>&1"

@@ -18,7 +18,7 @@ rule table1:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table1 {input.policy} --variant {params.variant} --bounds {input.bounds} "
+        "egosearch report table1 --force {input.policy} --variant {params.variant} --bounds {input.bounds} "
         "--out-prefix {params.prefix} > {log} 2>&1"
 
 
@@ -36,7 +36,7 @@ rule table2:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table2 --profile {params.learner} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report table2 --force --profile {params.learner} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule table2_paper:
@@ -52,7 +52,7 @@ rule table2_paper:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table2 --profile paper --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report table2 --force --profile paper --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig6:
@@ -72,7 +72,7 @@ rule fig6:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig6 {input.curves} --random {input.random} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report fig6 --force {input.curves} --random {input.random} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig7:
@@ -90,7 +90,7 @@ rule fig7:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig7 {input} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report fig7 --force {input} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig7_oracle:
@@ -108,7 +108,7 @@ rule fig7_oracle:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig7 {input} --out-prefix {params.prefix} --planner oracle > {log} 2>&1"
+        "egosearch report fig7 --force {input} --out-prefix {params.prefix} --planner oracle > {log} 2>&1"
 
 
 rule pathlength:
@@ -132,7 +132,7 @@ rule pathlength:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report pathlength {input.policy} --scenarios {input.scenarios} --bounds {input.bounds} "
+        "egosearch report pathlength --force {input.policy} --scenarios {input.scenarios} --bounds {input.bounds} "
         "--out-prefix {params.prefix} --out-csv {output.csv} > {log} 2>&1"
 
 
@@ -150,7 +150,7 @@ rule pictures:
     conda:
         CONDA_ENV
     shell:
-        "egosearch pictures --layout {params.layout} --out-dir {params.out_dir} > {log} 2>&1"
+        "egosearch pictures --force --layout {params.layout} --out-dir {params.out_dir} > {log} 2>&1"
 
 
 rule compare:
@@ -168,7 +168,7 @@ rule compare:
         CONDA_ENV
     shell:
         # writes {output.by_length} beside {output.cells} (egosearch.report.pathlength.by_length_path)
-        "egosearch report compare --reference {input.reference} --candidate {input.candidate} "
+        "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
         "--out {output.cells} 2>&1 | tee {log}"
 
 
@@ -198,4 +198,5 @@ rule provenance:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report provenance --profile {params.profile} --results {params.results} --out {output} > {log} 2>&1"
+        "egosearch report provenance --force --profile {params.profile} --results {params.results} --out {output} "
+        "> {log} 2>&1"

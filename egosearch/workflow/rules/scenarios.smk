@@ -18,5 +18,5 @@ rule scenarios:
     conda:
         CONDA_ENV
     shell:
-        "egosearch scenarios --layout {wildcards.layout} --placement {wildcards.placement} "
+        "egosearch scenarios --force --layout {wildcards.layout} --placement {wildcards.placement} "
         "--height {wildcards.height} --n {params.n} --seed {params.seed} --out {output} > {log} 2>&1"

@@ -34,7 +34,7 @@ rule trace:
     conda:
         CONDA_ENV
     shell:
-        "egosearch evaluate --policy actor --weights {input.actor} --scenarios {input.scenarios} "
+        "egosearch evaluate --force --policy actor --weights {input.actor} --scenarios {input.scenarios} "
         "--seed {wildcards.seed} --out {output.episodes} --traces {output.trace} > {log} 2>&1"
 
 
@@ -54,7 +54,7 @@ rule behaviour:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report behaviour {input} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report behaviour --force {input} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule searches:
@@ -73,4 +73,4 @@ rule searches:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report searches {input} --seed {params.seed} --out-dir {params.out_dir} > {log} 2>&1"
+        "egosearch report searches --force {input} --seed {params.seed} --out-dir {params.out_dir} > {log} 2>&1"

@@ -19,5 +19,5 @@ rule train:
     conda:
         CONDA_ENV
     shell:
-        "egosearch train --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
+        "egosearch train --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
         "--threads {threads} --work-dir {params.work_dir} --out-dir {params.out_dir} > {log} 2>&1"

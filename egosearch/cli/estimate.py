@@ -1,0 +1,180 @@
+"""``egosearch estimate all``: how long ``snakemake --cores N all`` takes from a fresh clone, on this
+machine, from the stored run's job times laid out on N cores (:mod:`egosearch.report.schedule`).
+
+The trainings dominate and their speed differs most between machines, so they are scaled to this
+machine: a minute of the learner benchmark (``egosearch bench learner``'s short real training) gives
+this machine's env steps per CPU-second, and the ratio between a stored training and the benchmark
+on the same kind of machine turns that into a training's rate. Every other job keeps the wall time
+the stored run recorded (evaluations and reports are a small share; the estimate says so).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import sys
+from pathlib import Path
+
+from egosearch.core.machine import cpu_model, cpu_vector_unit
+from egosearch.report.schedule import (
+    TRAIN,
+    durations_from_provenance,
+    env_steps_of,
+    machine_key,
+    scale_to_rate,
+    simulate,
+    training_rates,
+)
+from egosearch.report.workflow_jobs import job_cost_s
+from egosearch.workflow.dag import dag_jobs
+
+CALIBRATION_ENV_STEPS = 4000
+"""The calibration: a real cpu-profile training of this many env steps (what ``bench learner`` times)."""
+CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "egosearch" / "learner_rate.json"
+"""This machine's last calibration, so that ``snakemake all`` can print the estimate without a minute's wait."""
+
+
+def run(args) -> None:
+    if args.cores < 1:
+        raise ValueError(f"--cores={args.cores}: the estimate needs at least 1 core")
+    if args.rate is not None and not args.rate > 0:
+        raise ValueError(f"--rate={args.rate}: env steps per CPU-second must be a positive number")
+    results = Path("results") / args.profile
+    record_path = results / "provenance.json"
+    if not record_path.is_file():
+        raise FileNotFoundError(f"{record_path} not found: the estimate scales the stored run's job times "
+                                "(run it in the project's root, at a profile with a stored run)")
+    record = json.loads(record_path.read_text(encoding="utf-8"))
+    bench_path = Path(args.bench) if args.bench else results / "bench" / "learner.json"
+    rate, how = args.rate, "given"
+    if rate is None and args.from_bench:
+        bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
+        rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
+        if not rate:
+            raise FileNotFoundError(f"--from-bench: {bench_path} holds no learner benchmark "
+                                    "(egosearch bench learner --out writes one)")
+        how = f"recorded in {bench_path} on {machine_key(bench.get('machine'))}"
+    if rate is None:
+        print(f"calibrating: a {CALIBRATION_ENV_STEPS}-step cpu-profile training (about a minute) ...", flush=True)
+        rate, how = calibrate(), "measured now"
+    estimate = estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path)
+    for line in estimate["lines"]:
+        print(line)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(estimate, indent=1) + "\n", encoding="utf-8")
+        print(f"wrote {args.out}", file=sys.stderr)
+    if args.json:
+        print(json.dumps({k: v for k, v in estimate.items() if k != "lines"}))
+
+
+def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict) -> tuple[float, str] | None:
+    """A stored training's rate over the learner benchmark's, on the same kind of machine (CPU and
+    vector unit), and that machine; None when the record holds no training from the benchmark's machine."""
+    machine = bench.get("machine", {})
+    same = [rates[row["job"]] for row in record.get("jobs", [])
+            if row.get("rule") == TRAIN and row.get("job") in rates and row.get("machine")
+            and machine_key(row["machine"]) == machine_key(machine)]
+    bench_rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
+    if not same or not bench_rate:
+        return None
+    return statistics.median(same) / float(bench_rate), machine_key(machine)
+
+
+def calibrate() -> float:
+    """This machine's env steps per CPU-second in a short real cpu-profile training (~a minute),
+    remembered in :data:`CALIBRATION_CACHE` for this machine."""
+    # local: loads torch and the simulator, which an estimate from a given --rate never needs
+    from egosearch.rl.bench import training_throughput
+
+    rate = float(training_throughput("cpu", env_steps=CALIBRATION_ENV_STEPS)["env_steps_per_core_s"])
+    try:
+        CALIBRATION_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        CALIBRATION_CACHE.write_text(json.dumps({"machine": machine_key({"cpu": cpu_model(), "vector_unit":
+                                                 cpu_vector_unit(), "cores": os.cpu_count()}), "rate": rate}))
+    except OSError:
+        pass  # a read-only home: the next estimate calibrates again
+    return rate
+
+
+def cached_rate() -> float | None:
+    """This machine's last calibration (None when it has none, or it was another machine's)."""
+    try:
+        cached = json.loads(CALIBRATION_CACHE.read_text())
+    except (OSError, ValueError):
+        return None
+    here = machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
+    return float(cached["rate"]) if cached.get("machine") == here and cached.get("rate") else None
+
+
+def print_before_a_run(profile: str, cores: int) -> None:
+    """What ``snakemake ... all`` prints before its first job (the Snakefile's ``onstart``): the
+    estimate of the whole DAG from scratch, on this machine when it has been calibrated, else as the
+    stored run recorded it, with the command that calibrates. Never stops the run."""
+    record_path = Path("results") / profile / "provenance.json"
+    try:
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        rate = cached_rate()
+        lines = estimate_all(record, record_path.parent, cores, profile, rate=rate,
+                             rate_source="this machine's last calibration")["lines"][:-2]
+        if rate is None:
+            lines.append(f"  for this machine: egosearch estimate all --cores {cores} --profile {profile} (a minute)")
+    except (OSError, ValueError, RuntimeError, KeyError) as err:
+        lines = [f"(no estimate of the run's time: {err})"]
+    for line in lines:
+        print(line, file=sys.stderr)
+
+
+def _hours(seconds: float) -> str:
+    return f"{seconds / 3600:.1f} h"
+
+
+def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: float | None,
+                 rate_source: str = "given", bench: str | Path | None = None) -> dict:
+    """The simulated schedule of ``snakemake --cores <cores> all`` (fresh clone) as the stored run
+    recorded it, with every training at the slowest recorded rate, and on a machine whose learner
+    benchmark gives ``rate`` (left out when None). Returns the figures and the lines to print."""
+    jobs = dag_jobs("all", cores, config={"profile": profile})
+    stored = durations_from_provenance(record, jobs)
+    # every stored training's rate (lever screens too: one may share the benchmark's machine)
+    recorded_trainings = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+    all_rates = training_rates(record, env_steps_of(results, recorded_trainings))
+    rates = {j.job: all_rates[j.job] for j in jobs if j.record_rule == TRAIN and j.job in all_rates}
+    as_recorded = simulate(jobs, cores, stored)
+    slowest_rate = min(rates.values()) if rates else None
+    at_slowest = simulate(jobs, cores, scale_to_rate(stored, rates, slowest_rate)) if rates else None
+    in_dag = {(j.record_rule, j.job) for j in jobs}
+    cpu_over_cores = sum(job_cost_s(r) for r in record.get("jobs", []) if (r["rule"], r["job"]) in in_dag) / cores
+    bench_path = Path(bench) if bench else results / "bench" / "learner.json"
+    ratio = benchmark_ratio(record, all_rates, json.loads(bench_path.read_text())) if bench_path.is_file() else None
+    k = ratio[0] if ratio else 1.0
+    here = None
+    if rate is not None:
+        here = simulate(jobs, cores, scale_to_rate(stored, rates, k * rate)) if rates else as_recorded
+    lines = [
+        f"snakemake --cores {cores} all from a fresh clone, {profile} profile ({len(jobs)} jobs, simulated on "
+        f"{cores} cores with snakemake's greedy rule):"]
+    if here is not None:
+        lines += [
+            f"  on this machine: about {_hours(here.makespan)} (learner benchmark {rate:.0f} env steps per "
+            f"CPU-second, {rate_source}"
+            + (f"; a training runs at {k:.2f} x its benchmark, as on {ratio[1]} in the stored run" if ratio else
+               "; no stored training shares the benchmark record's machine: trainings taken at the benchmark's rate")
+            + ")",
+            "  slowest jobs here: " + ", ".join(f"{name} {_hours(s)}" for name, s in here.slowest(5))]
+    lines += [
+        f"  as the stored run recorded it: {_hours(as_recorded.makespan)}"
+        + (f"; every training at the slowest recorded rate ({slowest_rate:.0f} env steps per CPU-second): "
+           f"{_hours(at_slowest.makespan)}" if at_slowest else ""),
+        f"  (the old figure, CPU time / {cores}: {_hours(cpu_over_cores)}, assumes perfect packing and no waiting)",
+        "  " + stored.note() + " Only trainings are scaled to this machine.",
+    ]
+    return {"cores": cores, "profile": profile, "hours_here": here.makespan / 3600 if here else None,
+            "hours_as_recorded": as_recorded.makespan / 3600,
+            "hours_at_slowest_recorded_rate": at_slowest.makespan / 3600 if at_slowest else None,
+            "hours_cpu_over_cores": cpu_over_cores / 3600, "bench_rate": rate,
+            "training_over_bench": k, "slowest_recorded_rate": slowest_rate,
+            "slowest_jobs_here": here.slowest(5) if here else None, "rate_source": rate_source,
+            "recorded_training_rates": {job: round(r, 1) for job, r in sorted(rates.items())},
+            "note": stored.note(), "lines": lines}
