@@ -13,7 +13,8 @@ import sys
 
 from egosearch.cli import parsers
 
-COMMANDS = ("scenarios", "evaluate", "train", "variant", "fullbody", "bench", "video", "report", "pictures")
+COMMANDS = ("scenarios", "evaluate", "train", "variant", "fullbody", "bench", "estimate", "video", "report",
+            "pictures")
 """In the order ``egosearch --help`` lists them; each has ``parsers.add_<command>`` and a module."""
 
 

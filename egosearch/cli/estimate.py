@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 from egosearch.core.machine import cpu_model, cpu_vector_unit
+from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report.schedule import (
     TRAIN,
     durations_from_provenance,
@@ -40,6 +41,10 @@ def run(args) -> None:
         raise ValueError(f"--cores={args.cores}: the estimate needs at least 1 core")
     if args.rate is not None and not args.rate > 0:
         raise ValueError(f"--rate={args.rate}: env steps per CPU-second must be a positive number")
+    if args.rate is not None and args.from_bench:
+        raise ValueError("--rate and --from-bench both name the rate: give one")
+    check_outputs(files={"--out": args.out})
+    check_overwrites(files={"--out": args.out}, inputs={"--bench": args.bench}, force=args.force)
     results = Path("results") / args.profile
     record_path = results / "provenance.json"
     if not record_path.is_file():
@@ -47,18 +52,20 @@ def run(args) -> None:
                                 "(run it in the project's root, at a profile with a stored run)")
     record = json.loads(record_path.read_text(encoding="utf-8"))
     bench_path = Path(args.bench) if args.bench else results / "bench" / "learner.json"
-    rate, how = args.rate, "given"
+    rate, how, where = args.rate, "given", "on this machine"
     if rate is None and args.from_bench:
         bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
         rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
         if not rate:
             raise FileNotFoundError(f"--from-bench: {bench_path} holds no learner benchmark "
                                     "(egosearch bench learner --out writes one)")
-        how = f"recorded in {bench_path} on {machine_key(bench.get('machine'))}"
+        how = f"recorded in {bench_path}"
+        where = f"on {machine_key(bench.get('machine'))}"
     if rate is None:
         print(f"calibrating: a {CALIBRATION_ENV_STEPS}-step cpu-profile training (about a minute) ...", flush=True)
         rate, how = calibrate(), "measured now"
-    estimate = estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path)
+    estimate = estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path,
+                            where=where)
     for line in estimate["lines"]:
         print(line)
     if args.out:
@@ -131,7 +138,7 @@ def _hours(seconds: float) -> str:
 
 
 def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: float | None,
-                 rate_source: str = "given", bench: str | Path | None = None) -> dict:
+                 rate_source: str = "given", bench: str | Path | None = None, where: str = "on this machine") -> dict:
     """The simulated schedule of ``snakemake --cores <cores> all`` (fresh clone) as the stored run
     recorded it, with every training at the slowest recorded rate, and on a machine whose learner
     benchmark gives ``rate`` (left out when None). Returns the figures and the lines to print."""
@@ -157,7 +164,7 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
         f"{cores} cores with snakemake's greedy rule):"]
     if here is not None:
         lines += [
-            f"  on this machine: about {_hours(here.makespan)} (learner benchmark {rate:.0f} env steps per "
+            f"  {where}: about {_hours(here.makespan)} (learner benchmark {rate:.0f} env steps per "
             f"CPU-second, {rate_source}"
             + (f"; a training runs at {k:.2f} x its benchmark, as on {ratio[1]} in the stored run" if ratio else
                "; no stored training shares the benchmark record's machine: trainings taken at the benchmark's rate")
@@ -175,6 +182,6 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
             "hours_at_slowest_recorded_rate": at_slowest.makespan / 3600 if at_slowest else None,
             "hours_cpu_over_cores": cpu_over_cores / 3600, "bench_rate": rate,
             "training_over_bench": k, "slowest_recorded_rate": slowest_rate,
-            "slowest_jobs_here": here.slowest(5) if here else None, "rate_source": rate_source,
+            "slowest_jobs_here": here.slowest(5) if here else None, "rate_source": rate_source, "where": where,
             "recorded_training_rates": {job: round(r, 1) for job, r in sorted(rates.items())},
             "note": stored.note(), "lines": lines}

@@ -134,6 +134,27 @@ def add_bench(sub) -> None:
     add_force(p)
 
 
+def add_estimate(sub) -> None:
+    about = ("how long `snakemake --cores N all` takes from a fresh clone on this machine: the DAG's schedule "
+             "simulated from the stored run's job times, trainings scaled by a minute's calibration")
+    p = sub.add_parser("estimate", help=about, description=about)
+    p.add_argument("what", choices=("all",), help="all: the target `snakemake all` builds")
+    p.add_argument("--cores", type=int, default=2, help="the cores snakemake gets (--cores N; default 2)")
+    p.add_argument("--profile", default="cpu", choices=("cpu", "paper"),
+                   help="the profile whose stored run gives the job times (default cpu)")
+    p.add_argument("--rate", type=float, help="this machine's learner benchmark in env steps per CPU-second (what "
+                                              "`egosearch bench learner` prints as env_steps_per_core_s_cpu_profile): "
+                                              "skips the calibration")
+    p.add_argument("--from-bench", action="store_true",
+                   help="take the rate recorded in --bench instead of calibrating (the README's figure)")
+    p.add_argument("--bench", help="the learner benchmark record whose machine's ratio of a real training to the "
+                                   "benchmark is used (default results/<profile>/bench/learner.json)")
+    p.add_argument("--json", action="store_true", help="also print the figures as one JSON object")
+    p.add_argument("--out", help="also write the figures as JSON (results/cpu/bench/estimate_all.json is what the "
+                                 "README reads)")
+    add_force(p)
+
+
 def add_video(sub) -> None:
     p = sub.add_parser("video", help="a video of one full-body search: first-person depth + third-person view")
     p.add_argument("--character", default="humanoid_phase", help="humanoid_phase, humanoid_matching or fetch "
