@@ -52,6 +52,12 @@ onstart:
         from egosearch.cli.estimate import print_before_a_run
 
         print_before_a_run(PROFILE, workflow.cores)
+    for target in ("compare", "screen"):
+        if target in workflow.dag_settings.targets and config.get("variant"):
+            from egosearch.cli.estimate import print_variant_cost
+
+            seeds = SEEDS if target == "compare" else [config["screen_seed"]]
+            print_variant_cost(PROFILE, target, config["variant"], seeds, REF, workflow.cores)
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

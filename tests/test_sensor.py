@@ -441,3 +441,16 @@ def test_pyrender_pictures(furnished, scene_renderer):
     pic = depth_to_colormap(d, m)
     assert pic.shape == (100, 100, 3) and pic.dtype == np.uint8
     assert tuple(pic[0, 0]) == (230, 30, 30)
+
+
+def test_an_install_without_the_rasteriser_and_without_a_compiler_is_told_once(tmp_path, monkeypatch):
+    """pip shows a build's warning only under -v: the first egosearch command says it instead, once."""
+    from egosearch.sim import rasterbuild
+
+    marker = tmp_path / "noted"
+    monkeypatch.setattr(rasterbuild, "installed_library", lambda: None)
+    monkeypatch.setattr(rasterbuild, "find_compiler", lambda: None)
+    assert rasterbuild.notice_once(marker) == rasterbuild.NOT_BUILT and marker.exists()
+    assert rasterbuild.notice_once(marker) is None
+    monkeypatch.setattr(rasterbuild, "find_compiler", lambda: "/usr/bin/cc")  # compiles on first use: nothing to say
+    assert rasterbuild.notice_once(tmp_path / "other") is None

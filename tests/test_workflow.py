@@ -200,3 +200,14 @@ def test_a_stored_comparison_gives_no_missing_input_line():
     assert result.returncode == 0, result.stderr
     # other rules' lines (a budget setting not trained yet) are not this test's business
     assert "compare: its outputs are stored" not in result.stderr + result.stdout
+
+
+def test_a_screen_compares_one_seed_against_the_references_same_seed():
+    """`snakemake screen --config variant=NAME`: the lever screen as one command, on screen_seed only."""
+    out = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seed=1"])
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    assert "results/smoke/compare/screen_head_off_seed1_vs_head_on_seed1.csv" in text
+    assert "eval/head_off/seed1/" in text and "eval/head_on/seed1/" in text and "/seed0/" not in text
+    missing = run(["-n", "screen", "--config", "profile=smoke"])
+    assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr

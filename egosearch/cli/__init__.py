@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
+from pathlib import Path
 
 from egosearch.cli import parsers
+from egosearch.sim import rasterbuild
 
 COMMANDS = ("scenarios", "evaluate", "train", "variant", "fullbody", "bench", "estimate", "video", "report",
             "pictures")
@@ -26,8 +29,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+NOTICE_MARKER = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "egosearch" / "raster-noted"
+"""Remembers that this machine was told its install has no C rasteriser (said once, by the first command)."""
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    notice = rasterbuild.notice_once(NOTICE_MARKER)
+    if notice:
+        print(notice, file=sys.stderr)
     try:
         # local: a command's module loads what it runs (torch, the simulator), so `--help` and the
         # report commands start in a fraction of a second

@@ -11,6 +11,7 @@ the stored run recorded (evaluations and reports are a small share; the estimate
 from __future__ import annotations
 
 import json
+import math
 import os
 import statistics
 import sys
@@ -27,7 +28,7 @@ from egosearch.report.schedule import (
     simulate,
     training_rates,
 )
-from egosearch.report.workflow_jobs import job_cost_s
+from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
 from egosearch.workflow.dag import dag_jobs
 
 CALIBRATION_ENV_STEPS = 4000
@@ -185,3 +186,41 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
             "slowest_jobs_here": here.slowest(5) if here else None, "rate_source": rate_source, "where": where,
             "recorded_training_rates": {job: round(r, 1) for job, r in sorted(rates.items())},
             "note": stored.note(), "lines": lines}
+
+
+def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int], reference: str,
+                       cores: int) -> None:
+    """What ``snakemake compare``/``screen`` prints before its first job: the trainings and evaluations
+    of ``variant`` it still has to run (their files are missing), each at this machine's rate (its last
+    calibration, else the stored learner benchmark's machine, said which), and the wall time on
+    ``cores`` cores (one-thread jobs side by side). Never stops the run."""
+    # local: the variants layer loads gymnasium's registry; only a comparison's start reads a variant
+    from egosearch.variants import resolve_variant
+
+    results = Path("results") / profile
+    try:
+        record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
+        bench_path = results / "bench" / "learner.json"
+        bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
+        recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+        ratio = benchmark_ratio(record, training_rates(record, env_steps_of(results, recorded)), bench)
+        rate, where = cached_rate(), "this machine (its last calibration)"
+        if rate is None:
+            rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
+            where = f"{machine_key(bench.get('machine'))} (the stored learner benchmark; `egosearch estimate all` " \
+                    "calibrates this machine)"
+        steps = resolve_variant(variant, profile if profile != "smoke" else "smoke").config.total_env_steps
+        trainings = [s for s in seeds if not (results / "train" / variant / f"seed{s}" / "done.json").exists()]
+        evals = [r["wall_s"] for r in record.get("jobs", []) if r.get("rule") == "eval"]
+        per_eval = statistics.median(evals) if evals else 0.0
+        config = workflow_config()
+        n_evals = sum(not (results / "eval" / variant / f"seed{s}" / home / placement / f"h{height}.csv").exists()
+                      for s in seeds for home in config["homes"] for placement in config["placements"]
+                      for height in workflow_heights(config))
+        per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
+        hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
+        print(f"{target} of {variant} against {reference}: {len(trainings)} training(s) of {steps} env steps, about "
+              f"{per_training / 3600:.1f} h each on {where}, and {n_evals} evaluations of about "
+              f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)

@@ -74,3 +74,43 @@ def usable_here(build: str) -> str | None:
 
 def native_wanted() -> bool:
     return os.environ.get(NATIVE_BUILD_ENV, "1").strip() != "0"
+
+
+def installed_library() -> Path | None:
+    """The library ``pip install`` built beside this file (``setup.py``), if it did."""
+    import importlib.machinery
+
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = SOURCE.with_name(f"{LIBRARY}{suffix}")
+        if path.is_file():
+            return path
+    return None
+
+
+def find_compiler() -> str | None:
+    """The C compiler a first use would compile the rasteriser with: ``$CC``, cc, gcc or clang."""
+    import shutil
+
+    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+NOT_BUILT = ("note: egosearch's C depth rasteriser was not built at install and no C compiler is on PATH: the "
+             "sensor uses Embree (same images, slower); install a C compiler and `pip install -e .` again to build it")
+"""What the first ``egosearch`` command says once on such an install: pip shows a build's own warning
+only under ``pip -v``, so the install's warning goes unseen."""
+
+
+def notice_once(marker: Path) -> str | None:
+    """:data:`NOT_BUILT` the first time it applies on this machine (``marker`` remembers it was said),
+    else None."""
+    if installed_library() is not None or find_compiler() is not None or marker.exists():
+        return None
+    try:
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        marker.write_text(NOT_BUILT + "\n")
+    except OSError:
+        pass  # an unwritable home: the note comes again next time, which is better than never
+    return NOT_BUILT

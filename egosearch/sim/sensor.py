@@ -63,15 +63,12 @@ import ctypes
 import functools
 import glob
 import hashlib
-import importlib.machinery
 import math
 import os
-import shutil
 import subprocess
 import tempfile
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
 
@@ -275,21 +272,9 @@ def _cache_dir() -> str:
     raise OSError("no writable cache directory for the compiled rasteriser")
 
 
-def _find_compiler() -> str | None:
-    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
-        if name and shutil.which(name):
-            return shutil.which(name)
-    return None
-
-
-def _installed_library() -> Path | None:
-    """The library ``pip install`` built beside this module (``setup.py``), if it did."""
-    here = Path(__file__).resolve().parent
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        path = here / f"{rasterbuild.LIBRARY}{suffix}"
-        if path.is_file():
-            return path
-    return None
+# one definition each, shared with the install's notice (egosearch.sim.rasterbuild)
+_find_compiler = rasterbuild.find_compiler
+_installed_library = rasterbuild.installed_library
 
 
 def _build_of(lib) -> str:

@@ -74,19 +74,21 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
                           "scenario_seed; the fresh-set check needs sets never stored")
 
 
-def workflow_variants(config: dict, compare: bool = False, directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
+def workflow_variants(config: dict, compare: bool | str = False,
+                      directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
     """Every variant the run may train, read and checked against the run's learner profile:
     ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference and, when set (or when
-    ``compare`` is a target), ``variant``."""
+    ``compare`` names a target that compares, "compare" or "screen"), ``variant``."""
+    target = compare if isinstance(compare, str) else "compare"
     budget_config = config["profiles"][config["profile"]].get("budget", {})
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
     names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
                                + generalise["variants"]))
     if compare and not config.get("variant"):
-        raise VariantError("compare needs a variant: snakemake --cores 2 compare --config variant=NAME")
+        raise VariantError(f"{target} needs a variant: snakemake --cores 2 {target} --config variant=NAME")
     if compare and config["variant"] == config["reference_variant"]:
-        raise VariantError(f"variant={config['variant']!r} is the reference variant itself: compare needs another "
+        raise VariantError(f"variant={config['variant']!r} is the reference variant itself: {target} needs another "
                            "variant (or another reference_variant)")
     if config.get("variant"):
         names = list(dict.fromkeys(names + [config["variant"]]))
@@ -109,11 +111,12 @@ def workflow_variants(config: dict, compare: bool = False, directory: Path = ABL
 def checked_variants(config: dict, argv: list[str] | None = None,
                      directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
     """For the Snakefile: check the config and the variants, or print one line and exit 1.
-    ``compare`` among the command's targets makes ``variant`` required."""
+    ``compare`` or ``screen`` among the command's targets makes ``variant`` required."""
     argv = sys.argv[1:] if argv is None else argv
     try:
         check_config(config)
-        return workflow_variants(config, compare="compare" in argv, directory=directory)
+        comparing = next((t for t in ("compare", "screen") if t in argv), False)
+        return workflow_variants(config, compare=comparing, directory=directory)
     except (ConfigError, VariantError) as err:
         print(f"egosearch: error: {err}", file=sys.stderr)
         sys.exit(1)

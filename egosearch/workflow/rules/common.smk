@@ -107,6 +107,18 @@ def compare_candidate(wildcards):
     return eval_files(config["variant"])
 
 
+def screen_files(variant):
+    """One seed's evaluation files (config screen_seed) of every Table 1 cell: what a screen compares."""
+    return expand(f"{RESULTS}/eval/{variant}/seed{config['screen_seed']}/{{home}}/{{placement}}/h{{height}}.csv",
+                  home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def screen_candidate(wildcards):
+    if not config.get("variant"):
+        raise ValueError("screen needs a variant: snakemake screen --config variant=NAME")
+    return screen_files(config["variant"])
+
+
 # The floor, the classical searcher and the ceiling of Table 1, on the very scenario sets the policies
 # are evaluated on.
 # Their CSVs sit beside the variants' (eval/random, eval/frontier, ...): a variant may not take those names.

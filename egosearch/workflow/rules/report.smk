@@ -172,6 +172,28 @@ rule compare:
         "--out {output.cells} 2>&1 | tee {log}"
 
 
+rule screen:
+    """A lever's first test: the variant trained on one seed (screen_seed) against the reference's same
+    seed on the same stored sets, per cell and per shortest-path bin. With one seed on each side its
+    interval and p count the scenarios only, not how seeds differ: a variant that passes gets its
+    three-seed `compare`."""
+    input:
+        reference=ancient(screen_files(REF)),
+        candidate=screen_candidate,
+    output:
+        cells=f"{RESULTS}/compare/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}_vs_{REF}"
+              f"_seed{config['screen_seed']}.csv",
+        by_length=f"{RESULTS}/compare/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}_vs_{REF}"
+                  f"_seed{config['screen_seed']}_by_length.csv",
+    log:
+        f"{RESULTS}/logs/report/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}.log",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
+        "--out {output.cells} 2>&1 | tee {log}"
+
+
 rule provenance:
     """Commit, profile, machine, date, the wall time of every rule and the sha256 of every stored
     result file, next to the results. Every result of `all` is an input, so that the record is
