@@ -1,5 +1,5 @@
 # egosearch: the paper's experiments as one DAG.
-#   snakemake --cores 2 all                     # everything at the default `cpu` profile (hours; README: Provenance)
+#   snakemake --cores 2 all                     # everything at the default `cpu` profile (hours: `egosearch estimate all` says how many here)
 #   snakemake --cores 2 table1                  # Table 1 only (trains what it needs)
 #   snakemake --cores 2 compare --config variant=my_variant
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.

@@ -101,6 +101,7 @@ def test_unknown_variant_is_named_before_any_job():
     assert "hed_off" in out.stdout + out.stderr and "allowed" in out.stdout + out.stderr
 
 
+@pytest.mark.slow  # the whole smoke DAG, about 4 minutes on 2 cores: CI runs it (.ci/run)
 def test_smoke_table1_end_to_end(checkout):
     # the reference's success by path length reads the same evaluations: one more job. The timeout
     # only stops a hang: the run is 75 one-process jobs, and it took over 15 minutes beside three
