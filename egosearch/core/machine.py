@@ -3,6 +3,7 @@ the learner and the report layer can record it without importing each other)."""
 
 from __future__ import annotations
 
+import os
 import platform
 import sys
 from pathlib import Path
@@ -43,3 +44,13 @@ def gpu_model() -> str | None:
     if torch is None or not torch.cuda.is_available():
         return None
     return torch.cuda.get_device_name()
+
+
+def cpu_seconds_all() -> float | None:
+    """CPU time (s) every process of the machine has used since boot (/proc/stat), None off Linux."""
+    try:
+        with open("/proc/stat") as f:
+            fields = f.readline().split()[1:]
+        return (int(fields[0]) + int(fields[1]) + int(fields[2])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import torch
 
+from egosearch.core.machine import cpu_seconds_all
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
 from egosearch.rl.registry import make_agent
@@ -47,15 +48,6 @@ from egosearch.sim.home_pool import curve_homes
 
 if TYPE_CHECKING:  # the CLI resolves the variant: rl/ never imports the variants layer above it
     from egosearch.variants import ResolvedVariant
-
-
-def _cpu_seconds_all() -> float | None:
-    try:
-        with open("/proc/stat") as f:
-            fields = f.readline().split()[1:]
-        return (int(fields[0]) + int(fields[1]) + int(fields[2])) / os.sysconf("SC_CLK_TCK")
-    except (OSError, ValueError, IndexError):
-        return None
 
 
 def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0, size: int = 100,
@@ -135,7 +127,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     paper-profile training instead)."""
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
-    cpu0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
+    cpu0, own0, wall0 = cpu_seconds_all(), time.process_time(), time.perf_counter()
     eager = {"cuda_graph": False}  # the paper profile records its update on a GPU; these rows time it launched eagerly
     runs = {
         "table2": time_updates("paper", eager, updates=n),
@@ -150,7 +142,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
                   if cpu_profile_run else None)
     wall = time.perf_counter() - wall0
-    cpu1 = _cpu_seconds_all()
+    cpu1 = cpu_seconds_all()
     own = time.process_time() - own0
     result: dict = {}
     for key, r in runs.items():

@@ -18,7 +18,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 import egosearch.sim.envs  # noqa: F401  (registers the ids)
-from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
+from egosearch.core.machine import cpu_model, cpu_seconds_all, cpu_vector_unit, gpu_model
 from egosearch.scene.layouts import get_scene
 from egosearch.scene.meshes import triangle_count
 from egosearch.sim.scenarios import MAX_STEPS
@@ -116,16 +116,6 @@ def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: 
             "pinned_core": core, "cpu": platform.processor() or platform.machine()}
 
 
-def _cpu_seconds_all() -> float | None:
-    """CPU time (s) every process of the machine has used since boot (/proc/stat), None off Linux."""
-    try:
-        with open("/proc/stat") as f:
-            fields = f.readline().split()[1:]
-        return (int(fields[0]) + int(fields[1]) + int(fields[2])) / os.sysconf("SC_CLK_TCK")
-    except (OSError, ValueError, IndexError):
-        return None
-
-
 def _git(*args: str) -> str | None:
     try:
         return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
@@ -149,10 +139,10 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     average before and after, and ``other_load_cores``, the CPU time other processes used during the
     run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
     load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
-    busy0, own0, wall0 = _cpu_seconds_all(), time.process_time(), time.perf_counter()
+    busy0, own0, wall0 = cpu_seconds_all(), time.process_time(), time.perf_counter()
     result = run()
     wall = time.perf_counter() - wall0
-    busy1, own = _cpu_seconds_all(), time.process_time() - own0
+    busy1, own = cpu_seconds_all(), time.process_time() - own0
     status = _git("status", "--porcelain", "--untracked-files=no")
     return {
         "command": command,
