@@ -1,6 +1,7 @@
 """`egosearch estimate all`: the DAG's schedule from the stored record, scaled to a machine's rate."""
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -34,3 +35,19 @@ def test_bad_estimate_inputs_are_one_line(capsys):
     assert main(["estimate", "all", "--rate", "5", "--from-bench"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 3 and "--cores=0" in err and "--rate=-5" in err and "give one" in err
+
+
+def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypatch):
+    """From this machine's cached calibration; without one it names the command that makes one."""
+    import egosearch.cli.estimate as estimate
+    from egosearch.core.machine import cpu_model, cpu_vector_unit
+
+    monkeypatch.chdir(tmp_path)  # no stored record here: a training is taken at the calibrated rate
+    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    assert "egosearch estimate all" in estimate.training_time_line(200_000, "cpu")
+    here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0}))
+    assert estimate.training_time_line(180_000, "cpu").startswith("estimate: about 0.5 h of CPU time")
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0}))
+    assert "no calibration" in estimate.training_time_line(180_000, "cpu")
+    assert estimate.training_time_line(180_000, "smoke") is None

@@ -224,3 +224,27 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
               f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
     except (OSError, ValueError, KeyError, TypeError) as err:
         print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)
+
+
+def training_time_line(steps: int, profile: str) -> str | None:
+    """What ``egosearch train`` says at its start: how long ``steps`` env steps take on this machine,
+    from its last calibration (a cpu-profile training: None at other profiles, whose steps cost
+    otherwise), and the command that makes one when it has none."""
+    if profile != "cpu":
+        return None
+    rate = cached_rate()
+    if rate is None:
+        return "estimate: this machine has no calibration yet (`egosearch estimate all` makes one in a minute)"
+    results = Path("results") / profile
+    ratio = None
+    try:
+        record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
+        bench = json.loads((results / "bench" / "learner.json").read_text(encoding="utf-8"))
+        recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+        ratio = benchmark_ratio(record, training_rates(record, env_steps_of(results, recorded)), bench)
+    except (OSError, ValueError, KeyError):
+        pass
+    k = ratio[0] if ratio else 1.0
+    return (f"estimate: about {_hours(steps / (k * rate))} of CPU time for {steps} env steps on this machine "
+            f"(calibrated at {rate:.0f} env steps per CPU-second"
+            + (f", a training at {k:.2f} x that as in the stored run" if ratio else "") + ")")

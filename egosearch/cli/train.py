@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from egosearch.cli.checks import at_least, check_seed
+from egosearch.cli.estimate import training_time_line
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.core.staging import publish_run
 from egosearch.rl.run_files import CheckpointError, check_same_run
@@ -32,6 +33,9 @@ def run(args) -> None:
             check_published_run(Path(args.out_dir), resolved)
         except CheckpointError as err:
             raise ValueError(f"--out-dir: {err}") from None
+    line = training_time_line(resolved.config.total_env_steps, args.profile)
+    if line:
+        print(line, flush=True)
     try:
         summary = train(resolved.env_id, resolved.config, args.work_dir or args.out_dir, env_kwargs=env,
                         evaluate_fn=evaluator, variant=resolved.name, max_wall_s=args.max_wall_s)
