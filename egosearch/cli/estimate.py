@@ -77,6 +77,13 @@ def run(args) -> None:
         print(json.dumps({k: v for k, v in estimate.items() if k != "lines"}))
 
 
+def stored_training_rates(record: dict, results: Path) -> dict[str, float]:
+    """Every stored training's env steps per CPU-second (lever screens too: one may share the
+    learner benchmark's machine), by job key."""
+    recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+    return training_rates(record, env_steps_of(results, recorded))
+
+
 def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict) -> tuple[float, str] | None:
     """A stored training's rate over the learner benchmark's, on the same kind of machine (CPU and
     vector unit), and that machine; None when the record holds no training from the benchmark's machine."""
@@ -145,9 +152,7 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
     benchmark gives ``rate`` (left out when None). Returns the figures and the lines to print."""
     jobs = dag_jobs("all", cores, config={"profile": profile})
     stored = durations_from_provenance(record, jobs)
-    # every stored training's rate (lever screens too: one may share the benchmark's machine)
-    recorded_trainings = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
-    all_rates = training_rates(record, env_steps_of(results, recorded_trainings))
+    all_rates = stored_training_rates(record, results)
     rates = {j.job: all_rates[j.job] for j in jobs if j.record_rule == TRAIN and j.job in all_rates}
     as_recorded = simulate(jobs, cores, stored)
     slowest_rate = min(rates.values()) if rates else None
@@ -202,14 +207,13 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         bench_path = results / "bench" / "learner.json"
         bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
-        recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
-        ratio = benchmark_ratio(record, training_rates(record, env_steps_of(results, recorded)), bench)
+        ratio = benchmark_ratio(record, stored_training_rates(record, results), bench)
         rate, where = cached_rate(), "this machine (its last calibration)"
         if rate is None:
             rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
             where = f"{machine_key(bench.get('machine'))} (the stored learner benchmark; `egosearch estimate all` " \
                     "calibrates this machine)"
-        steps = resolve_variant(variant, profile if profile != "smoke" else "smoke").config.total_env_steps
+        steps = resolve_variant(variant, profile).config.total_env_steps
         trainings = [s for s in seeds if not (results / "train" / variant / f"seed{s}" / "done.json").exists()]
         evals = [r["wall_s"] for r in record.get("jobs", []) if r.get("rule") == "eval"]
         per_eval = statistics.median(evals) if evals else 0.0
@@ -240,8 +244,7 @@ def training_time_line(steps: int, profile: str) -> str | None:
     try:
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         bench = json.loads((results / "bench" / "learner.json").read_text(encoding="utf-8"))
-        recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
-        ratio = benchmark_ratio(record, training_rates(record, env_steps_of(results, recorded)), bench)
+        ratio = benchmark_ratio(record, stored_training_rates(record, results), bench)
     except (OSError, ValueError, KeyError):
         pass
     k = ratio[0] if ratio else 1.0
