@@ -1,4 +1,4 @@
-"""``egosearch bench learner``: SAC + CURL update speed and replay memory (under ~60 s).
+"""``egosearch bench learner``: the learners' update speed and replay memory (about two minutes).
 
 Every number is a full SAC + CURL update (replay sampling, crops, critic, actor + temperature
 every 2nd update, Polyak every 2nd update, CURL), batch 32, 5 x 100 x 100 uint8 frames cropped
@@ -14,9 +14,12 @@ Keys:
 - ``updates_per_s_naive``: CURL's update transcribed line by line (``impl="reference"``);
 - ``updates_per_s_table2_1thread``: the optimised update at Table 2 sizes on ONE thread;
 - ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
-  thread count (one);
+  thread count (one); ``..._reference``: the same update one op at a time (SAC-DrQ's
+  ``impl="reference"``, the same math), and ``speedup_cpu_profile_vs_reference`` their ratio;
 - ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
   the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details);
+- ``*_avx2`` (on a CPU with AVX-512): the cpu profile's rows again in a process whose oneDNN may
+  use AVX2 at most (``ONEDNN_MAX_CPU_ISA=AVX2``), for what a CPU without AVX-512 pays;
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
 - ``torch_threads``, ``device``, ``cpu``.
 """
@@ -25,8 +28,11 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import os
 import platform
+import subprocess
+import sys
 import tempfile
 import time
 import warnings
@@ -35,12 +41,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 import torch
 
-from egosearch.core.machine import cpu_seconds_all
+from egosearch.core.allocator import keep_freed_memory
+from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
+from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import torch_threads, train
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
@@ -81,6 +89,8 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
         if cfg.algorithm == "sac_curl":
             agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
+        elif cfg.algorithm == "sac_drq":
+            agent = SacDrqAgent(cfg, action_dim, 30, 4, device, state_dim, impl=impl)
         else:
             agent = make_agent(cfg, action_dim, 30, 4, device, state_dim)
         replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size),
@@ -125,6 +135,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
     ``cpu_profile_run=False`` leaves out the cpu profile's training run (a GPU check times a real
     paper-profile training instead)."""
+    keep_freed_memory()  # as a training does, so that its updates cost here what they cost there
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
     cpu0, own0, wall0 = cpu_seconds_all(), time.process_time(), time.perf_counter()
@@ -138,9 +149,14 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     if torch.cuda.is_available():  # the captured update: 4 eager warm-up updates and 2 captures first
         runs["table2_graph"] = time_updates("paper", {"cuda_graph": True}, warmup=8, updates=n)
     cpu_cfg = load_config("cpu", {})
-    runs["cpu_profile"] = time_updates("cpu", threads=torch_threads(cpu_cfg.num_threads), updates=2 * n)
+    cpu_threads = torch_threads(cpu_cfg.num_threads)
+    runs["cpu_profile"] = time_updates("cpu", threads=cpu_threads, updates=2 * n)
+    runs["cpu_profile_reference"] = time_updates("cpu", impl="reference", threads=cpu_threads, updates=2 * n)
     throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
                   if cpu_profile_run else None)
+    # oneDNN picks its kernels once per process, so the AVX2-limited rows need a process of their own
+    avx2 = (_avx2_limited_cpu_profile(quick, cpu_profile_run)
+            if cpu_vector_unit() == "AVX-512" and resolve_device("auto").type == "cpu" else None)
     wall = time.perf_counter() - wall0
     cpu1 = cpu_seconds_all()
     own = time.process_time() - own0
@@ -149,12 +165,16 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
         result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
     result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
+    result["speedup_cpu_profile_vs_reference"] = round(result["updates_per_s_cpu_profile"]
+                                                       / result["updates_per_s_cpu_profile_reference"], 2)
     if "updates_per_s_table2_graph" in result:
         result["speedup_graph_vs_table2"] = round(result["updates_per_s_table2_graph"]
                                                   / result["updates_per_s_table2"], 2)
     if throughput is not None:
         result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
         result["cpu_profile_run"] = throughput
+    if avx2 is not None:
+        result.update({f"{key}_avx2": value for key, value in avx2.items()})
     result["replay_gb_100k"] = round(replay_gb(100_000), 3)
     result["torch_threads"] = torch.get_num_threads()
     result["cpu_profile_threads"] = torch_threads(cpu_cfg.num_threads)
@@ -164,6 +184,36 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         result["other_load"] = round(max(0.0, (cpu1 - cpu0) - own) / wall, 2) if wall > 0 else None
     result["bench_s"] = round(wall, 1)
     return result
+
+
+def cpu_profile_rows(quick: bool, cpu_profile_run: bool) -> dict:
+    """The cpu profile's update rates (fast and reference) and, with ``cpu_profile_run``, its short
+    training's env steps per core-second, as :func:`bench_learner` names them (without a suffix)."""
+    keep_freed_memory()
+    n = 3 if quick else 10
+    threads = torch_threads(load_config("cpu", {}).num_threads)
+    rows = {}
+    for key, impl in (("cpu_profile", "fast"), ("cpu_profile_reference", "reference")):
+        r = time_updates("cpu", impl=impl, threads=threads, updates=2 * n)
+        rows[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
+    if cpu_profile_run:
+        rows["env_steps_per_core_s_cpu_profile"] = training_throughput(
+            "cpu", env_steps=400 * load_config("cpu", {}).num_envs if quick else 4000)["env_steps_per_core_s"]
+    return rows
+
+
+def _avx2_limited_cpu_profile(quick: bool, cpu_profile_run: bool) -> dict | None:
+    """:func:`cpu_profile_rows` in a child process whose oneDNN may use AVX2 at most
+    (``ONEDNN_MAX_CPU_ISA=AVX2``): what the same update costs on a CPU without AVX-512. None if the
+    child fails (its error is printed)."""
+    code = ("import json, sys; from egosearch.rl.bench import cpu_profile_rows; "
+            f"print(json.dumps(cpu_profile_rows({quick!r}, {cpu_profile_run!r})))")
+    child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           env={**os.environ, "ONEDNN_MAX_CPU_ISA": "AVX2"})
+    if child.returncode != 0:
+        print(f"the AVX2-limited rows failed: {child.stderr.strip().splitlines()[-1:]}", flush=True)
+        return None
+    return json.loads(child.stdout.strip().splitlines()[-1])
 
 
 def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: dict | None = None) -> float | None:

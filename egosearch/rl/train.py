@@ -42,6 +42,7 @@ import gymnasium
 import numpy as np
 import torch
 
+from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
 from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
@@ -157,26 +158,6 @@ def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
     if not (np.allclose(act.low, -1) and np.allclose(act.high, 1)):
         raise ValueError("action space must be Box(-1, 1): the actor's tanh output is not rescaled")
     return int(act.shape[0]), int(mask.shape[0]), int(proprio.shape[0])
-
-
-def keep_freed_memory() -> bool:
-    """Ask glibc to keep freed blocks of up to 32 MB instead of returning them to the OS.
-
-    Every update allocates and frees the same few-MB tensors; with glibc's defaults each one is a
-    fresh mmap whose pages fault in again, which measured ~1/3 of a small update's time here
-    (page faults 4x fewer with this). Same numbers either way. False where glibc is absent."""
-    import ctypes
-    import ctypes.util
-
-    name = ctypes.util.find_library("c")
-    if not name or os.name != "posix":
-        return False
-    try:
-        libc = ctypes.CDLL(name)
-        m_trim_threshold, m_mmap_threshold = -1, -3
-        return bool(libc.mallopt(m_mmap_threshold, 32 * 1024 * 1024) and libc.mallopt(m_trim_threshold, 1 << 30))
-    except (OSError, AttributeError):
-        return False
 
 
 def torch_threads(requested: int = 0) -> int:
