@@ -42,7 +42,7 @@ import numpy as np
 import torch
 
 from egosearch.core.allocator import keep_freed_memory
-from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit
+from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit, own_cpu_seconds
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import load_config
 from egosearch.rl.registry import make_agent
@@ -138,7 +138,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     keep_freed_memory()  # as a training does, so that its updates cost here what they cost there
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
-    cpu0, own0, wall0 = cpu_seconds_all(), time.process_time(), time.perf_counter()
+    cpu0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
     eager = {"cuda_graph": False}  # the paper profile records its update on a GPU; these rows time it launched eagerly
     runs = {
         "table2": time_updates("paper", eager, updates=n),
@@ -159,7 +159,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
             if cpu_vector_unit() == "AVX-512" and resolve_device("auto").type == "cpu" else None)
     wall = time.perf_counter() - wall0
     cpu1 = cpu_seconds_all()
-    own = time.process_time() - own0
+    own = own_cpu_seconds() - own0
     result: dict = {}
     for key, r in runs.items():
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)

@@ -18,7 +18,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 import egosearch.sim.envs  # noqa: F401  (registers the ids)
-from egosearch.core.machine import cpu_model, cpu_seconds_all, cpu_vector_unit, gpu_model
+from egosearch.core.machine import cpu_model, cpu_seconds_all, cpu_vector_unit, gpu_model, own_cpu_seconds
 from egosearch.scene.layouts import get_scene
 from egosearch.scene.meshes import triangle_count
 from egosearch.sim.scenarios import MAX_STEPS
@@ -139,10 +139,10 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     average before and after, and ``other_load_cores``, the CPU time other processes used during the
     run per second of it (0 on an idle machine; 1.0 is one core kept busy by something else)."""
     load_before = [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
-    busy0, own0, wall0 = cpu_seconds_all(), time.process_time(), time.perf_counter()
+    busy0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
     result = run()
     wall = time.perf_counter() - wall0
-    busy1, own = cpu_seconds_all(), time.process_time() - own0
+    busy1, own = cpu_seconds_all(), own_cpu_seconds() - own0
     status = _git("status", "--porcelain", "--untracked-files=no")
     return {
         "command": command,
