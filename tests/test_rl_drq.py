@@ -66,61 +66,6 @@ def test_channels_last_encoder_computes_the_same_features_and_gradients():
     torch.testing.assert_close(plain.convs[0].weight.grad, fast.convs[0].weight.grad, rtol=1e-4, atol=1e-5)
 
 
-def test_fused_conv_relu_gives_the_one_op_at_a_time_features_and_gradients():
-    torch.manual_seed(0)
-    encoder = PooledConvEncoder(5, 100, 2, 2, 8, 2, "relu").use_channels_last()
-    x = PooledConvEncoder.normalise(torch.randint(0, 256, (6, 5, 50, 50)).float())
-    assert encoder.can_fuse(x) == torch.backends.mkldnn.is_available()
-    grads = []
-    for convolve in (encoder.convolve, encoder.convolve_fused):
-        encoder.zero_grad()
-        features = convolve(x)
-        # a loss that reaches every feature with a different weight, and zeros where the ReLU clipped
-        (features * torch.linspace(-1, 1, features.shape[1])).square().sum().backward()
-        grads.append((features.detach(), *(p.grad.clone() for p in encoder.parameters())))
-    assert (grads[0][0] == 0).any() and (grads[0][0] > 0).any()
-    for reference, fused in zip(*grads):
-        torch.testing.assert_close(fused, reference, rtol=1e-6, atol=1e-7)
-    assert not PooledConvEncoder(5, 100, 2, 2, 8, 2, "elu").use_channels_last().can_fuse(x)
-
-
-def test_fast_update_matches_the_reference_update_to_float_rounding():
-    cfg = load_config("cpu", {"device": "cpu", "batch_size": 16})
-    agents = []
-    for impl in ("reference", "fast"):
-        torch.manual_seed(0)
-        agents.append(SacDrqAgent(cfg, 5, state_dim=3, impl=impl))
-    replay = MultiReplay(1, 64, image_size=agents[0].replay_image_size, frame_history=5, n_step=3, state_dim=3)
-    rng = np.random.default_rng(0)
-
-    def observation(depth):
-        return agents[0].replay_obs({"depth": depth, "mask": rng.normal(size=30).astype(np.float32),
-                                     "proprio": rng.normal(size=4).astype(np.float32),
-                                     "state": rng.normal(size=3).astype(np.float32)})
-
-    o = observation(rng.integers(0, 256, (5, 100, 100), dtype=np.uint8))
-    for t in range(40):
-        end = t % 10 == 9
-        newest = rng.integers(0, 256, (1, 50, 50), dtype=np.uint8)
-        o2 = {**observation(np.zeros((5, 100, 100), np.uint8)), "depth": np.concatenate([o["depth"][1:], newest])}
-        replay.add(0, o, rng.uniform(-1, 1, 5), float(rng.normal()), o2, False, end)
-        o = o2 if not end else observation(rng.integers(0, 256, (5, 100, 100), dtype=np.uint8))
-    batches = [replay.sample(16) for _ in range(8)]
-    metrics = []
-    for agent in agents:
-        torch.manual_seed(1)  # the same augmentation offsets and policy noise
-        metrics.append([agent.update(batch) for batch in batches])
-    for reference, fast in zip(*metrics):
-        for key in ("critic_loss", "actor_loss", "alpha_loss", "q_mean"):
-            assert fast[key] == pytest.approx(reference[key], rel=1e-5, abs=1e-6), key
-    for (name, a), (_, b) in zip(agents[0].critic.named_parameters(), agents[1].critic.named_parameters()):
-        torch.testing.assert_close(b, a, rtol=1e-5, atol=1e-6, msg=name)
-    torch.testing.assert_close(agents[1].encoder.convs[0].weight, agents[0].encoder.convs[0].weight,
-                               rtol=1e-5, atol=1e-6)
-    with pytest.raises(ValueError, match="impl"):
-        SacDrqAgent(cfg, 5, state_dim=3, impl="quick")
-
-
 def _obs(value: int, size: int = 8) -> dict:
     return {"depth": np.full((3, size, size), value, np.uint8), "mask": np.full(30, value, np.float32),
             "proprio": np.zeros(4, np.float32)}

@@ -362,7 +362,6 @@ def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_g
     monkeypatch.setattr(bench, "cpu_vector_unit", lambda: "AVX-512")
     monkeypatch.setattr(bench, "_avx2_limited_cpu_profile", lambda quick, run: {"updates_per_s_cpu_profile": 3.0})
     result = bench.bench_learner(quick=True, cpu_profile_run=False)
-    assert ("cpu", {}, "reference") in asked and result["speedup_cpu_profile_vs_reference"] == 1.0
     assert result["updates_per_s_cpu_profile_avx2"] == 3.0
     fast_table2 = [o for profile, o, impl in asked if profile == "paper" and impl == "fast"]
     assert len(fast_table2) == 3 and all(o.get("cuda_graph") is False for o in fast_table2)

@@ -33,10 +33,8 @@ LEARNER_KEYS = (
     ("table2_shared", "also reuses the critic's encoder pass for CURL and the actor: one optimiser step stale, "
                       "off by default"),
     ("table2_1thread", "the same on one thread"),
-    ("cpu_profile", "SAC-DrQ with the privileged critic, batch 64, one thread; each conv fused with its ReLU"),
-    ("cpu_profile_reference", "the same update one op at a time; same math"),
-    ("cpu_profile_avx2", "the cpu profile's update with oneDNN limited to AVX2"),
-    ("cpu_profile_reference_avx2", "the one-op-at-a-time update so limited"),
+    ("cpu_profile", "SAC-DrQ with the privileged critic, batch 64, one thread"),
+    ("cpu_profile_avx2", "the same with oneDNN limited to AVX2, in its own process"),
 )
 
 

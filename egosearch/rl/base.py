@@ -117,67 +117,13 @@ class PooledConvEncoder(nn.Module):
         sums = F.avg_pool2d(x, f, divisor_override=1)
         return torch.floor((sums + (f * f) // 2) / (f * f))
 
-    @staticmethod
-    def normalise(pooled: torch.Tensor) -> torch.Tensor:
-        """Pooled float pixels (0..255) -> the convs' input scale [-0.5, 0.5]."""
-        return pooled / 255.0 - 0.5
-
     def forward(self, pooled: torch.Tensor) -> torch.Tensor:
-        return self.convolve(self.normalise(pooled))
-
-    def convolve(self, h: torch.Tensor) -> torch.Tensor:
-        """Normalised pixels -> flat features, one op at a time."""
+        h = pooled / 255.0 - 0.5
         if self.channels_last:
             h = h.contiguous(memory_format=torch.channels_last)
         for conv in self.convs:
             h = self.act(conv(h))
         return h.flatten(1)
-
-    def can_fuse(self, h: torch.Tensor) -> bool:
-        """Whether :meth:`convolve_fused` can run oneDNN's fused conv + ReLU here: ReLU, channels-last
-        float32 on a CPU whose torch has oneDNN."""
-        return (isinstance(self.act, nn.ReLU) and self.channels_last and h.device.type == "cpu"
-                and h.dtype == torch.float32 and _FUSED_CONV_RELU is not None)
-
-    def convolve_fused(self, h: torch.Tensor) -> torch.Tensor:
-        """:meth:`convolve`'s values (to float rounding; on the machines tested, bit for bit) at less
-        memory traffic: each conv writes its ReLU'd output in one pass (oneDNN's fused post-op) and its
-        backward hands the ReLU a gradient in the maps' own layout (a mixed layout runs ~10x slower).
-        Falls back to :meth:`convolve` where it cannot fuse (:meth:`can_fuse`)."""
-        if not self.can_fuse(h):
-            return self.convolve(h)
-        h = h.contiguous(memory_format=torch.channels_last)
-        for conv in self.convs:
-            h = FusedConvReLU.apply(h, conv.weight, conv.bias, conv.stride)
-        return h.flatten(1)
-
-
-_FUSED_CONV_RELU = getattr(getattr(torch.ops, "mkldnn", None), "_convolution_pointwise", None) \
-    if torch.backends.mkldnn.is_available() else None
-
-
-class FusedConvReLU(torch.autograd.Function):
-    """relu(conv2d(x, weight, bias, stride)), unpadded, in oneDNN's one fused pass; the backward is
-    autograd's own for the two ops (ReLU's threshold, then the conv's), so gradients are the same."""
-
-    @staticmethod
-    def forward(ctx, x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor,
-                stride: tuple[int, int]) -> torch.Tensor:
-        out = _FUSED_CONV_RELU(x, weight, bias, [0, 0], list(stride), [1, 1], 1, "relu", [None], None)
-        ctx.save_for_backward(x, weight, out)
-        ctx.stride = list(stride)
-        return out
-
-    @staticmethod
-    def backward(ctx, grad: torch.Tensor):
-        x, weight, out = ctx.saved_tensors
-        channels_last = out.is_contiguous(memory_format=torch.channels_last)
-        layout = torch.channels_last if channels_last else torch.contiguous_format
-        grad = torch.ops.aten.threshold_backward(grad.contiguous(memory_format=layout), out, 0)
-        gx, gw, gb = torch.ops.aten.convolution_backward(
-            grad, x, weight, [weight.shape[0]], ctx.stride, [0, 0], [1, 1], False, [0, 0], 1,
-            [ctx.needs_input_grad[0], ctx.needs_input_grad[1], ctx.needs_input_grad[2]])
-        return gx, gw, gb, None
 
 
 def pooled_encoder(arch: dict[str, Any]) -> PooledConvEncoder:

@@ -14,8 +14,7 @@ Keys:
 - ``updates_per_s_naive``: CURL's update transcribed line by line (``impl="reference"``);
 - ``updates_per_s_table2_1thread``: the optimised update at Table 2 sizes on ONE thread;
 - ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
-  thread count (one); ``..._reference``: the same update one op at a time (SAC-DrQ's
-  ``impl="reference"``, the same math), and ``speedup_cpu_profile_vs_reference`` their ratio;
+  thread count (one);
 - ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
   the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details);
 - ``*_avx2`` (on a CPU with AVX-512): the cpu profile's rows again in a process whose oneDNN may
@@ -48,7 +47,6 @@ from egosearch.rl.config import load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
-from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import torch_threads, train
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
@@ -89,8 +87,6 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
         if cfg.algorithm == "sac_curl":
             agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
-        elif cfg.algorithm == "sac_drq":
-            agent = SacDrqAgent(cfg, action_dim, 30, 4, device, state_dim, impl=impl)
         else:
             agent = make_agent(cfg, action_dim, 30, 4, device, state_dim)
         replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size),
@@ -151,7 +147,6 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     cpu_cfg = load_config("cpu", {})
     cpu_threads = torch_threads(cpu_cfg.num_threads)
     runs["cpu_profile"] = time_updates("cpu", threads=cpu_threads, updates=2 * n)
-    runs["cpu_profile_reference"] = time_updates("cpu", impl="reference", threads=cpu_threads, updates=2 * n)
     throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
                   if cpu_profile_run else None)
     # oneDNN picks its kernels once per process, so the AVX2-limited rows need a process of their own
@@ -165,8 +160,6 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         result[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
         result[f"updates_per_s_{key}_best"] = round(1.0 / r["best_s"], 2)
     result["speedup_vs_naive"] = round(result["updates_per_s_table2"] / result["updates_per_s_naive"], 2)
-    result["speedup_cpu_profile_vs_reference"] = round(result["updates_per_s_cpu_profile"]
-                                                       / result["updates_per_s_cpu_profile_reference"], 2)
     if "updates_per_s_table2_graph" in result:
         result["speedup_graph_vs_table2"] = round(result["updates_per_s_table2_graph"]
                                                   / result["updates_per_s_table2"], 2)
@@ -187,15 +180,13 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
 
 
 def cpu_profile_rows(quick: bool, cpu_profile_run: bool) -> dict:
-    """The cpu profile's update rates (fast and reference) and, with ``cpu_profile_run``, its short
-    training's env steps per core-second, as :func:`bench_learner` names them (without a suffix)."""
+    """The cpu profile's update rate and, with ``cpu_profile_run``, its short training's env steps per
+    core-second, as :func:`bench_learner` names them (without a suffix)."""
     keep_freed_memory()
     n = 3 if quick else 10
     threads = torch_threads(load_config("cpu", {}).num_threads)
-    rows = {}
-    for key, impl in (("cpu_profile", "fast"), ("cpu_profile_reference", "reference")):
-        r = time_updates("cpu", impl=impl, threads=threads, updates=2 * n)
-        rows[f"updates_per_s_{key}"] = round(1.0 / r["median_s"], 2)
+    r = time_updates("cpu", threads=threads, updates=2 * n)
+    rows = {"updates_per_s_cpu_profile": round(1.0 / r["median_s"], 2)}
     if cpu_profile_run:
         rows["env_steps_per_core_s_cpu_profile"] = training_throughput(
             "cpu", env_steps=400 * load_config("cpu", {}).num_envs if quick else 4000)["env_steps_per_core_s"]

@@ -32,7 +32,7 @@ learner (registered as "sac_drq" in :mod:`egosearch.rl.registry`).
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 import torch
 import torch.nn.functional as F
@@ -105,19 +105,9 @@ class SacDrqAgent(SacDrqBase):
     optional ``discount`` (B, 1) column (gamma^n of n-step returns; default gamma)."""
 
     agent_format = AGENT_FORMAT
-    default_impl: ClassVar[str] = "fast"
-    """The ``impl`` of agents built without one (the registry's): the learner benchmark's "before" row
-    sets "reference" in its own process."""
 
     def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
-                 device: str | torch.device | None = None, state_dim: int = 0, impl: str | None = None):
-        """``impl``: "fast" (each conv fused with its ReLU, ``PooledConvEncoder.convolve_fused``) or
-        "reference" (one op at a time, ``PooledConvEncoder.convolve``); one update's math, the same
-        results to float rounding (``tests/test_sac_drq.py``)."""
-        impl = impl or self.default_impl
-        if impl not in ("fast", "reference"):
-            raise ValueError(f"impl={impl!r}; allowed: fast, reference")
-        self.impl = impl
+                 device: str | torch.device | None = None, state_dim: int = 0):
         super().__init__(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
         self.decoder: FrameDecoder | None = None
         if cfg.encoder_aux_loss == "reconstruction":
@@ -148,27 +138,26 @@ class SacDrqAgent(SacDrqBase):
         discount = batch.get("discount")
         if discount is None:
             discount = torch.full_like(batch["reward"], cfg.gamma)
-        # the replay holds pooled frames (see ``replay_obs``); obs and nxt are normalised pixels
-        obs = self.encoder.normalise(random_shift(batch["obs_depth"].float(), cfg.aug_pad))
-        nxt = self.encoder.normalise(random_shift(batch["next_obs_depth"].float(), cfg.aug_pad))
-        encode = self.encoder.convolve_fused if self.impl == "fast" else self.encoder.convolve
+        # the replay holds pooled frames (see ``replay_obs``)
+        obs = random_shift(batch["obs_depth"].float(), cfg.aug_pad)
+        nxt = random_shift(batch["next_obs_depth"].float(), cfg.aug_pad)
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
 
         with torch.no_grad():
-            h_next = encode(nxt)
+            h_next = self.encoder(nxt)
             mu, log_std = self.actor(h_next, next_extra)
             next_pi, next_log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
             tq1, tq2 = self.critic_target(h_next, next_critic_extra, next_pi)
             target_q = batch["reward"] + batch["not_done"] * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
 
-        h = encode(obs)
+        h = self.encoder(obs)
         q1, q2 = self.critic(h, critic_extra, batch["action"])
         critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
         loss = critic_loss
         if self.decoder is not None:
             # the newest frame as the encoder saw it (pooled, shifted), in its input scale
-            aux_loss = F.mse_loss(self.decoder(h), obs[:, -1])
+            aux_loss = F.mse_loss(self.decoder(h), obs[:, -1] / 255.0 - 0.5)
             loss = critic_loss + cfg.encoder_aux_weight * aux_loss
             self.optimisers["decoder"].zero_grad(set_to_none=True)
             out["aux_loss"] = aux_loss
