@@ -16,7 +16,7 @@ from pathlib import Path
 from egosearch.cli import parsers
 from egosearch.sim import rasterbuild
 
-COMMANDS = ("scenarios", "evaluate", "train", "variant", "fullbody", "bench", "estimate", "video", "report",
+COMMANDS = ("scenarios", "evaluate", "train", "demos", "variant", "fullbody", "bench", "estimate", "video", "report",
             "pictures")
 """In the order ``egosearch --help`` lists them; each has ``parsers.add_<command>`` and a module."""
 

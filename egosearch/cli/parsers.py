@@ -80,6 +80,21 @@ def add_train(sub) -> None:
     add_force(p)
 
 
+def add_demos(sub) -> None:
+    about = ("run the frontier searcher in a variant's training homes and store its transitions "
+             "(demonstrations for imitation and RL)")
+    p = sub.add_parser("demos", help=about, description=about)
+    p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...): its "
+                                                    "training homes, heights and observation")
+    p.add_argument("--profile", default="cpu", help="learner profile whose observation is stored: smoke, cpu or "
+                                                    "paper (default: cpu)")
+    p.add_argument("--episodes", type=int, required=True, help="demonstration episodes")
+    p.add_argument("--seed", type=int, default=0, help="seed of the episodes (default 0)")
+    p.add_argument("--out", required=True, metavar="FILE.replay.npz",
+                   help="the transitions (git-ignored); a summary goes beside it as FILE.json")
+    add_force(p)
+
+
 def add_variant(sub) -> None:
     p = sub.add_parser("variant", help="create a variant file in ablations/ from a template, or check variants")
     variants = p.add_subparsers(dest="what", required=True, metavar="ACTION")

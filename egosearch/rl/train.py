@@ -169,7 +169,7 @@ def torch_threads(requested: int = 0) -> int:
     return os.cpu_count() or 1
 
 
-def _make_env(env_id: str, env_kwargs: dict):
+def make_train_env(env_id: str, env_kwargs: dict):
     if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.sim.home_pool)
         if env_kwargs["layout"] == "paper_homes":
             return HomePoolEnv(env_id, home_names=LAYOUT_NAMES, **env_kwargs)
@@ -226,7 +226,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     envs: list = []
     try:
         for _ in range(cfg.num_envs):
-            envs.append(_make_env(env_id, train_env_kwargs(cfg, env_kwargs)))
+            envs.append(make_train_env(env_id, train_env_kwargs(cfg, env_kwargs)))
         return _train(envs, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt,
                       max_wall_s)
     finally:

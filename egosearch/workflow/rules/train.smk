@@ -21,3 +21,25 @@ rule train:
     shell:
         "egosearch train --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
         "--threads {threads} --work-dir {params.work_dir} --out-dir {params.out_dir} > {log} 2>&1"
+
+
+rule demos:
+    """The frontier searcher's transitions in the variant's training homes (issue: learn from the classical
+    searcher): the head-moving searcher for a body with a head, the head-fixed one otherwise. The transitions
+    are git-ignored (*.replay.npz); the summary beside them records episodes, success and CPU time."""
+    output:
+        transitions="results/{profile}/demos/{variant}/seed{seed}.replay.npz",
+        summary="results/{profile}/demos/{variant}/seed{seed}.json",
+    log:
+        "results/{profile}/logs/demos/{variant}/seed{seed}.log",
+    benchmark:
+        "results/{profile}/benchmarks/demos/{variant}/seed{seed}.tsv"
+    params:
+        learner=lambda wc: config["profiles"][wc.profile]["learner"],
+        episodes=lambda wc: config["demo_episodes"],
+    threads: 1
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch demos --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
+        "--episodes {params.episodes} --out {output.transitions} > {log} 2>&1"

@@ -1,0 +1,65 @@
+"""Demonstrations from the frontier searcher: stored as the learner's replay stores its transitions."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from egosearch.rl.base import pool_depth
+from egosearch.rl.config import load_config
+from egosearch.rl.demos import DEMO_SEED_BASE, collect_demonstrations, load_demonstrations, summary_path
+from egosearch.rl.train import make_train_env, train_env_kwargs
+from egosearch.searchers.frontier import FrontierPolicy
+
+ENV = {"layout": "kitchen_living", "placement": "everywhere"}
+
+
+@pytest.fixture(scope="module")
+def demos(tmp_path_factory):
+    cfg = load_config("cpu", {"seed": 3})
+    path = tmp_path_factory.mktemp("demos") / "head_on.replay.npz"
+    summary = collect_demonstrations("EgoSearch-v0", cfg, ENV, 3, path, seed=1, progress=False)
+    return cfg, path, summary
+
+
+def test_the_stored_transitions_are_the_teachers_own_steps(demos):
+    cfg, path, summary = demos
+    assert json.loads(summary_path(path).read_text()) == json.loads(json.dumps(summary))
+    assert summary["env_id"] == "EgoSearchMemory-v0"  # the cpu profile's observation: the target memory
+    assert summary["teacher_head"] and summary["episodes"] == 3
+    assert list(summary["env_kwargs"]["train_heights"]) == [cfg.train_height_min, 1.8]
+    replay = load_demonstrations(path, cfg)
+    buf = replay.buffers[0]
+    assert len(replay) == summary["transitions"] == buf.n_added
+    ends = np.flatnonzero(buf.terminated[:buf.n_added] | buf.truncated[:buf.n_added])
+    assert len(ends) == 3 and ends[-1] == buf.n_added - 1
+    assert np.mean(buf.terminated[ends]) == pytest.approx(summary["teacher_success"], abs=1e-4)
+
+    # the first episode again, from its seed: the teacher acts the same and sees the stored frames
+    env = make_train_env("EgoSearchMemory-v0", train_env_kwargs(cfg, ENV))
+    obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * 1)
+    teacher = FrontierPolicy(env)
+    stacks, _ = buf.stacks(np.arange(ends[0] + 1))
+    for t in range(ends[0] + 1):
+        np.testing.assert_array_equal(stacks[t], pool_depth(obs["depth"], cfg.obs_downsample))
+        action = teacher.act(obs)
+        np.testing.assert_allclose(buf.action[t], action, atol=1e-6)
+        obs, reward, *_ = env.step(action)
+        assert buf.reward[t] == pytest.approx(reward, abs=1e-5)
+    env.close()
+
+
+def test_demonstrations_sample_as_the_learners_replay_with_n_step_returns(demos):
+    cfg, path, _ = demos
+    batch = load_demonstrations(path, cfg).sample(16)
+    assert batch["obs_depth"].shape == (16, cfg.frame_history, 50, 50)
+    assert batch["state"].shape[1] > 0 and batch["action"].shape == (16, 5)
+    assert (batch["discount"] <= cfg.gamma + 1e-6).all()
+    assert (batch["discount"] >= cfg.gamma ** cfg.n_step - 1e-6).all()
+
+
+def test_a_demonstrations_file_is_named_for_git_to_ignore(tmp_path):
+    with pytest.raises(ValueError, match="replay.npz"):
+        collect_demonstrations("EgoSearch-v0", load_config("cpu", {}), ENV, 1, tmp_path / "d.npz", progress=False)
