@@ -95,6 +95,7 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
         {"updates_per_s_naive": 3.1, "updates_per_s_naive_best": 3.3, "updates_per_s_table2": 4.2,
          "updates_per_s_table2_best": 4.4, "updates_per_s_cpu_profile": 60.5, "updates_per_s_cpu_profile_best": 62.0,
          "env_steps_per_core_s_cpu_profile": 151.2, "cpu_profile_run": {"env_steps": 4000, "core_s": 26.5},
+         "updates_per_s_cpu_profile_avx2": 58.0, "env_steps_per_core_s_cpu_profile_avx2": 171.0,
          "replay_gb_100k": 1.156}, "egosearch bench learner", other=1.5)))
     train = tmp_path / "results" / "p" / "train" / "head_on" / "seed0"
     train.mkdir(parents=True)
@@ -111,7 +112,10 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     assert "**650 env steps/s** (1.538 ms a step, 7 resets included; target 700: not met)" in text
     assert "| `updates_per_s_table2` (" in text and "| 4.2 (4.4) |" in text and "| 60.5 (62.0) |" in text
     assert "target of 12: not met" in text and "**`env_steps_per_core_s_cpu_profile` 151.2**" in text
-    assert "4,000-step" in text and "of 150: met" in text
+    assert "4,000-step" in text and "of 200: not met" in text
+    assert "| `updates_per_s_cpu_profile_avx2` (" in text and "| 58.0 (–) |" in text
+    assert "`ONEDNN_MAX_CPU_ISA=AVX2`, its own process): **171.0** env steps per core-second; the issue's target " \
+        "of 170: met" in text
     # how busy the machine was is part of every figure
     assert "other processes used 1.50 cores meanwhile, load average 0.10 before" in text
     assert "X CPU with 2 cores" in text and "commit `0123456`" in text
