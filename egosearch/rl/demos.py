@@ -5,8 +5,8 @@ bound): head moving in an env whose body has a head (``head_on``), head fixed wh
 (``head_off``). It searches the variant's training homes under the training distribution: the same env
 id (with the observation the learner sees, ``target_memory`` included), heights, reward form and
 privileged state as :func:`egosearch.rl.train.train_env_kwargs` gives a training, but no start-distance
-curriculum (a training aid of RL's, not part of the task). Episodes are seeded apart from every stored
-scenario set and from the training's own seeds (:data:`DEMO_SEED_BASE`).
+curriculum (a training aid of RL's, not part of the task). Episodes are seeded apart from the training
+curve's evaluation episodes (:data:`DEMO_SEED_BASE`).
 
 Each transition is stored as the learner's replay stores it (pooled depth frames once each, mask,
 proprioception, privileged state, action, reward, flags): a :class:`egosearch.rl.replay.ReplayBuffer`
@@ -34,8 +34,9 @@ from egosearch.sim.envs import observed_env_id
 from egosearch.sim.scenarios import MAX_STEPS
 
 DEMO_SEED_BASE = 7_000_000
-"""Episode i of a collection with ``seed`` s resets with seed DEMO_SEED_BASE + 100_000 s + i: far from the
-stored scenario sets' and the trainings' seeds (all below a million)."""
+"""Episode i of a collection with ``seed`` s resets with seed DEMO_SEED_BASE + 100_000 s + i: apart from the
+training curve's evaluation episodes (``rl.train.EVAL_SEED_BASE`` + i); Table 1's scenario sets fix their
+episodes by stored start poses and targets, not by seeds."""
 DEMO_FORMAT = "egosearch-demos-v1"
 
 

@@ -24,9 +24,9 @@ rule train:
 
 
 rule demos:
-    """The frontier searcher's transitions in the variant's training homes (issue: learn from the classical
-    searcher): the head-moving searcher for a body with a head, the head-fixed one otherwise. The transitions
-    are git-ignored (*.replay.npz); the summary beside them records episodes, success and CPU time."""
+    """The frontier searcher's transitions in the variant's training homes (demonstrations for imitation and
+    RL): the head-moving searcher for a body with a head, the head-fixed one otherwise. The transitions are
+    git-ignored (*.replay.npz); the summary beside them records episodes, success and CPU time."""
     output:
         transitions="results/{profile}/demos/{variant}/seed{seed}.replay.npz",
         summary="results/{profile}/demos/{variant}/seed{seed}.json",
