@@ -10,7 +10,7 @@ import pytest
 from egosearch.rl.base import pool_depth
 from egosearch.rl.config import load_config
 from egosearch.rl.demos import DEMO_SEED_BASE, collect_demonstrations, load_demonstrations, summary_path
-from egosearch.rl.train import make_train_env, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
 
 ENV = {"layout": "kitchen_living", "placement": "everywhere"}

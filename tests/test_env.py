@@ -122,7 +122,7 @@ def test_start_radius_curriculum_starts_near_the_target():
 
 def test_training_heights_of_the_cpu_profile_reach_the_lowest_evaluation_camera():
     from egosearch.rl.config import load_config
-    from egosearch.rl.train import train_env_kwargs
+    from egosearch.rl.train_env import train_env_kwargs
 
     assert "train_heights" not in train_env_kwargs(load_config("paper"), {"layout": "kitchen_living"})
     kwargs = train_env_kwargs(load_config("cpu"), {"layout": "kitchen_living"})

@@ -53,7 +53,8 @@ def test_act_and_update_shapes(action_dim):
     assert set(m1) == set(METRIC_KEYS)
     assert np.isnan(m1["actor_loss"])  # the actor is updated every 2nd update (CURL)
     assert np.isnan(m2["aux_loss"])  # SAC+CURL's encoder has CURL's loss, no decoder
-    assert all(np.isfinite(v) for k, v in m2.items() if k != "aux_loss")
+    assert np.isnan(m2["bc_loss"])  # nor a teacher
+    assert all(np.isfinite(v) for k, v in m2.items() if k not in ("aux_loss", "bc_loss"))
     assert m2["alpha"] != pytest.approx(0.1, abs=0) and m2["alpha"] == pytest.approx(0.1, rel=1e-2)
 
 

@@ -273,13 +273,16 @@ class SacMixin:
         return float(self.log_alpha.detach().exp())
 
     def actor_and_alpha_step(self, alpha: torch.Tensor, log_pi: torch.Tensor, aq1: torch.Tensor,
-                             aq2: torch.Tensor, out: dict[str, torch.Tensor]) -> None:
+                             aq2: torch.Tensor, out: dict[str, torch.Tensor],
+                             penalty: torch.Tensor | None = None) -> None:
         """SAC's actor step (gradients to the actor's parameters only) on log pi and the critic's Q of
-        the sampled actions, then the temperature's step; the losses go into ``out``."""
+        the sampled actions, plus ``penalty`` when given (a behaviour-cloning term), then the
+        temperature's step; the losses go into ``out`` (``actor_loss`` is SAC's alone)."""
         actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
+        total = actor_loss if penalty is None else actor_loss + penalty
         self.actor_opt.zero_grad(set_to_none=True)
         actor_params = [p for g in self.actor_opt.param_groups for p in g["params"]]
-        for p, g in zip(actor_params, torch.autograd.grad(actor_loss, actor_params)):
+        for p, g in zip(actor_params, torch.autograd.grad(total, actor_params)):
             p.grad = g
         self.actor_opt.step()
         alpha_loss = (self.log_alpha.exp() * (-log_pi - self.target_entropy).detach()).mean()

@@ -20,7 +20,8 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-METRIC_KEYS = ("critic_loss", "actor_loss", "alpha", "alpha_loss", "curl_loss", "aux_loss", "entropy", "q_mean")
+METRIC_KEYS = ("critic_loss", "actor_loss", "alpha", "alpha_loss", "curl_loss", "aux_loss", "bc_loss", "entropy",
+               "q_mean")
 """What every learner's ``update`` returns (NaN for a loss not computed that update)."""
 LOG_2PI = math.log(2.0 * math.pi)
 

@@ -319,6 +319,38 @@ class LearnerConfig:
     collided twice as often as at 1.05 m), so the cpu profile trains at every Table 1 height.
     TRAINING ONLY: evaluation uses the stored scenarios' fixed heights."""
 
+    # ---- learning from the classical searcher ("sac_drq" only; the paper has no teacher) ---------
+    # The levers of learning from demonstrations: TRAINING ONLY, each a CHANGE OF ALGORITHM (a teacher
+    # the paper's learner does not have). The actor, its file and every evaluation are as without them.
+    demo_episodes: int = 0
+    """Paper: 0 (no demonstrations). N > 0: a fresh training first runs the classical frontier searcher
+    (``egosearch.searchers.frontier``, untuned, head moving where the body has a head) for N episodes of
+    its own training envs and keeps their transitions (``egosearch.rl.demos``, seeded by ``seed``), for
+    ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from frontier-exploration
+    demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations kept in replay:
+    RLPD (Ball et al., ICML 2023). Their collection is part of the training's time."""
+    bc_updates: int = 0
+    """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
+    before the first env step, this many behaviour-cloning steps of the encoder and the actor on
+    ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
+    its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
+    act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy."""
+    critic_warmup_updates: int = 0
+    """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
+    the first policy steps follow a critic fitted to it): the first this many RL updates train only
+    the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned."""
+    demo_batch_fraction: float = 0.0
+    """RLPD (Ball et al. 2023: 0.5, "symmetric sampling"): this fraction of every update's batch is
+    drawn from the demonstrations, the rest from the online replay. 0: online only (the paper)."""
+    bc_weight: float = 0.0
+    """TD3+BC (Fujimoto & Gu 2021: the actor's loss plus a squared error to the data's action, weighted
+    against the critic's scale; their alpha 2.5 is a weight of 1 / 2.5 = 0.4 here), the optional term of
+    RLPD-style training: the actor's SAC loss plus ``bc_weight`` x mean |Q| x the squared error
+    between its mean action and the teacher's on the batch's demonstration rows. It decays linearly to
+    0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none."""
+    bc_decay_steps: int = 0
+    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0."""
+
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
     """CURL: environment steps of uniformly random actions before the first update."""
@@ -428,6 +460,7 @@ class LearnerConfig:
             bad("encoder_aux_loss", f"none for algorithm {self.algorithm} (only sac_drq has a decoder)")
         if self.encoder_aux_weight < 0:
             bad("encoder_aux_weight", ">= 0")
+        self._validate_demonstrations(bad)
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
         # Updates fall on the multiples of update_every from the last warm-up step on (train._Run.update):
@@ -484,6 +517,28 @@ class LearnerConfig:
                 or self.device == "mps"):
             bad("device", "auto, cpu, cuda, cuda:N or mps")
         return self
+
+    def _validate_demonstrations(self, bad: Callable[[str, str], None]) -> None:
+        """The imitation levers read demonstrations, and only SAC-DrQ's update knows them."""
+        for name in ("demo_episodes", "bc_updates", "critic_warmup_updates", "bc_decay_steps"):
+            if getattr(self, name) < 0:
+                bad(name, "an integer >= 0")
+        if not 0.0 <= self.demo_batch_fraction < 1.0:
+            bad("demo_batch_fraction", "[0, 1) (the rest of each batch is online)")
+        if self.bc_weight < 0:
+            bad("bc_weight", ">= 0")
+        uses = {"bc_updates": self.bc_updates > 0, "demo_batch_fraction": self.demo_batch_fraction > 0,
+                "bc_weight": self.bc_weight > 0}
+        for name, used in uses.items():
+            if used and self.demo_episodes == 0:
+                bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations)")
+        if self.bc_weight > 0 and self.demo_batch_fraction == 0:
+            bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
+        if self.bc_weight > 0 and self.bc_decay_steps == 0:
+            bad("bc_decay_steps", ">= 1 with bc_weight > 0 (the env steps over which the term decays)")
+        if (self.demo_episodes or self.critic_warmup_updates) and self.algorithm != "sac_drq":
+            bad("demo_episodes" if self.demo_episodes else "critic_warmup_updates",
+                f"0 for algorithm {self.algorithm} (only sac_drq learns from demonstrations)")
 
     def _validate_ppo(self, bad: Callable[[str, str], None]) -> None:
         """The rules of an on-policy update on the rollout the loop leaves in the replay."""

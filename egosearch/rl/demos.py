@@ -4,7 +4,7 @@ The teacher is :class:`egosearch.searchers.frontier.FrontierPolicy`, untuned (it
 bound): head moving in an env whose body has a head (``head_on``), head fixed where the body has none
 (``head_off``). It searches the variant's training homes under the training distribution: the same env
 id (with the observation the learner sees, ``target_memory`` included), heights, reward form and
-privileged state as :func:`egosearch.rl.train.train_env_kwargs` gives a training, but no start-distance
+privileged state as :func:`egosearch.rl.train_env.train_env_kwargs` gives a training, but no start-distance
 curriculum (a training aid of RL's, not part of the task). Episodes are seeded apart from the training
 curve's evaluation episodes (:data:`DEMO_SEED_BASE`).
 
@@ -28,7 +28,7 @@ from egosearch.rl.base import pool_depth, pooled_side
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.run_files import atomic_json
-from egosearch.rl.train import make_train_env, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.sim.envs import observed_env_id
 from egosearch.sim.scenarios import MAX_STEPS

@@ -256,7 +256,7 @@ class ReplayBuffer:
         n_fr = min(self.frames_written, self.n_frames)
         for name, arr in self._arrays().items():
             state[name] = arr[:n_fr] if name == "frames" else arr[:n_tr]
-        state["rng"] = _rng_state_to_plain(self.rng)
+        state["rng"] = rng_to_plain(self.rng)
         state["format"] = _FORMAT
         return state
 
@@ -276,7 +276,7 @@ class ReplayBuffer:
             arr[:src.shape[0]] = src
         for name in self._SCALARS:
             setattr(self, name, bool(state[name]) if name == "in_episode" else int(state[name]))
-        self.rng.bit_generator.state = _rng_state_from_plain(state["rng"])
+        self.rng.bit_generator.state = rng_from_plain(state["rng"])
 
     def save(self, path: str | os.PathLike) -> Path:
         """Write an ``.npz`` atomically (temp file in the same folder, fsync, rename)."""
@@ -307,14 +307,16 @@ class ReplayBuffer:
         self.load_state_dict(state)
 
 
-def _rng_state_to_plain(rng: np.random.Generator) -> dict:
+def rng_to_plain(rng: np.random.Generator) -> dict:
+    """A numpy generator's state as plain values (a checkpoint stores them)."""
     state = rng.bit_generator.state
     return {"bit_generator": state["bit_generator"],
             "state": {k: str(v) for k, v in state["state"].items()},
             "has_uint32": int(state["has_uint32"]), "uinteger": str(state["uinteger"])}
 
 
-def _rng_state_from_plain(plain: dict) -> dict:
+def rng_from_plain(plain: dict) -> dict:
+    """The bit generator state that :func:`rng_to_plain` stored."""
     return {"bit_generator": plain["bit_generator"],
             "state": {k: int(v) for k, v in plain["state"].items()},
             "has_uint32": int(plain["has_uint32"]), "uinteger": int(plain["uinteger"])}

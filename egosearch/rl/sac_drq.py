@@ -25,6 +25,11 @@ one update several times cheaper:
   hidden ``state`` vector (asymmetric actor-critic); the actor never does.
 - ``encoder_aux_loss`` ("none" unless a config sets it): "reconstruction" adds SAC-AE's decoder
   of the newest frame, whose loss trains the encoder beside the critic's (a lever, not a default).
+- learning from demonstrations (off unless a config sets it; the training loop holds them):
+  :meth:`SacDrqAgent.clone_update` is a behaviour-cloning step of the encoder and actor (PIRLNav's
+  first phase); the first ``critic_warmup_updates`` updates train only the critic's head (PIRLNav);
+  a batch's ``demo`` rows (RLPD's half batches) add ``bc_weight_now`` x a behaviour-cloning term to
+  the actor's loss (TD3+BC's form), the training loop decaying ``bc_weight_now``.
 
 It is an :class:`egosearch.rl.agent.Agent`, so :mod:`egosearch.rl.train` drives it as any other
 learner (registered as "sac_drq" in :mod:`egosearch.rl.registry`).
@@ -105,6 +110,8 @@ class SacDrqAgent(SacDrqBase):
     optional ``discount`` (B, 1) column (gamma^n of n-step returns; default gamma)."""
 
     agent_format = AGENT_FORMAT
+    bc_weight_now: float = 0.0
+    """The behaviour-cloning term's weight at this update (``bc_weight``, decayed by the training loop)."""
 
     def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
                  device: str | torch.device | None = None, state_dim: int = 0):
@@ -143,6 +150,8 @@ class SacDrqAgent(SacDrqBase):
         nxt = random_shift(batch["next_obs_depth"].float(), cfg.aug_pad)
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
+        # PIRLNav's critic warm-up: the cloned encoder and actor stay as they are
+        warming_up = self.num_updates <= cfg.critic_warmup_updates
 
         with torch.no_grad():
             h_next = self.encoder(nxt)
@@ -151,7 +160,8 @@ class SacDrqAgent(SacDrqBase):
             tq1, tq2 = self.critic_target(h_next, next_critic_extra, next_pi)
             target_q = batch["reward"] + batch["not_done"] * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
 
-        h = self.encoder(obs)
+        with torch.set_grad_enabled(not warming_up):
+            h = self.encoder(obs)
         q1, q2 = self.critic(h, critic_extra, batch["action"])
         critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
         loss = critic_loss
@@ -168,15 +178,41 @@ class SacDrqAgent(SacDrqBase):
             self.optimisers["decoder"].step()
         out["critic_loss"], out["q_mean"] = critic_loss, q1.mean()
 
-        if self.num_updates % cfg.actor_update_freq == 0:
+        if self.num_updates % cfg.actor_update_freq == 0 and not warming_up:
             h_actor = h.detach()
             mu, log_std = self.actor(h_actor, extra)
             pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
             aq1, aq2 = self.critic(h_actor, critic_extra, pi)
-            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out)
+            penalty = None
+            if self.bc_weight_now > 0 and "demo" in batch:
+                # TD3+BC: the squared error to the teacher, scaled by the critic's magnitude
+                demo = batch["demo"]
+                error = ((torch.tanh(mu) - batch["action"]).pow(2).sum(-1, keepdim=True) * demo).sum()
+                out["bc_loss"] = error / demo.sum().clamp(min=1.0)
+                penalty = self.bc_weight_now * torch.min(aq1, aq2).abs().mean().detach() * out["bc_loss"]
+            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out, penalty)
             out["entropy"] = gaussian_entropy(log_std)
 
         return self.finish_update(out)
+
+    def clone_update(self, batch: dict[str, torch.Tensor], optimiser: torch.optim.Optimizer) -> dict[str, float]:
+        """A behaviour-cloning step (PIRLNav's first phase) of the encoder and the actor, with ``optimiser``
+        over their parameters: the squared error between the actor's mean action (after its tanh) and the
+        batch's, summed over the action's values, on shifted frames as in :meth:`update`. Returns
+        ``bc_loss``. (The log-likelihood of the teacher's actions, tried first, fitted the mean far
+        worse: the teacher's actions sit at +-1 half of the time, where the tanh's inverse blows up.)"""
+        extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
+        h = self.encoder(random_shift(batch["obs_depth"].float(), self.cfg.aug_pad))
+        mu, _ = self.actor(h, extra)
+        loss = (torch.tanh(mu) - batch["action"]).pow(2).sum(-1).mean()
+        optimiser.zero_grad(set_to_none=True)
+        loss.backward()
+        optimiser.step()
+        return {"bc_loss": float(loss.detach())}
+
+    def clone_parameters(self) -> list[torch.nn.Parameter]:
+        """What behaviour cloning trains: the encoder and the actor."""
+        return [*self.encoder.parameters(), *self.actor.parameters()]
 
     # ---- persistence -----------------------------------------------------------------------
     def state_dict(self) -> dict[str, Any]:

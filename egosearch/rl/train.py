@@ -16,7 +16,14 @@ leaves is run by :class:`egosearch.rl.actor.ActorPolicy`.
   never commit it);
 - ``actor.pt``: actor-only weights + metadata (variant, env_id, config), readable with
   ``torch.load(weights_only=True)``; load it with :class:`egosearch.rl.actor.ActorPolicy`;
+- ``ckpt/demos.replay.npz`` (+ ``ckpt/demos.json``): with ``cfg.demo_episodes``, the frontier
+  searcher's transitions that the run learns from (:mod:`egosearch.rl.demos`), collected at the
+  fresh start, deleted with the checkpoint; ``done.json`` keeps their summary;
 - ``done.json``: written last; its presence means the run is complete.
+
+With ``cfg.bc_updates`` a fresh run clones the teacher (behaviour cloning of the encoder and the
+actor on the demonstrations) before its step-0 evaluation, so curve.csv's first row is the cloned
+policy; ``train.csv`` gets one row at step 0 with the cloning's last loss (``bc_loss``).
 
 Killing the process at any moment and running the same call again resumes from the last
 checkpoint: CSV rows written after that checkpoint are dropped and recomputed, so the CSVs end up
@@ -48,8 +55,9 @@ from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.demos import collect_demonstrations, load_demonstrations, summary_path
 from egosearch.rl.registry import learner, make_agent
-from egosearch.rl.replay import MultiReplay
+from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (
     CHECKPOINT_FORMAT,
     CHECKPOINT_NAME,
@@ -66,17 +74,15 @@ from egosearch.rl.run_files import (
     to_numpy,
     to_tensors,
 )
-from egosearch.scene.layouts import LAYOUT_NAMES
-from egosearch.sim.agent import AgentSpec
+from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.sim.envs import observed_env_id
-from egosearch.sim.home_pool import HomePoolEnv
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
 CURVE_EPISODE_COLUMNS = ("env_steps", "home", "height", "scenario_id", "success", "shortest_path", "path_length")
 TRAIN_COLUMNS = ("env_steps", "episodes", "updates", "train_return", "train_success", "critic_loss",
-                 "actor_loss", "alpha_loss", "curl_loss", "aux_loss", "alpha", "entropy", "q_mean", "steps_per_s",
-                 "updates_per_s", "wall_s")
+                 "actor_loss", "alpha_loss", "curl_loss", "aux_loss", "bc_loss", "alpha", "entropy", "q_mean",
+                 "steps_per_s", "updates_per_s", "wall_s")
 EVAL_SEED_BASE = 1_000_000
 """Default evaluation: episode i is ``reset(seed=EVAL_SEED_BASE + i)``, the same at every
 evaluation, for every training seed and variant."""
@@ -169,14 +175,6 @@ def torch_threads(requested: int = 0) -> int:
     return os.cpu_count() or 1
 
 
-def make_train_env(env_id: str, env_kwargs: dict):
-    if env_kwargs.get("layout") in ("generated", "paper_homes"):  # several homes (egosearch.sim.home_pool)
-        if env_kwargs["layout"] == "paper_homes":
-            return HomePoolEnv(env_id, home_names=LAYOUT_NAMES, **env_kwargs)
-        return HomePoolEnv(env_id, **env_kwargs)
-    return gymnasium.make(env_id, **env_kwargs)
-
-
 # ---- training -----------------------------------------------------------------------------
 
 def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwargs: dict | None = None,
@@ -235,23 +233,6 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
         torch.set_num_threads(threads_before)
 
 
-def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
-    """The training envs' keyword arguments: the variant's, with r_d's form
-    (``train_distance_reward``) and the training heights (``train_height_min``) from the learner
-    config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
-    privileged state when the critic reads it (``critic_privileged_state``). The paper's values are
-    the env's defaults, so they are not passed (envs without the options still train)."""
-    aids: dict = {}
-    if cfg.train_distance_reward != "distance":
-        aids["distance_reward"] = cfg.train_distance_reward
-    paper_low, paper_high = AgentSpec().train_height_range
-    if cfg.train_height_min != paper_low:
-        aids["train_heights"] = (cfg.train_height_min, paper_high)
-    if cfg.critic_privileged_state:
-        aids["privileged_state"] = True
-    return {**aids, **env_kwargs}
-
-
 def _act_batch(agent: Agent, observations: list[dict]) -> list[np.ndarray]:
     # a recurrent agent's act() is the evaluation episode's: training envs always go through act_batch
     if len(observations) == 1 and not agent.recurrent:
@@ -273,7 +254,7 @@ def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
 def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
            progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None) -> dict:
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
-    run = _Run(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt)
+    run = _Run(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
     own_eval = evaluate_fn is None
     evaluate_fn = evaluate_fn or default_evaluator(env_id, env_kwargs, cfg.eval_episodes)
     bar = run.open_progress(progress)
@@ -281,6 +262,7 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
     last_row = None
     try:
         if run.step == 0 and run.curve.rows() == 0:
+            run.imitate()
             last_row = run.evaluate(evaluate_fn)
         while run.step < cfg.total_env_steps:
             before = run.step
@@ -320,7 +302,7 @@ class _Run:
     resets, updates), so that a resumed run equals the one that was not stopped."""
 
     def __init__(self, envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, variant: str,
-                 ckpt: dict | None):
+                 ckpt: dict | None, progress: bool = False):
         self.envs, self.env_id, self.cfg, self.variant = envs, env_id, cfg, variant
         self.out_dir, self.env_kwargs = out_dir, env_kwargs
         self.ckpt_path, self.done_path = out_dir / CHECKPOINT_NAME, out_dir / "done.json"
@@ -351,6 +333,7 @@ class _Run:
         self.policy = AgentPolicy(self.agent)
         self.say = print
         self.means = {"curve": _Mean(), "train": _Mean()}
+        self.demos, self.demo_summary = self._demonstrations(ckpt, progress)
 
     # ---- start ----------------------------------------------------------------------------
     def _fresh(self) -> list[int]:
@@ -378,6 +361,31 @@ class _Run:
         # The run that was not stopped cut its episodes here too (see restart_episodes).
         self.replay.end_episodes()
         return self._restart_seeds()
+
+    def _demonstrations(self, ckpt: dict | None, progress: bool) -> tuple[MultiReplay | None, dict | None]:
+        """The teacher's transitions (``demo_episodes``): collected at a fresh start, read back on resume."""
+        cfg = self.cfg
+        if not cfg.demo_episodes:
+            return None, None
+        path = self.demos_path
+        if ckpt is None or not path.exists():
+            if ckpt is not None:
+                raise CheckpointError(f"{self.ckpt_path} needs the run's demonstrations {path}, which are gone")
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self.say(f"collecting {cfg.demo_episodes} demonstration episodes of the frontier searcher -> {path}")
+            collect_demonstrations(self.env_id, cfg, self.env_kwargs, cfg.demo_episodes, path, seed=cfg.seed,
+                                   progress=progress)
+        demos = load_demonstrations(path, cfg, str(self.device))
+        if ckpt is not None and "demo_rng" in ckpt:
+            demos.buffers[0].rng.bit_generator.state = rng_from_plain(ckpt["demo_rng"])
+        summary = json.loads(summary_path(path).read_text(encoding="utf-8"))
+        self.say(f"demonstrations: {summary['episodes']} frontier episodes, {summary['transitions']} transitions, "
+                 f"teacher success {summary['teacher_success']:.2f}, {summary['cpu_s']:.0f} CPU-s")
+        return demos, summary
+
+    @property
+    def demos_path(self) -> Path:
+        return self.ckpt_path.parent / "demos.replay.npz"
 
     def _restart_seeds(self) -> list[int]:
         return [self.cfg.seed + 7919 * self.step + 104_729 * i for i in range(len(self.envs))]
@@ -425,8 +433,9 @@ class _Run:
         return e.reset(seed=seed, options=None if radius is None else {"start_radius": radius})[0]
 
     def actions(self, live: list) -> list[np.ndarray]:
-        """Uniform random actions during the warm-up, the agent's samples after it."""
-        if self.step < self.cfg.init_steps:
+        """Uniform random actions during the warm-up (the cloned policy's samples after behaviour
+        cloning), the agent's samples after it."""
+        if self.step < self.cfg.init_steps and not self.cfg.bc_updates:
             return [e.action_space.sample() for e in live]
         return _act_batch(self.agent, self.observations[: len(live)])
 
@@ -471,14 +480,41 @@ class _Run:
         if self.step < cfg.init_steps:
             return
         first_due = max(before, cfg.init_steps - 1)
+        if cfg.bc_weight:
+            self.agent.bc_weight_now = cfg.bc_weight * max(0.0, 1.0 - self.step / cfg.bc_decay_steps)
         for _ in range((self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step):
             metrics = self.agent.update(self.sample())
             self.means["curve"].add(metrics)
             self.means["train"].add(metrics)
 
     def sample(self) -> dict:
-        """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout)."""
-        return self.agent.sample_batch(self.replay)
+        """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout);
+        with ``demo_batch_fraction`` that share drawn from the demonstrations (marked by ``demo``)."""
+        if self.demos is None or not self.cfg.demo_batch_fraction:
+            return self.agent.sample_batch(self.replay)
+        size = self.cfg.batch_size
+        from_demos = round(size * self.cfg.demo_batch_fraction)
+        online, demo = self.replay.sample(size - from_demos), self.demos.sample(from_demos)
+        batch = {k: torch.cat([online[k], demo[k]]) for k in online}
+        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
+        return batch
+
+    # ---- imitating ------------------------------------------------------------------------
+    def imitate(self) -> None:
+        """Behaviour cloning on the demonstrations (``bc_updates`` steps), at a fresh start only."""
+        cfg = self.cfg
+        if not cfg.bc_updates:
+            return
+        optimiser = torch.optim.Adam(self.agent.clone_parameters(), lr=cfg.actor_lr,
+                                     betas=(cfg.actor_beta1, cfg.actor_beta2))
+        t0, losses = time.perf_counter(), deque(maxlen=100)
+        for i in range(cfg.bc_updates):
+            losses.append(self.agent.clone_update(self.demos.sample(cfg.batch_size), optimiser)["bc_loss"])
+            if (i + 1) % max(cfg.bc_updates // 10, 1) == 0 or i + 1 == cfg.bc_updates:
+                self.say(f"behaviour cloning {i + 1}/{cfg.bc_updates}: squared error {np.mean(losses):.3f} "
+                         f"({time.perf_counter() - t0:.0f} s)")
+        self.train_log.write({"env_steps": 0, "episodes": 0, "updates": 0, "bc_loss": float(np.mean(losses)),
+                              "alpha": self.agent.alpha, "wall_s": self.wall()})
 
     # ---- logging and evaluating -----------------------------------------------------------
     def log_train(self, bar=None) -> None:
@@ -527,6 +563,8 @@ class _Run:
             "agent": self.agent.state_dict(), "replay": to_tensors(self.replay.state_dict()),
             "rng": rng_states(self.envs),
         }
+        if self.demos is not None:
+            state["demo_rng"] = rng_to_plain(self.demos.buffers[0].rng)
         atomic_write(self.ckpt_path, lambda f: torch.save(state, f))
 
     def machine(self) -> dict:
@@ -562,7 +600,12 @@ class _Run:
                    # wall_s is core time only on the machine that ran it: the budget study shows which
                    "machine": self.machine(),
                    "config": cfg.to_dict()}
+        if self.demo_summary is not None:
+            summary["demonstrations"] = self.demo_summary
         atomic_json(self.done_path, summary)
+        if not cfg.keep_checkpoint:
+            for demos in (self.demos_path, summary_path(self.demos_path)):
+                demos.unlink(missing_ok=True)
         if not cfg.keep_checkpoint and self.ckpt_path.exists():
             self.ckpt_path.unlink()
             try:
