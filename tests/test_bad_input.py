@@ -42,6 +42,12 @@ BAD_VARIANT_FILES = [
      "ablations/steps_below_warmup.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=500 is "
      "out of range; allowed: >= 4000, the env step of the first update (after init_steps=4000 random steps, an "
      "update every 4 steps): fewer train no update"),
+    ("cloning_without_teacher", HEAD + "config: {bc_updates: 5000}\n",
+     "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=5000 is "
+     "out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations)"),
+    ("half_batches_all_demos", HEAD + "config: {demo_episodes: 100, demo_batch_fraction: 1.0}\n",
+     "ablations/half_batches_all_demos.yaml: config (on the cpu learner profile): "
+     "LearnerConfig.demo_batch_fraction=1.0 is out of range; allowed: [0, 1) (the rest of each batch is online)"),
     ("flag_word", HEAD + "config: {encoder_tanh: maybe}\n",
      "ablations/flag_word.yaml: config: encoder_tanh='maybe' is not a bool"),
     ("config_list", HEAD + "config: [1, 2]\n",
@@ -253,7 +259,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["demos", "--variant", "head_on", "--episodes", "0", "--out", str(tmp_path / "d.replay.npz")],
          "egosearch demos: error: --episodes=0: a number of episodes must be >= 1"),
         (["demos", "--variant", "head_on", "--episodes", "5", "--out", str(tmp_path / "d.npz")],
-         f"egosearch demos: error: --out '{tmp_path / 'd.npz'}': name it *.replay.npz (git-ignored: hundreds of MB)"),
+         f"egosearch demos: error: --out={tmp_path / 'd.npz'}: a demonstrations file (git-ignored: hundreds of MB) "
+         "must end in .replay.npz"),
         (["bench", "gpu", "--seconds", "60"],
          "egosearch bench: error: bench gpu needs --out-dir (the paper-profile training's folder)"),
         (["bench", "gpu", "--seconds", "-1", "--out-dir", str(tmp_path / "run")],

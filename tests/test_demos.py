@@ -59,7 +59,3 @@ def test_demonstrations_sample_as_the_learners_replay_with_n_step_returns(demos)
     assert (batch["discount"] <= cfg.gamma + 1e-6).all()
     assert (batch["discount"] >= cfg.gamma ** cfg.n_step - 1e-6).all()
 
-
-def test_a_demonstrations_file_is_named_for_git_to_ignore(tmp_path):
-    with pytest.raises(ValueError, match="replay.npz"):
-        collect_demonstrations("EgoSearch-v0", load_config("cpu", {}), ENV, 1, tmp_path / "d.npz", progress=False)

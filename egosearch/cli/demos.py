@@ -4,15 +4,14 @@ from __future__ import annotations
 
 import json
 
-from egosearch.cli.checks import at_least, check_seed
+from egosearch.cli.checks import at_least, check_seed, check_suffix
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.demos import collect_demonstrations, summary_path
 from egosearch.variants import resolve_variant
 
 
 def run(args) -> None:
-    if not args.out.endswith(".replay.npz"):
-        raise ValueError(f"--out {args.out!r}: name it *.replay.npz (git-ignored: hundreds of MB)")
+    check_suffix("--out", args.out, (".replay.npz",), "a demonstrations file (git-ignored: hundreds of MB)")
     check_outputs(files={"--out": args.out})
     check_overwrites(files={"--out": args.out, "--out (summary)": str(summary_path(args.out))}, force=args.force)
     at_least("--episodes", args.episodes, 1, "a number of episodes")

@@ -54,8 +54,6 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
     if episodes < 1:
         raise ValueError(f"episodes={episodes}; allowed: >= 1")
     out_path = Path(out_path)
-    if not out_path.name.endswith(".replay.npz"):
-        raise ValueError(f"{out_path}: a demonstrations file is named *.replay.npz (git-ignored)")
     observed = observed_env_id(env_id, cfg.target_memory)
     env = make_train_env(observed, train_env_kwargs(cfg, env_kwargs))
     cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -86,7 +84,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
             returns.append(total)
             if bar is not None:
                 bar.update(1)
-                bar.set_postfix(success=f"{np.mean(successes):.2f}", steps=sum(lengths))
+                bar.set_postfix(success=f"{np.mean(successes):.2f}", steps=sum(lengths), refresh=False)
         if bar is not None:
             bar.close()
     finally:

@@ -1,0 +1,144 @@
+"""Learning from the classical searcher: behaviour cloning, the critic's warm-up, the behaviour-cloning
+term on the actor, and a training that holds demonstrations (half batches, resumable)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import torch
+
+from egosearch.rl.config import load_config
+from egosearch.rl.demos import collect_demonstrations, load_demonstrations
+from egosearch.rl.run_files import CHECKPOINT_NAME
+from egosearch.rl.sac_drq import SacDrqAgent
+from egosearch.rl.train import train
+
+ENV = {"layout": "kitchen_living", "placement": "everywhere"}
+SMALL = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2,
+         "encoder_stride2_layers": 2, "aug_pad": 1, "target_memory": True, "critic_privileged_state": True,
+         "train_height_min": 0.45, "n_step": 3, "batch_size": 32, "actor_update_freq": 1,
+         "critic_target_update_freq": 1}
+"""The cpu profile's learner and observation at smoke sizes."""
+
+
+@pytest.fixture(scope="module")
+def demos(tmp_path_factory):
+    cfg = load_config("smoke", {**SMALL, "seed": 2})
+    path = tmp_path_factory.mktemp("demos") / "teacher.replay.npz"
+    collect_demonstrations("EgoSearch-v0", cfg, ENV, 3, path, seed=2, progress=False)
+    replay = load_demonstrations(path, cfg)
+    return cfg, replay
+
+
+def new_agent(cfg, replay) -> SacDrqAgent:
+    torch.manual_seed(0)
+    batch = replay.sample(2)
+    return SacDrqAgent(cfg, 5, batch["mask"].shape[1], batch["proprio"].shape[1], "cpu", batch["state"].shape[1])
+
+
+def squared_error(agent: SacDrqAgent, batch: dict) -> float:
+    """The actor's mean action against the batch's, summed over an action's values, mean over the batch."""
+    with torch.no_grad():
+        extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
+        mu, _ = agent.actor(agent.encoder(batch["obs_depth"].float()), extra)
+        return float((torch.tanh(mu) - batch["action"]).pow(2).sum(-1).mean())
+
+
+def parameters(module: torch.nn.Module) -> list[torch.Tensor]:
+    return [p.detach().clone() for p in module.parameters()]
+
+
+def same(a: list[torch.Tensor], b: list[torch.Tensor]) -> bool:
+    return all(torch.equal(x, y) for x, y in zip(a, b))
+
+
+def test_cloning_fits_the_teachers_actions_and_leaves_the_critic_alone(demos):
+    cfg, replay = demos
+    agent = new_agent(cfg, replay)
+    held = replay.sample(200)
+    before, critic = squared_error(agent, held), parameters(agent.critic)
+    optimiser = torch.optim.Adam(agent.clone_parameters(), lr=1e-3)
+    for _ in range(150):
+        metrics = agent.clone_update(replay.sample(32), optimiser)
+    after = squared_error(agent, held)
+    assert after < 0.5 * before, (before, after)
+    assert set(metrics) == {"bc_loss"} and metrics["bc_loss"] >= 0
+    assert same(critic, parameters(agent.critic))
+    assert agent.num_updates == 0  # cloning is not an RL update: the critic's warm-up counts from the first
+
+
+def test_the_critic_warms_up_while_the_clone_stays_as_it_is(demos):
+    cfg, replay = demos
+    agent = new_agent(load_config("smoke", {**SMALL, "demo_episodes": 3, "critic_warmup_updates": 2}), replay)
+    encoder, actor, critic = parameters(agent.encoder), parameters(agent.actor), parameters(agent.critic)
+    alpha = agent.alpha
+    for _ in range(2):
+        metrics = agent.update(replay.sample(32))
+        assert metrics["actor_loss"] != metrics["actor_loss"]  # NaN: no actor step
+    assert same(encoder, parameters(agent.encoder)) and same(actor, parameters(agent.actor))
+    assert agent.alpha == alpha
+    assert not same(critic, parameters(agent.critic))
+    agent.update(replay.sample(32))  # the third: SAC as usual
+    assert not same(encoder, parameters(agent.encoder)) and not same(actor, parameters(agent.actor))
+
+
+def test_the_cloning_term_pulls_the_actor_to_the_teacher_on_the_demonstration_rows(demos):
+    cfg, replay = demos
+    held = replay.sample(200)
+    errors, bc_losses = {}, {}
+    for weight in (0.0, 50.0):
+        agent = new_agent(cfg, replay)
+        agent.bc_weight_now = weight
+        torch.manual_seed(1)
+        for _ in range(60):
+            batch = replay.sample(32)
+            batch["demo"] = torch.cat([torch.zeros(16, 1), torch.ones(16, 1)])
+            metrics = agent.update(batch)
+        errors[weight], bc_losses[weight] = squared_error(agent, held), metrics["bc_loss"]
+    assert errors[50.0] < 0.7 * errors[0.0], errors
+    assert bc_losses[0.0] != bc_losses[0.0] and bc_losses[50.0] >= 0  # logged only when the term is on
+
+
+def constant_evaluator(policy) -> dict:
+    return {"success_rate": 0.5, "spl": 0.25, "episode_return": 1.0}
+
+
+def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_run(tmp_path, monkeypatch):
+    cfg = load_config("smoke", {**SMALL, "seed": 4, "demo_episodes": 2, "bc_updates": 20, "critic_warmup_updates": 10,
+                                "demo_batch_fraction": 0.25, "bc_weight": 0.4, "bc_decay_steps": 200})
+    from egosearch.rl import train as train_module
+
+    drawn = []
+    sample = train_module._Run.sample
+
+    def counting(run):
+        batch = sample(run)
+        drawn.append(int(batch["demo"].sum()))
+        return batch
+
+    monkeypatch.setattr(train_module._Run, "sample", counting)
+    whole, resumed = tmp_path / "whole", tmp_path / "resumed"
+    train("EgoSearch-v0", cfg, whole, ENV, constant_evaluator, progress=False)
+    assert drawn and set(drawn) == {8}  # a quarter of 32 from the demonstrations, every update
+
+    class Stop(Exception):
+        pass
+
+    def stop(step: int) -> None:
+        if step == 230:
+            raise Stop
+
+    with pytest.raises(Stop):
+        train("EgoSearch-v0", cfg, resumed, ENV, constant_evaluator, progress=False, on_step=stop)
+    assert (resumed / CHECKPOINT_NAME).parent.joinpath("demos.replay.npz").exists()
+    train("EgoSearch-v0", cfg, resumed, ENV, constant_evaluator, progress=False)
+    a, b = (torch.load(run / "actor.pt", weights_only=True)["state_dict"] for run in (whole, resumed))
+    assert all(torch.equal(a[k], b[k]) for k in a)
+
+    done = json.loads((whole / "done.json").read_text())
+    assert done["demonstrations"]["episodes"] == 2 and done["demonstrations"]["teacher_head"]
+    assert not (whole / CHECKPOINT_NAME).parent.exists()  # the demonstrations went with the checkpoint
+    first = (whole / "train.csv").read_text().splitlines()[1].split(",")
+    header = (whole / "train.csv").read_text().splitlines()[0].split(",")
+    assert float(first[header.index("env_steps")]) == 0 and float(first[header.index("bc_loss")]) > 0
