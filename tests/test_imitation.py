@@ -136,6 +136,21 @@ def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_
     a, b = (torch.load(run / "actor.pt", weights_only=True)["state_dict"] for run in (whole, resumed))
     assert all(torch.equal(a[k], b[k]) for k in a)
 
+    # a run stopped before its first checkpoint (while cloning, say) keeps its demonstrations and starts from them
+    early = tmp_path / "early"
+    with pytest.raises(Stop):
+        train("EgoSearch-v0", cfg, early, ENV, constant_evaluator, progress=False,
+              on_step=lambda step: stop(230 if step == 40 else step))
+    assert not (early / CHECKPOINT_NAME).exists()
+
+    def collect_again(*args, **kwargs):
+        raise AssertionError("collected again")
+
+    monkeypatch.setattr(train_module, "collect_demonstrations", collect_again)
+    train("EgoSearch-v0", cfg, early, ENV, constant_evaluator, progress=False)
+    c = torch.load(early / "actor.pt", weights_only=True)["state_dict"]
+    assert all(torch.equal(a[k], c[k]) for k in a)
+
     done = json.loads((whole / "done.json").read_text())
     assert done["demonstrations"]["episodes"] == 2 and done["demonstrations"]["teacher_head"]
     assert not (whole / CHECKPOINT_NAME).parent.exists()  # the demonstrations went with the checkpoint

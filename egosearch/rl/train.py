@@ -368,9 +368,9 @@ class _Run:
         if not cfg.demo_episodes:
             return None, None
         path = self.demos_path
-        if ckpt is None or not path.exists():
-            if ckpt is not None:
-                raise CheckpointError(f"{self.ckpt_path} needs the run's demonstrations {path}, which are gone")
+        if ckpt is not None and not path.exists():
+            raise CheckpointError(f"{self.ckpt_path} needs the run's demonstrations {path}, which are gone")
+        if ckpt is None and not self._own_demonstrations(path):  # kept when a run stopped before its checkpoint
             path.parent.mkdir(parents=True, exist_ok=True)
             self.say(f"collecting {cfg.demo_episodes} demonstration episodes of the frontier searcher -> {path}")
             collect_demonstrations(self.env_id, cfg, self.env_kwargs, cfg.demo_episodes, path, seed=cfg.seed,
@@ -382,6 +382,19 @@ class _Run:
         self.say(f"demonstrations: {summary['episodes']} frontier episodes, {summary['transitions']} transitions, "
                  f"teacher success {summary['teacher_success']:.2f}, {summary['cpu_s']:.0f} CPU-s")
         return demos, summary
+
+    def _own_demonstrations(self, path: Path) -> bool:
+        """Whether ``path`` holds the demonstrations this run would collect (same teacher episodes, stored
+        as this learner stores them): a run killed while cloning starts again from them."""
+        try:
+            held = json.loads(summary_path(path).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return False
+        cfg = self.cfg
+        wanted = {"env_id": self.env_id, "env_kwargs": json.loads(json.dumps(train_env_kwargs(cfg, self.env_kwargs))),
+                  "seed": cfg.seed, "episodes": cfg.demo_episodes, "frame_history": cfg.frame_history,
+                  "image_size": self.agent.replay_image_size}
+        return path.exists() and all(held.get(key) == value for key, value in wanted.items())
 
     @property
     def demos_path(self) -> Path:
