@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 import torch
 
@@ -157,3 +158,50 @@ def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_
     first = (whole / "train.csv").read_text().splitlines()[1].split(",")
     header = (whole / "train.csv").read_text().splitlines()[0].split(",")
     assert float(first[header.index("env_steps")]) == 0 and float(first[header.index("bc_loss")]) > 0
+
+
+def test_cloning_draws_from_each_source_in_proportion_to_its_size():
+    from egosearch.rl.imitation import proportional_counts
+
+    assert proportional_counts([90, 10], 64) == [58, 6]  # 57.6 and 6.4: the larger remainder gets the rest
+    assert proportional_counts([1, 1, 1], 32) == [11, 11, 10]
+    assert sum(proportional_counts([5, 700, 33], 64)) == 64
+
+
+class StandStill:
+    """A student that never moves: the teacher must still label every state it is shown."""
+
+    replay_image_size = 50
+
+    def act(self, obs, deterministic=True):
+        return np.zeros(5, np.float32)
+
+
+def test_dagger_labels_each_state_the_student_reaches_with_the_teachers_action(demos):
+    from egosearch.rl.imitation import DAGGER_SEED_BASE, dagger_round
+    from egosearch.rl.train_env import make_train_env, train_env_kwargs
+    from egosearch.searchers.frontier import FrontierPolicy
+
+    cfg, _ = demos
+    labelled, figures = dagger_round(StandStill(), "EgoSearchMemory-v0", cfg, ENV, 1, round_index=1)
+    buf = labelled.buffers[0]
+    assert figures["episodes"] == 1 and figures["transitions"] == buf.n_added > 0
+    # the same episode again: the student stands still, a fresh teacher says what it would do at each state
+    env = make_train_env("EgoSearchMemory-v0", train_env_kwargs(cfg, ENV))
+    obs, _ = env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg.seed + 10_000 * 1)
+    teacher = FrontierPolicy(env)
+    teacher.reset()
+    for t in range(buf.n_added):
+        np.testing.assert_allclose(buf.action[t], teacher.act(obs), atol=1e-6)
+        obs, *_ = env.step(np.zeros(5, np.float32))
+    env.close()
+    assert np.abs(buf.action[:buf.n_added]).max() > 0.1  # the teacher wanted to move
+
+
+def test_a_training_with_dagger_records_its_rounds(tmp_path):
+    cfg = load_config("smoke", {**SMALL, "seed": 5, "demo_episodes": 2, "bc_updates": 10, "dagger_rounds": 2,
+                                "dagger_episodes": 1, "total_env_steps": 150, "init_steps": 100, "eval_every": 150,
+                                "checkpoint_every": 150})
+    done = train("EgoSearch-v0", cfg, tmp_path, ENV, constant_evaluator, progress=False)
+    assert [r["round"] for r in done["dagger"]] == [1, 2]
+    assert all(r["episodes"] == 1 and r["transitions"] > 0 for r in done["dagger"])

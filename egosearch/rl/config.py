@@ -335,6 +335,15 @@ class LearnerConfig:
     ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
     its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
     act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy."""
+    dagger_rounds: int = 0
+    """Paper: 0. DAgger (Ross, Gordon & Bagnell 2011), after ``bc_updates``: this many rounds in which the
+    cloned student drives ``dagger_episodes`` training-side episodes (its mean action), the teacher labels
+    every state it reaches (the frontier searcher's map updates from whatever it sees), the labelled states
+    join the demonstrations for cloning only (their actions are the teacher's, not the ones taken, so RL
+    never samples them), and the student is cloned again for ``bc_updates`` steps on all of them, drawn in
+    proportion to their sizes (``egosearch.rl.imitation``)."""
+    dagger_episodes: int = 0
+    """Ours (with ``dagger_rounds``): episodes the student drives in each DAgger round."""
     critic_warmup_updates: int = 0
     """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
     the first policy steps follow a critic fitted to it): the first this many RL updates train only
@@ -520,7 +529,8 @@ class LearnerConfig:
 
     def _validate_demonstrations(self, bad: Callable[[str, str], None]) -> None:
         """The imitation levers read demonstrations, and only SAC-DrQ's update knows them."""
-        for name in ("demo_episodes", "bc_updates", "critic_warmup_updates", "bc_decay_steps"):
+        for name in ("demo_episodes", "bc_updates", "critic_warmup_updates", "bc_decay_steps", "dagger_rounds",
+                     "dagger_episodes"):
             if getattr(self, name) < 0:
                 bad(name, "an integer >= 0")
         if not 0.0 <= self.demo_batch_fraction < 1.0:
@@ -532,6 +542,12 @@ class LearnerConfig:
         for name, used in uses.items():
             if used and self.demo_episodes == 0:
                 bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations)")
+        if self.dagger_rounds and not self.bc_updates:
+            bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
+        if bool(self.dagger_rounds) != bool(self.dagger_episodes):
+            bad("dagger_episodes", "1..10000 with dagger_rounds >= 1, else 0")
+        if self.dagger_episodes > 10_000:
+            bad("dagger_episodes", "1..10000 (a round's episodes stay below the next round's seeds)")
         if self.bc_weight > 0 and self.demo_batch_fraction == 0:
             bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
         if self.bc_weight > 0 and self.bc_decay_steps == 0:

@@ -71,12 +71,12 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
                 obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * seed + episode)
             teacher = FrontierPolicy(getattr(env, "current", env))  # a pool of homes swaps its env on reset
             teacher.reset()
-            stored = _stored(obs, cfg)
+            stored = stored_observation(obs, cfg)
             total, steps, terminated, truncated = 0.0, 0, False, False
             while not (terminated or truncated):
                 action = teacher.act(obs)
                 obs, reward, terminated, truncated, _ = env.step(action)
-                next_stored = _stored(obs, cfg)
+                next_stored = stored_observation(obs, cfg)
                 buffer.add(stored, action, float(reward), next_stored, terminated, truncated)
                 stored, total, steps = next_stored, total + float(reward), steps + 1
             successes.append(bool(terminated))
@@ -118,7 +118,8 @@ def load_demonstrations(path: str | Path, cfg: LearnerConfig, device: str = "cpu
     return replay
 
 
-def _stored(obs: dict, cfg: LearnerConfig) -> dict:
+def stored_observation(obs: dict, cfg: LearnerConfig) -> dict:
+    """An env observation as the learner's replay stores it: the depth frames pooled by ``obs_downsample``."""
     return {**obs, "depth": pool_depth(np.asarray(obs["depth"]), cfg.obs_downsample)}
 
 

@@ -56,6 +56,7 @@ from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.demos import collect_demonstrations, load_demonstrations, summary_path
+from egosearch.rl.imitation import clone, dagger_round
 from egosearch.rl.registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (
@@ -334,6 +335,7 @@ class _Run:
         self.say = print
         self.means = {"curve": _Mean(), "train": _Mean()}
         self.demos, self.demo_summary = self._demonstrations(ckpt, progress)
+        self.imitation: dict = {"dagger": []} if ckpt is None else dict(ckpt.get("imitation", {"dagger": []}))
 
     # ---- start ----------------------------------------------------------------------------
     def _fresh(self) -> list[int]:
@@ -514,19 +516,26 @@ class _Run:
 
     # ---- imitating ------------------------------------------------------------------------
     def imitate(self) -> None:
-        """Behaviour cloning on the demonstrations (``bc_updates`` steps), at a fresh start only."""
+        """Behaviour cloning on the demonstrations (``bc_updates`` steps), then ``dagger_rounds`` DAgger
+        rounds (:mod:`egosearch.rl.imitation`), at a fresh start only."""
         cfg = self.cfg
         if not cfg.bc_updates:
             return
         optimiser = torch.optim.Adam(self.agent.clone_parameters(), lr=cfg.actor_lr,
                                      betas=(cfg.actor_beta1, cfg.actor_beta2))
-        t0, losses = time.perf_counter(), deque(maxlen=100)
-        for i in range(cfg.bc_updates):
-            losses.append(self.agent.clone_update(self.demos.sample(cfg.batch_size), optimiser)["bc_loss"])
-            if (i + 1) % max(cfg.bc_updates // 10, 1) == 0 or i + 1 == cfg.bc_updates:
-                self.say(f"behaviour cloning {i + 1}/{cfg.bc_updates}: squared error {np.mean(losses):.3f} "
-                         f"({time.perf_counter() - t0:.0f} s)")
-        self.train_log.write({"env_steps": 0, "episodes": 0, "updates": 0, "bc_loss": float(np.mean(losses)),
+        sources = [self.demos]
+        loss = clone(self.agent, sources, cfg.bc_updates, cfg.batch_size, optimiser, self.say)
+        for r in range(cfg.dagger_rounds):
+            labelled, figures = dagger_round(self.agent, self.env_id, cfg, self.env_kwargs, cfg.dagger_episodes, r,
+                                             self.device)
+            self.imitation["dagger"].append(figures)
+            self.say(f"DAgger round {r + 1}/{cfg.dagger_rounds}: the student succeeded in "
+                     f"{figures['student_success']:.2f} of {figures['episodes']} episodes; "
+                     f"{figures['transitions']} states labelled ({figures['cpu_s']:.0f} CPU-s)")
+            sources.append(labelled)
+            loss = clone(self.agent, sources, cfg.bc_updates, cfg.batch_size, optimiser, self.say,
+                         f"DAgger round {r + 1}: cloning")
+        self.train_log.write({"env_steps": 0, "episodes": 0, "updates": 0, "bc_loss": loss,
                               "alpha": self.agent.alpha, "wall_s": self.wall()})
 
     # ---- logging and evaluating -----------------------------------------------------------
@@ -578,6 +587,7 @@ class _Run:
         }
         if self.demos is not None:
             state["demo_rng"] = rng_to_plain(self.demos.buffers[0].rng)
+            state["imitation"] = self.imitation
         atomic_write(self.ckpt_path, lambda f: torch.save(state, f))
 
     def machine(self) -> dict:
@@ -615,6 +625,8 @@ class _Run:
                    "config": cfg.to_dict()}
         if self.demo_summary is not None:
             summary["demonstrations"] = self.demo_summary
+        if self.imitation["dagger"]:
+            summary["dagger"] = self.imitation["dagger"]
         atomic_json(self.done_path, summary)
         if not cfg.keep_checkpoint:
             for demos in (self.demos_path, summary_path(self.demos_path)):

@@ -1,0 +1,105 @@
+"""Imitation before RL: behaviour cloning on the teacher's demonstrations (PIRLNav's first phase), then
+DAgger rounds (Ross, Gordon & Bagnell 2011) in which the student drives and the teacher labels.
+
+The teacher is the classical frontier searcher (:class:`egosearch.searchers.frontier.FrontierPolicy`,
+untuned). Its map updates from whatever it sees, so it can label a trajectory it did not drive: at
+every state the student reaches it is shown the observation and says what it would do there. Those
+labels train the student only by cloning: the stored action is the teacher's, not the one taken, so
+the transitions are no RL data and never join the batches of ``demo_batch_fraction``.
+
+:func:`clone` is the cloning loop over any number of sources (the demonstrations, each DAgger round's
+labelled states), drawing from each in proportion to its size. :func:`dagger_round` runs one round.
+:mod:`egosearch.rl.train` runs both before the first env step of a fresh training.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable
+
+import numpy as np
+import torch
+
+from egosearch.rl.config import LearnerConfig
+from egosearch.rl.demos import stored_observation
+from egosearch.rl.replay import MultiReplay
+from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.sim.scenarios import MAX_STEPS
+
+DAGGER_SEED_BASE = 8_000_000
+"""Episode i of DAgger round r of a training with seed s resets with seed
+DAGGER_SEED_BASE + 100_000 s + 10_000 r + i: apart from the demonstrations' (``rl.demos.DEMO_SEED_BASE``)
+and the training curve's evaluation episodes."""
+MAX_DAGGER_EPISODES = 10_000
+"""A round's episodes stay below the next round's seeds."""
+
+
+def proportional_counts(sizes: list[int], batch_size: int) -> list[int]:
+    """``batch_size`` split over sources in proportion to ``sizes`` (largest remainders get the rest)."""
+    total = sum(sizes)
+    exact = [batch_size * s / total for s in sizes]
+    counts = [int(x) for x in exact]
+    for i in sorted(range(len(sizes)), key=lambda i: exact[i] - counts[i], reverse=True)[:batch_size - sum(counts)]:
+        counts[i] += 1
+    return counts
+
+
+def clone(agent, sources: list[MultiReplay], steps: int, batch_size: int, optimiser: torch.optim.Optimizer,
+          say: Callable[[str], None] = print, what: str = "behaviour cloning") -> float:
+    """``steps`` behaviour-cloning steps of ``agent`` (``clone_update``) on batches drawn from ``sources``
+    in proportion to their sizes; returns the mean squared error of the last 100 steps."""
+    counts = proportional_counts([len(s) for s in sources], batch_size)
+    t0, losses = time.perf_counter(), deque(maxlen=100)
+    for i in range(steps):
+        parts = [s.sample(n) for s, n in zip(sources, counts) if n > 0]
+        batch = {k: torch.cat([p[k] for p in parts]) for k in ("obs_depth", "mask", "proprio", "action")}
+        losses.append(agent.clone_update(batch, optimiser)["bc_loss"])
+        if (i + 1) % max(steps // 10, 1) == 0 or i + 1 == steps:
+            say(f"{what} {i + 1}/{steps}: squared error {np.mean(losses):.3f} ({time.perf_counter() - t0:.0f} s)")
+    return float(np.mean(losses))
+
+
+def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episodes: int, round_index: int,
+                 device: torch.device | str = "cpu") -> tuple[MultiReplay, dict]:
+    """One DAgger round: the student (``agent``'s mean action) drives ``episodes`` training-side episodes
+    of ``env_id`` under ``cfg``'s training env settings; at every state the teacher says what it would
+    do. Returns the labelled states (one ring, actions = the teacher's labels) and the round's figures:
+    the student's success, the mean squared difference of its actions from the labels, CPU seconds."""
+    if not 1 <= episodes <= MAX_DAGGER_EPISODES:
+        raise ValueError(f"episodes={episodes}; allowed: 1..{MAX_DAGGER_EPISODES}")
+    env = make_train_env(env_id, train_env_kwargs(cfg, env_kwargs))
+    cpu0 = time.process_time()
+    labelled = None
+    successes, differences = [], []
+    try:
+        for episode in range(episodes):
+            obs, _ = env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg.seed + 10_000 * round_index + episode)
+            if labelled is None:
+                state_dim = int(np.asarray(obs["state"]).shape[0]) if cfg.critic_privileged_state else 0
+                labelled = MultiReplay(1, episodes * MAX_STEPS, agent.replay_image_size, cfg.frame_history,
+                                       int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
+                                       int(env.action_space.shape[0]), device=device, seed=cfg.seed,
+                                       state_dim=state_dim)
+            teacher = FrontierPolicy(getattr(env, "current", env))  # a pool of homes swaps its env on reset
+            teacher.reset()
+            stored = stored_observation(obs, cfg)
+            terminated = truncated = False
+            while not (terminated or truncated):
+                label = teacher.act(obs)
+                action = agent.act(obs, deterministic=True)
+                differences.append(float(np.sum((action - label) ** 2)))
+                obs, reward, terminated, truncated, _ = env.step(action)
+                next_stored = stored_observation(obs, cfg)
+                labelled.add(0, stored, label, float(reward), next_stored, terminated, truncated)
+                stored = next_stored
+            successes.append(bool(terminated))
+    finally:
+        env.close()
+    figures = {"round": round_index + 1, "episodes": episodes, "transitions": len(labelled),
+               "student_success": round(float(np.mean(successes)), 4),
+               "squared_difference_from_teacher": round(float(np.mean(differences)), 4),
+               "cpu_s": round(time.process_time() - cpu0, 1)}
+    return labelled, figures
+
