@@ -205,3 +205,19 @@ def test_a_training_with_dagger_records_its_rounds(tmp_path):
     done = train("EgoSearch-v0", cfg, tmp_path, ENV, constant_evaluator, progress=False)
     assert [r["round"] for r in done["dagger"]] == [1, 2]
     assert all(r["episodes"] == 1 and r["transitions"] > 0 for r in done["dagger"])
+
+
+def test_figure6_marks_where_a_trainings_imitation_ends(tmp_path):
+    from egosearch.report.figures import imitation_phases
+
+    def phases(**fields):
+        cfg = load_config("cpu", fields).to_dict()
+        (tmp_path / "config.json").write_text(json.dumps({"config": cfg}))
+        return [step for step, _ in imitation_phases(tmp_path / "curve.csv")]
+
+    assert phases() == []  # from scratch
+    # the first update at the warm-up's last step (4000), then 2500 critic-only updates, one every 4 env steps
+    assert phases(demo_episodes=10, bc_updates=5, critic_warmup_updates=2500, demo_batch_fraction=0.5,
+                  bc_weight=0.4, bc_decay_steps=100_000) == [14_000, 100_000]
+    assert phases(demo_episodes=10, bc_updates=5, critic_warmup_updates=10**6) == []  # imitation alone: never ends
+    assert imitation_phases(tmp_path / "elsewhere" / "curve.csv") == []

@@ -7,6 +7,7 @@ needs a display nor changes the global backend; the style is applied per figure 
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Iterable, Mapping
@@ -161,6 +162,27 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
 
 
+def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
+    """Where a training's learning from the teacher changes phase, read from the ``config.json`` beside its
+    ``curve.csv``: (env step, label) for the first RL step of the actor after behaviour cloning (after the
+    warm-up and the critic's warm-up: ``bc_updates``, ``critic_warmup_updates``), and for the end of the
+    decaying cloning term (``bc_decay_steps``). Empty for a training without a teacher (or no config)."""
+    try:
+        cfg = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))["config"]
+    except (OSError, ValueError, KeyError):
+        return []
+    phases = []
+    if cfg.get("bc_updates"):
+        first_update = -(-max(cfg["init_steps"], 1) // cfg["update_every"]) * cfg["update_every"]
+        warmup_steps = -(-cfg.get("critic_warmup_updates", 0) // cfg["updates_per_step"]) * cfg["update_every"]
+        start = first_update + warmup_steps
+        if start <= cfg["total_env_steps"]:
+            phases.append((start, "imitation ends: RL steps the actor"))
+    if cfg.get("bc_weight") and cfg.get("bc_decay_steps", 0) <= cfg["total_env_steps"]:
+        phases.append((int(cfg["bc_decay_steps"]), "cloning term reaches 0"))
+    return phases
+
+
 def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,
             confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
             random_files: Iterable[PathLike] | None = None) -> list[Path]:
@@ -171,7 +193,9 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     ``head_on`` -> "with head movement", ``head_off`` -> "without head movement"). Writes
     ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (the plotted numbers; a directory
     prefix gets ``fig6.*``) and returns the paths. ValueError on no curves / no evaluated rows.
-    ``random_files`` (see :func:`figure6_frame`) add the random searcher as a dashed line.
+    ``random_files`` (see :func:`figure6_frame`) add the random searcher as a dashed line. A training that
+    learned from the classical searcher marks where its imitation phase ends (:func:`imitation_phases`;
+    its step-0 point is the cloned policy).
     """
     df = figure6_frame(curves, labels, confidence, n_resamples, seed, random_files=random_files)
     base = output_base(out_prefix, "fig6")
@@ -193,6 +217,13 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
             if band.any():
                 ax.fill_between(x, g["low"].to_numpy(), g["high"].to_numpy(), where=band, color=colour,
                                 alpha=0.2, linewidth=0, interpolate=False)
+        phases = {}
+        for variant_paths in curves.values():
+            paths = [variant_paths] if isinstance(variant_paths, (str, os.PathLike)) else list(variant_paths)
+            for step, label in (imitation_phases(paths[0]) if paths else []):
+                phases.setdefault((step, label), None)
+        for (step, label), style in zip(phases, (":", "-.", (0, (1, 3)), (0, (3, 1, 1, 1)))):
+            ax.axvline(step, color="#333333", linestyle=style, linewidth=0.9, label=label)
         ax.set_xlabel("Environment steps")
         ax.set_ylabel("Success rate")
         ax.set_ylim(0, 1.02)
