@@ -51,3 +51,21 @@ def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypat
     (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
     assert estimate.training_time_line(180_000, "smoke") is None
+
+
+def test_a_training_that_learned_from_the_teacher_gives_no_learner_rate(tmp_path):
+    """Its CPU time also paid for the teacher's episodes and the cloning: 4,000 env steps in 600 CPU-s is no
+    rate of the learner's, and would put the benchmark's pairing with a training at 1/20 of itself."""
+    import json
+
+    from egosearch.cli.estimate import stored_training_rates
+
+    results = tmp_path / "results" / "cpu"
+    jobs = []
+    for job, steps, cpu_s, demos in (("scratch/seed0", 200_000, 2000.0, 0), ("cloned/seed0", 4000, 600.0, 1500)):
+        run = results / "train" / job
+        run.mkdir(parents=True)
+        (run / "curve.csv").write_text(f"env_steps,success_rate\n0,0.1\n{steps},0.5\n")
+        (run / "config.json").write_text(json.dumps({"config": {"demo_episodes": demos}}))
+        jobs.append({"rule": "train", "job": job, "wall_s": cpu_s, "cpu_s": cpu_s})
+    assert stored_training_rates({"jobs": jobs}, results) == {"scratch/seed0": 100.0}

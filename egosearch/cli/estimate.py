@@ -79,9 +79,20 @@ def run(args) -> None:
 
 def stored_training_rates(record: dict, results: Path) -> dict[str, float]:
     """Every stored training's env steps per CPU-second (lever screens too: one may share the
-    learner benchmark's machine), by job key."""
-    recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+    learner benchmark's machine), by job key; a training that learned from the classical searcher is
+    left out: its CPU time also paid for the teacher's episodes and the cloning, so its env steps per
+    CPU-second is not the learner's rate."""
+    recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN
+                and not learned_from_teacher(results / "train" / r["job"])]
     return training_rates(record, env_steps_of(results, recorded))
+
+
+def learned_from_teacher(run_dir: Path) -> bool:
+    """Whether the training in ``run_dir`` collected demonstrations (its config.json's ``demo_episodes``)."""
+    try:
+        return bool(json.loads((run_dir / "config.json").read_text(encoding="utf-8"))["config"].get("demo_episodes"))
+    except (OSError, ValueError, KeyError):
+        return False
 
 
 def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict) -> tuple[float, str] | None:
