@@ -69,3 +69,28 @@ def test_a_training_that_learned_from_the_teacher_gives_no_learner_rate(tmp_path
         (run / "config.json").write_text(json.dumps({"config": {"demo_episodes": demos}}))
         jobs.append({"rule": "train", "job": job, "wall_s": cpu_s, "cpu_s": cpu_s})
     assert stored_training_rates({"jobs": jobs}, results) == {"scratch/seed0": 100.0}
+
+
+def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_path, monkeypatch):
+    """Hand-worked: 100 demonstration and 20 DAgger episodes at 0.25 CPU-s each and 2 x 500 cloning steps at 50
+    updates per second on the benchmark's machine (30 + 20 s), on a machine calibrated at half its rate: 100 s."""
+    import egosearch.cli.estimate as estimate
+    from egosearch.core.machine import cpu_model, cpu_vector_unit
+    from egosearch.rl.config import load_config
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 50.0}))
+    results = tmp_path / "results" / "cpu"
+    (results / "bench").mkdir(parents=True)
+    bench = {"result": {"updates_per_s_cpu_profile": 50.0, "env_steps_per_core_s_cpu_profile": 100.0}}
+    (results / "bench" / "learner.json").write_text(json.dumps(bench))
+    cfg = load_config("cpu", {"demo_episodes": 100, "bc_updates": 500, "dagger_rounds": 1, "dagger_episodes": 20})
+    assert "no stored measurement" in estimate.training_time_line(200_000, "cpu", cfg)
+    run = results / "train" / "cloned" / "seed0"
+    run.mkdir(parents=True)
+    (run / "done.json").write_text(json.dumps({"demonstrations": {"episodes": 1500, "cpu_s": 375.0}}))
+    # 100 + 20 episodes x 0.25 s = 30 s, 1000 cloning steps / 50 per s = 20 s; x 100 / 50 = 100 s
+    assert estimate.teacher_cost_s(cfg, results, bench, 50.0) == pytest.approx(100.0)
+    assert "plus about 0.0 h for the teacher's 100 episodes" in estimate.training_time_line(200_000, "cpu", cfg)

@@ -241,24 +241,58 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
         print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)
 
 
-def training_time_line(steps: int, profile: str) -> str | None:
+def training_time_line(steps: int, profile: str, config=None) -> str | None:
     """What ``egosearch train`` says at its start: how long ``steps`` env steps take on this machine,
     from its last calibration (a cpu-profile training: None at other profiles, whose steps cost
-    otherwise), and the command that makes one when it has none."""
+    otherwise), and the command that makes one when it has none. With a ``config`` that learns from the
+    classical searcher, the teacher's episodes and the cloning steps are added (:func:`teacher_cost_s`)."""
     if profile != "cpu":
         return None
     rate = cached_rate()
     if rate is None:
         return "estimate: this machine has no calibration yet (`egosearch estimate all` makes one in a minute)"
     results = Path("results") / profile
-    ratio = None
+    ratio, bench = None, {}
     try:
-        record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         bench = json.loads((results / "bench" / "learner.json").read_text(encoding="utf-8"))
+        record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         ratio = benchmark_ratio(record, stored_training_rates(record, results), bench)
     except (OSError, ValueError, KeyError):
         pass
     k = ratio[0] if ratio else 1.0
-    return (f"estimate: about {_hours(steps / (k * rate))} of CPU time for {steps} env steps on this machine "
+    line = (f"estimate: about {_hours(steps / (k * rate))} of CPU time for {steps} env steps on this machine "
             f"(calibrated at {rate:.0f} env steps per CPU-second"
             + (f", a training at {k:.2f} x that as in the stored run" if ratio else "") + ")")
+    if config is not None and getattr(config, "demo_episodes", 0):
+        extra = teacher_cost_s(config, results, bench, rate)
+        line += (f", plus about {_hours(extra)} for the teacher's {config.demo_episodes} episodes and the cloning"
+                 if extra is not None else
+                 f", plus the teacher's {config.demo_episodes} episodes and the cloning (no stored measurement)")
+    return line
+
+
+def teacher_cost_s(config, results: Path, bench: dict, rate: float) -> float | None:
+    """CPU seconds of a training's imitation phase on a machine calibrated at ``rate``: its demonstration
+    episodes and its DAgger rounds' episodes at the stored trainings' measured CPU-s per demonstration
+    episode (their ``done.json``), and its cloning steps (``bc_updates`` after the demonstrations and after
+    each DAgger round) at the learner benchmark's update rate; all
+    scaled from the benchmark's machine to this one by the two calibrations. None without a measurement."""
+    per_episode = [d["demonstrations"]["cpu_s"] / d["demonstrations"]["episodes"]
+                   for d in _stored_done(results) if d.get("demonstrations", {}).get("episodes")]
+    updates_per_s = bench.get("result", {}).get("updates_per_s_cpu_profile")
+    bench_rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
+    if not per_episode or not updates_per_s or not bench_rate:
+        return None
+    cloning = config.bc_updates * (1 + config.dagger_rounds) / updates_per_s
+    dagger = config.dagger_rounds * config.dagger_episodes * statistics.median(per_episode)
+    return (config.demo_episodes * statistics.median(per_episode) + dagger + cloning) * bench_rate / rate
+
+
+def _stored_done(results: Path) -> list[dict]:
+    out = []
+    for path in sorted(results.glob("train/*/seed*/done.json")):
+        try:
+            out.append(json.loads(path.read_text(encoding="utf-8")))
+        except (OSError, ValueError):
+            continue
+    return out

@@ -33,7 +33,7 @@ def run(args) -> None:
             check_published_run(Path(args.out_dir), resolved)
         except CheckpointError as err:
             raise ValueError(f"--out-dir: {err}") from None
-    line = training_time_line(resolved.config.total_env_steps, args.profile)
+    line = training_time_line(resolved.config.total_env_steps, args.profile, resolved.config)
     if line:
         print(line, flush=True)
     try:
