@@ -35,6 +35,7 @@ folder, fsync, ``os.replace``).
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -507,12 +508,19 @@ class _Run:
         with ``demo_batch_fraction`` that share drawn from the demonstrations (marked by ``demo``)."""
         if self.demos is None or not self.cfg.demo_batch_fraction:
             return self.agent.sample_batch(self.replay)
+        demo_rows = self.demo_rows
+        from_demos = int(demo_rows.sum())
+        online, demo = self.replay.sample(len(demo_rows) - from_demos), self.demos.sample(from_demos)
+        batch = {k: torch.cat([online[k], demo[k]]) for k in online}
+        batch["demo"] = demo_rows
+        return batch
+
+    @functools.cached_property
+    def demo_rows(self) -> torch.Tensor:
+        """(batch_size, 1): 1 on the rows a batch draws from the demonstrations (the last ones), once per run."""
         size = self.cfg.batch_size
         from_demos = round(size * self.cfg.demo_batch_fraction)
-        online, demo = self.replay.sample(size - from_demos), self.demos.sample(from_demos)
-        batch = {k: torch.cat([online[k], demo[k]]) for k in online}
-        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
-        return batch
+        return torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
 
     # ---- imitating ------------------------------------------------------------------------
     def imitate(self) -> None:
