@@ -69,8 +69,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
         for episode in range(episodes):
             if episode:
                 obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * seed + episode)
-            teacher = FrontierPolicy(getattr(env, "current", env))  # a pool of homes swaps its env on reset
-            teacher.reset()
+            teacher = new_teacher(env)
             stored = stored_observation(obs, cfg)
             total, steps, terminated, truncated = 0.0, 0, False, False
             while not (terminated or truncated):
@@ -116,6 +115,14 @@ def load_demonstrations(path: str | Path, cfg: LearnerConfig, device: str = "cpu
                          state_dim=int(meta["state_dim"]))
     replay.buffers[0].load(path)
     return replay
+
+
+def new_teacher(env) -> FrontierPolicy:
+    """The frontier searcher for an episode just reset in ``env``, reset itself (a pool of homes swaps its
+    env at each reset, so the teacher is made per episode, for the home the episode is in)."""
+    teacher = FrontierPolicy(getattr(env, "current", env))
+    teacher.reset()
+    return teacher
 
 
 def stored_observation(obs: dict, cfg: LearnerConfig) -> dict:

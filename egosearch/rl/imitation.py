@@ -22,10 +22,9 @@ import numpy as np
 import torch
 
 from egosearch.rl.config import LearnerConfig
-from egosearch.rl.demos import stored_observation
+from egosearch.rl.demos import new_teacher, stored_observation
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
-from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.sim.scenarios import MAX_STEPS
 
 DAGGER_SEED_BASE = 8_000_000
@@ -82,8 +81,7 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
                                        int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
                                        state_dim=state_dim)
-            teacher = FrontierPolicy(getattr(env, "current", env))  # a pool of homes swaps its env on reset
-            teacher.reset()
+            teacher = new_teacher(env)
             stored = stored_observation(obs, cfg)
             terminated = truncated = False
             while not (terminated or truncated):
