@@ -145,6 +145,22 @@ def test_a_bad_config_is_one_line_naming_the_key(suite, monkeypatch, capsys, ent
     assert stop.value.code == 1 and capsys.readouterr().err == f"egosearch: error: {message.format(allowed=allowed)}\n"
 
 
+@pytest.mark.parametrize("pairs, message", [
+    ([["head_on", "head_on"]], "config claims_pairs: ['head_on', 'head_on'] is one searcher twice; a pair is [head "
+                               "moving, head fixed]"),
+    ([["head_on", "head_of"]], re.compile(r"variant='head_of' is unknown; allowed: .*")),
+    ([["head_on"]], re.compile(r"config claims_pairs/0: \['head_on'\] is too short")),
+], ids=["one_searcher_twice", "variant_typo", "one_searcher"])
+def test_a_bad_claims_pair_is_one_line(suite, monkeypatch, capsys, pairs, message):
+    monkeypatch.chdir(suite)
+    with pytest.raises(SystemExit) as stop:
+        checked_variants(config(claims_pairs=pairs), argv=["behaviour"], directory=suite / "ablations")
+    err = capsys.readouterr().err
+    assert stop.value.code == 1 and err.count("\n") == 1 and err.startswith("egosearch: error: ")
+    line = err.removeprefix("egosearch: error: ").rstrip("\n")
+    assert message.fullmatch(line) if isinstance(message, re.Pattern) else line == message, line
+
+
 def test_a_generalise_reference_outside_its_variants_is_one_line(suite, monkeypatch, capsys):
     monkeypatch.chdir(suite)
     base = config()
@@ -632,13 +648,13 @@ NEW_CASES = [
      "egosearch report: error: --out-prefix={t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05 writes "
      "{t}/g_in/head_on/seed0/generated_heldout/everywhere/h1.05.csv, which is also an input (the input files): a "
      "command never writes over its own input; choose another output path"),
-    ("behaviour_head_on_not_traced", "silent", ["report", "behaviour", *TRACES, "--head-on", "nope", "--out-prefix",
-                                                "{t}/b"],
-     "egosearch report: error: --head-on='nope' has no trace file among the files (their variants: head_on, "
-     "head_off)"),
-    ("behaviour_head_on_is_head_off", "silent", ["report", "behaviour", *TRACES, "--head-off", "head_on",
-                                                 "--out-prefix", "{t}/b"],
-     "egosearch report: error: --head-on and --head-off are both 'head_on': the claims compare two variants"),
+    ("behaviour_pair_not_traced", "silent", ["report", "behaviour", *TRACES, "--pairs", "head_on:nope",
+                                             "--out-prefix", "{t}/b"],
+     "egosearch report: error: no trace files of nope (the pairs' variants); the files hold head_off, head_on"),
+    ("behaviour_pair_of_one_searcher", "silent", ["report", "behaviour", *TRACES, "--pairs", "head_on:head_on",
+                                                  "--out-prefix", "{t}/b"],
+     "egosearch report: error: --pairs 'head_on:head_on': expected HEAD_ON:HEAD_OFF, two different searchers (e.g. "
+     "head_on:head_off)"),
     ("behaviour_csv_named_npz", "cryptic",
      ["report", "behaviour", "{t}/badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", TRACES[1],
       "--out-prefix", "{t}/b"],

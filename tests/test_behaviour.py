@@ -236,3 +236,44 @@ def test_the_readme_block_and_the_command(tmp_path, capsys):
     rendered = render_readme(text, root, "cpu")
     assert "| paper (where) |" in rendered and "From `paper_figs/cpu/behaviour_claims.csv`" in rendered
     assert main(["report", "behaviour", str(tmp_path / "nothing" / "h1.65.npz"), "--out-prefix", str(tmp_path)]) == 2
+
+
+def test_the_claims_are_read_on_each_pair_side_by_side(tmp_path):
+    from egosearch.report.behaviour import claims_markdown
+
+    # Two pairs: the learned one gains 0.15 in success with head movement, the classical one loses 0.05.
+    summary = _summary([("head_on", "success", 0.8, 0.7, 0.9), ("head_off", "success", 0.65, 0.55, 0.75),
+                        ("head_on - head_off", "success", 0.15, 0.05, 0.25),
+                        ("frontier", "success", 0.7, 0.6, 0.8), ("frontier_head_off", "success", 0.75, 0.65, 0.85),
+                        ("frontier - frontier_head_off", "success", -0.05, -0.09, -0.01)])
+    got = claims_frame(summary, [("head_on", "head_off"), ("frontier", "frontier_head_off")])
+    assert list(got["searchers"]) == ["head_on / head_off"] * 5 + ["frontier / frontier_head_off"] * 5
+    success = got[got["claim"].str.contains("20% higher")].set_index("searchers")
+    assert success.loc["head_on / head_off", "verdict"] == "sign holds, size reproduced"
+    assert success.loc["frontier / frontier_head_off", "verdict"] == "sign opposite, size not reproduced"
+    # each pair's "20% of the head-off rate" reading uses its own head-off searcher's rate
+    assert "head_off's own rate 0.650" in success.loc["head_on / head_off", "detail"]
+    assert "frontier_head_off's own rate 0.750" in success.loc["frontier / frontier_head_off", "detail"]
+    md = claims_markdown(got)
+    header, _, *rows = md.split("\n")[:7]
+    assert header.endswith("| `head_on / head_off` | `frontier / frontier_head_off` |")
+    assert len(rows) == 5 and all(r.count("**") == 4 for r in rows)
+    line = next(r for r in rows if "20% higher" in r)
+    assert "+0.150 [+0.050, +0.250], 100 × 3: **sign holds, size reproduced**" in line
+    assert line.endswith("-0.050 [-0.090, -0.010], 100 × 3: **sign opposite, size not reproduced** |")
+    assert "What each verdict rests on" in md and md.count("`frontier / frontier_head_off`: ") == 5
+    # one pair: the single-pair table, as before
+    assert "| verdict: sign, size |" in claims_markdown(claims_frame(summary))
+
+
+def test_a_pair_without_traces_is_one_line_before_any_work(tmp_path):
+    from egosearch.cli import main
+
+    path = tmp_path / "traces" / "head_on" / "seed0" / "kitchen_living" / "everywhere" / "h1.65.npz"
+    _write_trace(path, {0: HAND})
+    with pytest.raises(ValueError, match=r"^no trace files of frontier, head_off \(the pairs' variants\)"):
+        behaviour_report([path], tmp_path / "out" / "behaviour", pairs=[("head_on", "head_off"),
+                                                                        ("frontier", "head_on")])
+    assert not (tmp_path / "out").exists()
+    assert main(["report", "behaviour", str(path), "--pairs", "head_on", "--out-prefix", str(tmp_path)]) == 2
+    assert main(["report", "behaviour", str(path), "--pairs", "head_on:head_on", "--out-prefix", str(tmp_path)]) == 2

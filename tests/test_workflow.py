@@ -66,14 +66,20 @@ def test_the_budget_study_reads_its_settings_against_the_profiles_reference():
     assert "--chosen head_on " in smoke.stdout + smoke.stderr
 
 
-def test_dry_run_of_behaviour_traces_both_variants_outside_all():
+def test_dry_run_of_behaviour_traces_every_pair_outside_all():
     out = run(["-n", "-p", "behaviour", "searches", "--config", "profile=smoke"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
-    for variant in ("head_on", "head_off"):
+    for variant in ("head_on", "head_off", "frontier", "frontier_head_off"):
         for home in ("kitchen_living", "bedroom_bath"):
             assert f"traces/{variant}/seed0/{home}/everywhere/h1.65.npz" in text, (variant, home)
     assert "--traces results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz" in text
+    # the classical searchers are traced by their own rule, with no actor
+    assert ("egosearch evaluate --force --policy frontier_head_off --scenarios "
+            "results/smoke/scenarios/bedroom_bath/everywhere/h1.65.csv --seed 0 --out "
+            "results/smoke/traces/frontier_head_off/seed0/bedroom_bath/everywhere/h1.65.csv --traces") in text
+    assert "--pairs head_on:head_off frontier:frontier_head_off --out-prefix paper_figs/smoke/behaviour" in text
+    assert "searches/frontier_" not in text
     assert "searches/gaze_kitchen_living_everywhere_h1.65.png" in text
     assert "trace" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout.split()
 

@@ -293,10 +293,11 @@ def add_report(sub) -> None:
     r = reports.add_parser("behaviour", help="how the policies search, from per-step traces, and the paper's "
                                              "behaviour sentences (Section 6.3, Figure 6) read against them")
     r.add_argument("files", nargs="+", help=traces)
-    r.add_argument("--head-on", default="head_on", help="the variant that moves its head, one of the files' "
-                                                        "(default: head_on)")
-    r.add_argument("--head-off", default="head_off", help="the variant without head movement, another of the "
-                                                          "files' (default: head_off)")
+    r.add_argument("--pairs", nargs="+", default=["head_on:head_off"],
+                   metavar="HEAD_ON:HEAD_OFF",
+                   help="the pairs the claims are read on, side by side, the first leading: the variant (or "
+                        "searcher) that moves its head and the one that does not, each among the files' "
+                        "(default: head_on:head_off)")
     r.add_argument("--out-prefix", required=True,
                    help=prefix.format("_episodes.csv, .csv, .md, _claims.csv and _claims.md"))
     add_force(r)

@@ -16,7 +16,7 @@ from pathlib import Path
 from egosearch.cli.checks import at_least, check_npz_files, check_text_files
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report import cli as report
-from egosearch.report.behaviour import behaviour_report, parse_trace_path
+from egosearch.report.behaviour import behaviour_report, check_pairs, parse_pair, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
 from egosearch.report.data import parse_eval_path
 from egosearch.report.fresh import fresh_report
@@ -127,13 +127,7 @@ def _check_generalise(args) -> None:
 
 
 def _check_behaviour(args) -> None:
-    variants = _variants(args.files, parse_trace_path)
-    if args.head_on == args.head_off:
-        raise ValueError(f"--head-on and --head-off are both {args.head_on!r}: the claims compare two variants")
-    for option, value in (("--head-on", args.head_on), ("--head-off", args.head_off)):
-        if value not in variants:
-            raise ValueError(f"{option}={value!r} has no trace file among the files (their variants: "
-                             f"{', '.join(variants)})")
+    check_pairs([parse_pair(p) for p in args.pairs], _variants(args.files, parse_trace_path))
 
 
 def _check_searches(args) -> None:
@@ -319,7 +313,7 @@ def _compare(args) -> None:
 
 
 def _behaviour(args) -> None:
-    for path in behaviour_report(args.files, args.out_prefix, head_on=args.head_on, head_off=args.head_off):
+    for path in behaviour_report(args.files, args.out_prefix, pairs=[parse_pair(p) for p in args.pairs]):
         print(f"wrote {path}")
 
 

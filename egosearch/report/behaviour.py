@@ -65,6 +65,10 @@ PAPER_HEAD_GAIN = 0.20
 """Figure 6 and Section 6.2: "a 20% higher success rate" with head movement, read as 20 points of
 success rate (the claims table also gives the reading as 20% of the head-off rate)."""
 
+Pair = tuple[str, str]
+"""(the searcher that moves its head, its counterpart that does not): the claims are read on each pair."""
+DEFAULT_PAIRS: tuple[Pair, ...] = (("head_on", "head_off"),)
+
 _TRACE = re.compile(r"^h(\d+(?:\.\d+)?)\.npz$")
 _SEED = re.compile(r"^seed(\d+)$")
 
@@ -282,10 +286,11 @@ def _drawn(sums: dict[str, np.ndarray], rows: np.ndarray, cols: np.ndarray) -> d
     return {name: out[:, i] for i, name in enumerate(names)}
 
 
-def summarise(episodes: pd.DataFrame, head_on: str = "head_on", head_off: str = "head_off",
-              confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0, chunk: int = 1000) -> pd.DataFrame:
-    """Every statistic per variant, and ``{head_on} - {head_off}`` on the scenarios both ran (rows with
-    ``variant`` = ``"head_on - head_off"``, named by the two variants): value, interval, scenarios, seeds."""
+def summarise(episodes: pd.DataFrame, pairs: Iterable[Pair] = DEFAULT_PAIRS, confidence: float = 0.95,
+              n_resamples: int = 10_000, seed: int = 0, chunk: int = 1000) -> pd.DataFrame:
+    """Every statistic per variant, and for each (head on, head off) pair of ``pairs`` whose two variants
+    both have episodes, ``{head_on} - {head_off}`` on the scenarios both ran (rows with ``variant`` =
+    ``"head_on - head_off"``, named by the two variants): value, interval, scenarios, seeds."""
     columns = _columns(STATISTICS)
     rows = []
     sides = {}
@@ -308,9 +313,10 @@ def summarise(episodes: pd.DataFrame, head_on: str = "head_on", head_off: str = 
             rows.append({"variant": variant, "statistic": s.name, "value": float(_estimate(s, totals)),
                          "ci_low": lo, "ci_high": hi, "unit": s.unit, "n_scenarios": n_s, "n_seeds": n_k,
                          "n_episodes": int(totals["episodes"]), "description": s.text})
-    if head_on in sides and head_off in sides:
-        rows += _paired(sides[head_on], sides[head_off], f"{head_on} - {head_off}", confidence, n_resamples, seed,
-                        chunk)
+    for head_on, head_off in pairs:
+        if head_on in sides and head_off in sides:
+            rows += _paired(sides[head_on], sides[head_off], f"{head_on} - {head_off}", confidence, n_resamples,
+                            seed, chunk)
     return pd.DataFrame(rows)
 
 
@@ -373,9 +379,10 @@ CLAIMS: tuple[Claim, ...] = (
     Claim("To look around the environment, the agent needs to rotate its entire body around", "Section 6.2",
           "body turn per step, head on minus head off (rad)", "body_turn_per_step", "contrast", -1),
 )
-CLAIM_COLUMNS = ("claim", "source", "measure", "paper_size", "value", "ci_low", "ci_high", "n_scenarios", "n_seeds",
-                 "sign", "size", "verdict", "detail")
-"""``sign``: :data:`SIGN_HOLDS`, :data:`SIGN_NOT_SHOWN`, :data:`SIGN_OPPOSITE` or :data:`NOT_TESTABLE`;
+CLAIM_COLUMNS = ("searchers", "claim", "source", "measure", "paper_size", "value", "ci_low", "ci_high", "n_scenarios",
+                 "n_seeds", "sign", "size", "verdict", "detail")
+"""``searchers``: the pair the row reads the claim on (:func:`pair_label`); ``sign``: :data:`SIGN_HOLDS`,
+:data:`SIGN_NOT_SHOWN`, :data:`SIGN_OPPOSITE` or :data:`NOT_TESTABLE`;
 ``size``: :data:`SIZE_REPRODUCED`, :data:`SIZE_NOT_REPRODUCED`, :data:`NO_SIZE` or :data:`NOT_TESTABLE`;
 ``verdict``: the two read together (``sign holds, size not reproduced``); ``paper_size``: the sentence's
 number in the measure's unit (empty where it gives none)."""
@@ -418,17 +425,28 @@ _SIGN_DETAIL = {SIGN_HOLDS: "95% interval excludes 0 on the sentence's side",
                 SIGN_OPPOSITE: "95% interval lies on the other side of 0"}
 
 
-def claims_frame(summary: pd.DataFrame, head_on: str = "head_on", head_off: str = "head_off") -> pd.DataFrame:
-    """One row per paper sentence: the number behind it, its 95% interval and two verdicts, read from that
-    interval: the sign (:func:`sign_verdict`: holds / not shown / opposite) and, where the sentence states
-    a number, the size (:func:`size_verdict`: the paper's number inside the interval or not);
-    ``not testable here`` when the traces cannot give the number. Columns :data:`CLAIM_COLUMNS`."""
+def pair_label(pair: Pair) -> str:
+    """``head_on / head_off``: a pair's name in the claims table."""
+    return f"{pair[0]} / {pair[1]}"
+
+
+def claims_frame(summary: pd.DataFrame, pairs: Iterable[Pair] = DEFAULT_PAIRS) -> pd.DataFrame:
+    """One row per pair and paper sentence (pairs in their order, the sentences in :data:`CLAIMS`' order
+    within each): the number behind it, its 95% interval and two verdicts, read from that interval: the
+    sign (:func:`sign_verdict`: holds / not shown / opposite) and, where the sentence states a number, the
+    size (:func:`size_verdict`: the paper's number inside the interval or not); ``not testable here`` when
+    the traces cannot give the number. Columns :data:`CLAIM_COLUMNS`."""
+    return pd.DataFrame([row for pair in pairs for row in _pair_claims(summary, *pair)], columns=list(CLAIM_COLUMNS))
+
+
+def _pair_claims(summary: pd.DataFrame, head_on: str, head_off: str) -> list[dict]:
     out = []
     for c in CLAIMS:
         variant = head_on if c.side == "on" else f"{head_on} - {head_off}"
         hit = summary[(summary["variant"] == variant) & (summary["statistic"] == c.statistic)]
         size = NO_SIZE if c.paper_size is None else NOT_TESTABLE
-        row = {"claim": c.claim, "source": c.source, "measure": c.measure,
+        row = {"searchers": pair_label((head_on, head_off)), "claim": c.claim, "source": c.source,
+               "measure": c.measure,
                "paper_size": math.nan if c.paper_size is None else c.paper_size, "value": math.nan,
                "ci_low": math.nan, "ci_high": math.nan, "n_scenarios": 0, "n_seeds": "", "sign": NOT_TESTABLE,
                "size": size, "verdict": NOT_TESTABLE}
@@ -464,32 +482,63 @@ def claims_frame(summary: pd.DataFrame, head_on: str = "head_on", head_off: str 
             f = ref.iloc[0]
             row["detail"] += f"; {head_off} for reference: {_num(f.value)} [{_num(f.ci_low)}, {_num(f.ci_high)}]"
         out.append(row)
-    return pd.DataFrame(out, columns=list(CLAIM_COLUMNS))
+    return out
 
 
 def _num(x: float, digits: int = 3) -> str:
     return "–" if x is None or not math.isfinite(x) else f"{x:+.{digits}f}"
 
 
+def _interval(r) -> str:
+    return f"{_num(r.value)} [{_num(r.ci_low)}, {_num(r.ci_high)}]" if math.isfinite(r.value) else "–"
+
+
+def _scenarios_by_seeds(r) -> str:
+    return f"{r.n_scenarios} × {r.n_seeds}" if r.n_scenarios else "–"
+
+
+def _paper_size(r) -> str:
+    return _num(r.paper_size, 2) if math.isfinite(r.paper_size) else "none stated"
+
+
+_HOW_TO_READ = ("Measured on the abstract searcher's evaluation episodes (the policy that plans the full-body "
+                "character's steps), from per-step traces. Intervals: bootstrap over scenarios, then seeds; head on "
+                "minus head off draws the scenarios both ran once for both sides. Two verdicts per sentence, both "
+                "read from the 95% interval. Sign: *holds* when the interval lies wholly on the sentence's side of "
+                "0, *not shown* when it holds 0, *opposite* when it lies wholly on the other side. Size, where the "
+                "sentence states a number: *size reproduced* when the interval holds the paper's number, *size not "
+                "reproduced* when it does not; *no size in the paper* where the sentence gives only a direction. "
+                "\"Sign holds, size not reproduced\" means the direction was reproduced and the amount was not.")
+
+
 def claims_markdown(claims: pd.DataFrame) -> str:
-    """The claims table as Markdown, with how to read it."""
-    lines = ["| paper (where) | measured as | paper's size | value [95% CI] | scenarios × seeds "
-             "| verdict: sign, size |", "|---|---|---|---|---|---|"]
-    for r in claims.itertuples(index=False):
-        value = (f"{_num(r.value)} [{_num(r.ci_low)}, {_num(r.ci_high)}]" if math.isfinite(r.value) else "–")
-        size = f"{r.n_scenarios} × {r.n_seeds}" if r.n_scenarios else "–"
-        paper = _num(r.paper_size, 2) if math.isfinite(r.paper_size) else "none stated"
-        lines.append(f"| \"{r.claim}\" ({r.source}) | {r.measure} | {paper} | {value} | {size} | **{r.verdict}** "
-                     f"({r.detail}) |")
-    return ("\n".join(lines) + "\n\nMeasured on the abstract searcher's evaluation episodes (the policy that plans "
-            "the full-body character's steps), from per-step traces. Intervals: bootstrap over scenarios, then "
-            "seeds; head on minus head off draws the scenarios both ran once for both sides. Two verdicts per "
-            "sentence, both read from the 95% interval. Sign: *holds* when the interval lies wholly on the "
-            "sentence's side of 0, *not shown* when it holds 0, *opposite* when it lies wholly on the other side. "
-            "Size, where the sentence states a number: *size reproduced* when the interval holds the paper's "
-            "number, *size not reproduced* when it does not; *no size in the paper* where the sentence gives "
-            "only a direction. \"Sign holds, size not reproduced\" means the direction was reproduced and the "
-            "amount was not.\n")
+    """The claims table as Markdown, with how to read it: one row per sentence and a column per verdict for
+    one pair of searchers; with several pairs, the pairs side by side (one column each, the first pair
+    first) and each verdict's detail listed below the table."""
+    if "searchers" not in claims.columns:
+        claims = claims.assign(searchers="")
+    pairs = list(dict.fromkeys(claims["searchers"]))
+    if len(pairs) <= 1:
+        lines = ["| paper (where) | measured as | paper's size | value [95% CI] | scenarios × seeds "
+                 "| verdict: sign, size |", "|---|---|---|---|---|---|"]
+        for r in claims.itertuples(index=False):
+            lines.append(f"| \"{r.claim}\" ({r.source}) | {r.measure} | {_paper_size(r)} | {_interval(r)} | "
+                         f"{_scenarios_by_seeds(r)} | **{r.verdict}** ({r.detail}) |")
+        return "\n".join(lines) + "\n\n" + _HOW_TO_READ + "\n"
+    lines = ["| paper (where) | measured as | paper's size | " + " | ".join(f"`{p}`" for p in pairs) + " |",
+             "|---|---|---|" + "---|" * len(pairs)]
+    notes = []
+    for claim, rows in claims.groupby("claim", sort=False):
+        by_pair = {r.searchers: r for r in rows.itertuples(index=False)}
+        first = rows.iloc[0]
+        cells = [f"{_interval(by_pair[p])}, {_scenarios_by_seeds(by_pair[p])}: **{by_pair[p].verdict}**"
+                 if p in by_pair else "–" for p in pairs]
+        lines.append(f"| \"{claim}\" ({first.source}) | {first.measure} | {_paper_size(first)} | "
+                     + " | ".join(cells) + " |")
+        notes.append(f"- \"{claim}\": " + "; ".join(f"`{p}`: {by_pair[p].detail}" for p in pairs if p in by_pair))
+    return ("\n".join(lines) + "\n\nOne column per pair of searchers (the one that moves its head / the one that "
+            "does not), each cell the value [95% CI], scenarios × seeds and the verdict. " + _HOW_TO_READ
+            + "\n\nWhat each verdict rests on:\n\n" + "\n".join(notes) + "\n")
 
 
 def behaviour_markdown(summary: pd.DataFrame, first: tuple[str, ...] = ("head_on", "head_off")) -> str:
@@ -507,21 +556,42 @@ def behaviour_markdown(summary: pd.DataFrame, first: tuple[str, ...] = ("head_on
     return "\n".join(lines) + "\n"
 
 
-def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, head_on: str = "head_on",
-                     head_off: str = "head_off", n_resamples: int = 10_000) -> list[Path]:
+def parse_pair(text: str) -> Pair:
+    """``head_on:head_off`` -> ("head_on", "head_off")."""
+    on, sep, off = text.partition(":")
+    if not sep or not on or not off or ":" in off or on == off:
+        raise ValueError(f"--pairs {text!r}: expected HEAD_ON:HEAD_OFF, two different searchers (e.g. "
+                         "head_on:head_off)")
+    return on, off
+
+
+def check_pairs(pairs: Iterable[Pair], variants: Iterable[str]) -> None:
+    """One line naming each variant of ``pairs`` that no trace file holds (a typo reads every claim as not
+    testable otherwise)."""
+    have = set(variants)
+    missing = sorted({v for pair in pairs for v in pair} - have)
+    if missing:
+        raise ValueError(f"no trace files of {', '.join(missing)} (the pairs' variants); the files hold "
+                         f"{', '.join(sorted(have))}")
+
+
+def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, pairs: Iterable[Pair] = DEFAULT_PAIRS,
+                     n_resamples: int = 10_000) -> list[Path]:
     """``{prefix}_episodes.csv``, ``{prefix}.csv`` / ``.md`` (every statistic) and ``{prefix}_claims.csv`` /
-    ``.md`` from trace files; a folder as ``out_prefix`` (an existing one, or ending in ``/``) means
-    ``folder/behaviour``."""
+    ``.md`` from trace files, the claims read on each (head on, head off) pair of ``pairs``; a folder as
+    ``out_prefix`` (an existing one, or ending in ``/``) means ``folder/behaviour``."""
+    pairs, paths = tuple(tuple(p) for p in pairs), list(paths)
+    check_pairs(pairs, (parse_trace_path(p)["variant"] for p in paths))
     out = output_base(out_prefix, "behaviour")
     episodes = behaviour_episodes(paths)
-    summary = summarise(episodes, head_on, head_off, n_resamples=n_resamples)
-    claims = claims_frame(summary, head_on, head_off)
+    summary = summarise(episodes, pairs, n_resamples=n_resamples)
+    claims = claims_frame(summary, pairs)
     written = [out.with_name(out.name + "_episodes.csv"), out.with_name(out.name + ".csv"),
                out.with_name(out.name + ".md"), out.with_name(out.name + "_claims.csv"),
                out.with_name(out.name + "_claims.md")]
     episodes.to_csv(written[0], index=False)
     summary.to_csv(written[1], index=False)
-    written[2].write_text(behaviour_markdown(summary, (head_on, head_off)), encoding="utf-8")
+    written[2].write_text(behaviour_markdown(summary, tuple(v for pair in pairs for v in pair)), encoding="utf-8")
     claims.to_csv(written[3], index=False)
     written[4].write_text(claims_markdown(claims), encoding="utf-8")
     return written

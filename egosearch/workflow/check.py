@@ -17,6 +17,9 @@ from pathlib import Path
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
+CLASSICAL_SEARCHERS = ("frontier", "frontier_head_off")
+"""The names in ``claims_pairs`` that are the classical searchers (traced by the ``trace_bound`` rule), not
+variant files."""
 
 
 class ConfigError(ValueError):
@@ -69,6 +72,10 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     except jsonschema.ValidationError as err:
         where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
         raise ConfigError(f"config {where}: {err.message}") from None
+    for pair in config.get("claims_pairs", []):
+        if pair[0] == pair[1]:
+            raise ConfigError(f"config claims_pairs: {pair} is one searcher twice; a pair is [head moving, head "
+                              "fixed]")
     if config.get("fresh_scenario_seed") == config["scenario_seed"]:
         raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
                           "scenario_seed; the fresh-set check needs sets never stored")
@@ -77,14 +84,16 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
 def workflow_variants(config: dict, compare: bool | str = False,
                       directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
     """Every variant the run may train, read and checked against the run's learner profile:
-    ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference and, when set (or when
+    ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference, the variants of
+    ``claims_pairs`` and, when set (or when
     ``compare`` names a target that compares, "compare" or "screen"), ``variant``."""
     target = compare if isinstance(compare, str) else "compare"
     budget_config = config["profiles"][config["profile"]].get("budget", {})
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
+    claims = [name for pair in config.get("claims_pairs", []) for name in pair if name not in CLASSICAL_SEARCHERS]
     names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
-                               + generalise["variants"]))
+                               + generalise["variants"] + claims))
     if compare and not config.get("variant"):
         raise VariantError(f"{target} needs a variant: snakemake --cores 2 {target} --config variant=NAME")
     if compare and config["variant"] == config["reference_variant"]:

@@ -7,10 +7,17 @@
 TRACE_CELLS = [(placement, height) for placement in PLACEMENTS for height in HEIGHTS]
 # The pictures: the humanoid's camera height of Section 6.3, with targets inside cabinets allowed.
 SEARCH_CELLS = [("everywhere", HEIGHTS[-1])]
-# Figure 6's pair: the head moving, and held fixed.
-TRACE_VARIANTS = ["head_on", "head_off"]
+# The pairs the claims are read on (config claims_pairs): variants with every seed, the classical
+# searchers with BOUND_SEEDS. The first pair is Figure 6's (the head moving, and held fixed): the
+# pictured searches are its.
+CLAIMS_PAIRS = [tuple(pair) for pair in config["claims_pairs"]]
+TRACE_VARIANTS = list(CLAIMS_PAIRS[0])
+
+
 TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
-               for v in TRACE_VARIANTS for s in SEEDS for home in HOMES for placement, height in TRACE_CELLS]
+               for v in dict.fromkeys(v for pair in CLAIMS_PAIRS for v in pair)
+               for s in (BOUND_SEEDS if v in CLASSICAL_SEARCHERS else SEEDS)
+               for home in HOMES for placement, height in TRACE_CELLS]
 SEARCH_TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
                       for v in TRACE_VARIANTS for s in SEEDS for home in HOMES for placement, height in SEARCH_CELLS]
 
@@ -38,9 +45,38 @@ rule trace:
         "--seed {wildcards.seed} --out {output.episodes} --traces {output.trace} > {log} 2>&1"
 
 
+# traces/frontier/... and traces/frontier_head_off/... are the classical searchers', not variants.
+ruleorder: trace_bound > trace
+
+
+rule trace_bound:
+    """A classical searcher on one Table 1 cell, every step of every episode recorded (the claims read
+    on the classical pair)."""
+    input:
+        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+    output:
+        trace="results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.npz",
+        episodes="results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    wildcard_constraints:
+        bound="|".join(CLASSICAL_SEARCHERS),
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --force --policy {wildcards.bound} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output.episodes} --traces {output.trace} > {log} 2>&1"
+
+
 rule behaviour:
-    """Behaviour statistics per variant and head on minus head off, and the paper's behaviour
-    sentences (Section 6.3, Figure 6) with their verdicts."""
+    """Behaviour statistics per searcher and head on minus head off per pair, and the paper's behaviour
+    sentences (Section 6.3, Figure 6) with their verdicts, read on each pair side by side."""
     input:
         ancient(TRACE_FILES),
     output:
@@ -51,10 +87,11 @@ rule behaviour:
         f"{RESULTS}/benchmarks/report/behaviour.tsv"
     params:
         prefix=lambda wc, output: output[1].rsplit(".", 1)[0],
+        pairs=" ".join(f"{on}:{off}" for on, off in CLAIMS_PAIRS),
     conda:
         CONDA_ENV
     shell:
-        "egosearch report behaviour --force {input} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report behaviour --force {input} --pairs {params.pairs} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule searches:
