@@ -26,7 +26,6 @@ from egosearch.report.schedule import (
     machine_key,
     scale_to_rate,
     simulate,
-    training_rates,
 )
 from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
 from egosearch.workflow.dag import dag_jobs
@@ -78,13 +77,38 @@ def run(args) -> None:
 
 
 def stored_training_rates(record: dict, results: Path) -> dict[str, float]:
-    """Every stored training's env steps per CPU-second (lever screens too: one may share the
-    learner benchmark's machine), by job key; a training that learned from the classical searcher is
-    left out: its CPU time also paid for the teacher's episodes and the cloning, so its env steps per
-    CPU-second is not the learner's rate."""
-    recorded = [r["job"] for r in record.get("jobs", []) if r.get("rule") == TRAIN
-                and not learned_from_teacher(results / "train" / r["job"])]
-    return training_rates(record, env_steps_of(results, recorded))
+    """Every stored training's env steps per CPU-second of its learner (lever screens too: one may share
+    the learner benchmark's machine), by job key. A training that learned from the classical searcher
+    counts the CPU time of its RL phase only (its run's, less the teacher's episodes and the cloning that
+    its ``done.json`` records); one that recorded no cloning time is left out: its env steps per
+    CPU-second would mix the teacher's cost into the learner's rate."""
+    jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN]
+    steps = env_steps_of(results, [r["job"] for r in jobs])
+    out = {}
+    for row in jobs:
+        outside = cpu_s_outside_rl(results / "train" / row["job"])
+        if row["job"] not in steps or outside is None:
+            continue
+        cost = job_cost_s(row) - outside
+        if cost > 0:
+            out[row["job"]] = steps[row["job"]] / cost
+    return out
+
+
+def cpu_s_outside_rl(run_dir: Path) -> float | None:
+    """CPU seconds a training spent before its RL phase: 0 for one from scratch; for one that learned
+    from the classical searcher (its config.json's ``demo_episodes``), its demonstrations' and its
+    imitation's (cloning, DAgger) ``cpu_s`` from its ``done.json``, None when it recorded no imitation."""
+    if not learned_from_teacher(run_dir):
+        return 0.0
+    try:
+        done = json.loads((run_dir / "done.json").read_text(encoding="utf-8"))
+        imitation = done.get("imitation", {}).get("cpu_s", 0.0 if not done["config"].get("bc_updates") else None)
+        if imitation is None:
+            return None
+        return float(done["demonstrations"]["cpu_s"]) + float(imitation)
+    except (OSError, ValueError, KeyError):
+        return None
 
 
 def learned_from_teacher(run_dir: Path) -> bool:

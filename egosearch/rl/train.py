@@ -529,6 +529,7 @@ class _Run:
         cfg = self.cfg
         if not cfg.bc_updates:
             return
+        cpu0, wall0 = time.process_time(), time.perf_counter()
         optimiser = torch.optim.Adam(self.agent.clone_parameters(), lr=cfg.actor_lr,
                                      betas=(cfg.actor_beta1, cfg.actor_beta2))
         sources = [self.demos]
@@ -543,6 +544,9 @@ class _Run:
             sources.append(labelled)
             loss = clone(self.agent, sources, cfg.bc_updates, cfg.batch_size, optimiser, self.say,
                          f"DAgger round {r + 1}: cloning")
+        # The learner's own rate (env steps per CPU-second, what the estimates scale) leaves this out.
+        self.imitation.update(cpu_s=round(time.process_time() - cpu0, 1), wall_s=round(time.perf_counter() - wall0, 1),
+                              bc_updates=cfg.bc_updates * (1 + cfg.dagger_rounds))
         self.train_log.write({"env_steps": 0, "episodes": 0, "updates": 0, "bc_loss": loss,
                               "alpha": self.agent.alpha, "wall_s": self.wall()})
 
@@ -635,6 +639,8 @@ class _Run:
             summary["demonstrations"] = self.demo_summary
         if self.imitation["dagger"]:
             summary["dagger"] = self.imitation["dagger"]
+        if "cpu_s" in self.imitation:
+            summary["imitation"] = {k: self.imitation[k] for k in ("cpu_s", "wall_s", "bc_updates")}
         atomic_json(self.done_path, summary)
         if not cfg.keep_checkpoint:
             for demos in (self.demos_path, summary_path(self.demos_path)):
