@@ -59,3 +59,16 @@ def test_demonstrations_sample_as_the_learners_replay_with_n_step_returns(demos)
     assert (batch["discount"] <= cfg.gamma + 1e-6).all()
     assert (batch["discount"] >= cfg.gamma ** cfg.n_step - 1e-6).all()
 
+
+
+def test_the_head_off_body_learns_from_the_head_fixed_searcher(tmp_path):
+    """head_off's demonstrations: the frontier searcher holding its camera fixed, in the head-off env."""
+    cfg = load_config("cpu", {"seed": 3})
+    path = tmp_path / "head_off.replay.npz"
+    summary = collect_demonstrations("EgoSearchNoHead-v0", cfg, ENV, 2, path, seed=1, progress=False)
+    assert not summary["teacher_head"] and "NoHead" in summary["env_id"]
+    env = make_train_env(summary["env_id"], train_env_kwargs(cfg, ENV))
+    assert not FrontierPolicy(env).head
+    buf = load_demonstrations(path, cfg).buffers[0]
+    assert buf.action.shape[1] == env.action_space.shape[0] < 5  # no head angles to act on
+    env.close()
