@@ -26,3 +26,29 @@ def test_bad_variant_files(tmp_path):
         load_variant("wrongname", tmp_path)
     with pytest.raises(VariantError, match="allowed: typo, wrongname"):
         load_variant("missing", tmp_path)
+
+
+# Fields that change how fast or how often a run reports, not what it learns.
+NOT_LEARNING = {"num_threads", "device", "compile", "cuda_graph", "channels_last", "share_encoder_forward",
+                "eval_episodes", "eval_every", "log_every", "checkpoint_every", "keep_checkpoint", "seed"}
+REPO = __import__("pathlib").Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize("run", sorted(str(p.parent.relative_to(REPO)) for p in
+                                       (REPO / "results").glob("*/train/*/seed*/config.json")))
+def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
+    """So a profile that changes pins the old values in the files of the runs stored before it (as
+    head_on_25px does): otherwise `compare` would read a stored run as the variant's, trained otherwise."""
+    import dataclasses
+    import json
+
+    from egosearch.rl.config import LearnerConfig, load_config
+
+    _, profile, _, name, _ = run.split("/")
+    stored = json.loads((REPO / run / "config.json").read_text())
+    want = load_config(profile, load_variant(name).config).to_dict()
+    got = {f.name: f.default for f in dataclasses.fields(LearnerConfig)} | stored["config"]
+    # runs from before target_memory was a learner field name the memory in their env id
+    got["target_memory"] = got["target_memory"] or any(m in stored["env_id"] for m in ("Memory", "Map"))
+    differ = {k: (got[k], v) for k, v in want.items() if k not in NOT_LEARNING and got[k] != v}
+    assert not differ, f"{run}: stored, variant file: {differ}"
