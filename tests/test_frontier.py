@@ -51,3 +51,29 @@ def test_frontier_head_fixed_never_moves_the_head_and_maps_obstacles():
             break
     assert (policy.grid == 1).sum() > 100 and (policy.grid == 2).sum() > 10  # free floor and obstacles seen
     env.close()
+
+
+def test_the_stored_bound_rows_are_the_nearest_frontier_choice_and_another_choice_is_honoured():
+    """The choice of where to explore is one method: left alone it repeats the stored Table 1 bound row for
+    row; overridden (here: the farthest frontier by path), the searcher walks elsewhere."""
+    import csv
+    from pathlib import Path
+
+    from egosearch.sim.scenarios import read_scenarios
+
+    cell = Path(__file__).resolve().parent.parent / "results/cpu/{}/kitchen_living/no_low_cabinets/h1.05.csv"
+    scenarios = read_scenarios(str(cell).format("scenarios"))[:3]
+    with open(str(cell).format("eval/frontier/seed0"), newline="") as f:
+        stored = list(csv.DictReader(f))[:3]
+    rows = evaluate("EgoSearch-v0", FrontierPolicy, scenarios, seed=0)
+    for row, want in zip(rows, stored, strict=True):
+        assert (row["scenario_id"], row["steps"], row["success"]) == (int(want["scenario_id"]), int(want["steps"]),
+                                                                      bool(int(want["success"])))
+        assert row["path_length"] == float(want["path_length"])
+
+    class Farthest(FrontierPolicy):
+        def choose_frontier(self, frontier, dist, offset):
+            return np.unravel_index(int(np.argmax(np.where(frontier, dist, -np.inf))), dist.shape)
+
+    other = evaluate("EgoSearch-v0", Farthest, scenarios, seed=0)
+    assert [r["path_length"] for r in other] != [r["path_length"] for r in rows]

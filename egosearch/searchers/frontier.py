@@ -162,7 +162,10 @@ class FrontierPolicy:
         if not goal.any():
             self.path = []
             return
-        end = np.unravel_index(int(np.argmin(np.where(goal, dist, np.inf))), dist.shape)
+        if self.target is None:
+            end = self.choose_frontier(goal, dist, offset)
+        else:
+            end = np.unravel_index(int(np.argmin(np.where(goal, dist, np.inf))), dist.shape)
         # walk back down the distance field from the goal to the start
         path = [tuple(int(v) for v in end)]
         while path[-1] != local:
@@ -178,6 +181,13 @@ class FrontierPolicy:
                 break
             path.append(best)
         self.path = [(r + offset[0], c + offset[1]) for r, c in path[::-1]]
+
+    def choose_frontier(self, frontier: np.ndarray, dist: np.ndarray, offset: tuple[int, int]) -> tuple[int, int]:
+        """Where to explore next: a cell of ``frontier`` (free, reachable, next to unknown cells, at least
+        0.5 m away) of the planning window whose top-left map cell is ``offset``; ``dist`` is the path
+        length (m) to each cell. This searcher takes the nearest by path; a searcher that learns where to
+        go overrides only this choice and keeps the mapping, planning and walking."""
+        return np.unravel_index(int(np.argmin(np.where(frontier, dist, np.inf))), dist.shape)
 
     # -- acting -------------------------------------------------------------------------------
     def act(self, obs: dict) -> np.ndarray:
