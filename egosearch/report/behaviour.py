@@ -8,7 +8,8 @@ Three steps, each a function:
    episodes, with a two-level bootstrap interval (scenarios, then seeds, as ``stats.two_level_ci``);
    and head-on minus head-off on the scenarios both ran (one draw of scenarios for both sides, the
    seeds per side, as ``stats.paired_two_level_ci``);
-3. :func:`claims_frame`: one row per paper sentence with two verdicts, for its sign and for its size.
+3. :func:`claims_frame`: one row per pair of searchers (head moving, head fixed) and paper sentence, with two
+   verdicts, for its sign and for its size.
 
 A statistic is ``sum(numerator) / sum(denominator)`` over the drawn episodes (a mean over steps
 weighs every step alike, a share of episodes every episode alike), so an episode with nothing to
