@@ -103,10 +103,13 @@ def cpu_s_outside_rl(run_dir: Path) -> float | None:
         return 0.0
     try:
         done = json.loads((run_dir / "done.json").read_text(encoding="utf-8"))
-        imitation = done.get("imitation", {}).get("cpu_s", 0.0 if not done["config"].get("bc_updates") else None)
-        if imitation is None:
-            return None
-        return float(done["demonstrations"]["cpu_s"]) + float(imitation)
+        if "imitation" in done:
+            imitation = float(done["imitation"]["cpu_s"])
+        elif done["config"].get("bc_updates"):
+            return None  # cloned before trainings recorded the cloning's time
+        else:
+            imitation = 0.0  # demonstrations in replay, no cloning
+        return float(done["demonstrations"]["cpu_s"]) + imitation
     except (OSError, ValueError, KeyError):
         return None
 

@@ -12,8 +12,6 @@ SEARCH_CELLS = [("everywhere", HEIGHTS[-1])]
 # pictured searches are its.
 CLAIMS_PAIRS = [tuple(pair) for pair in config["claims_pairs"]]
 TRACE_VARIANTS = list(CLAIMS_PAIRS[0])
-
-
 TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
                for v in dict.fromkeys(v for pair in CLAIMS_PAIRS for v in pair)
                for s in (BOUND_SEEDS if v in CLASSICAL_SEARCHERS else SEEDS)
