@@ -39,7 +39,9 @@ class Variant:
     """File stem in ``ablations/``; the ``{variant}`` of every output path."""
     env_id: str
     """``EgoSearch-v0`` (head on) or ``EgoSearchNoHead-v0`` (head off); the ``*Memory-v0`` ids add
-    the last-seen target memory to the observation (a change of observation)."""
+    the last-seen target memory to the observation (a change of observation), the ``*Map-v0`` ids a floor
+    map too; the ``*Modular-v0`` ids learn only where to explore and how to sweep the head, and the
+    frontier searcher walks (``egosearch.searchers.modular``)."""
     train_env: dict
     """Keyword arguments of the training env (layout, placement, objects, training-only aids)."""
     config: dict = field(default_factory=dict)

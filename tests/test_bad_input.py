@@ -65,7 +65,8 @@ BAD_VARIANT_FILES = [
      "ablations/key_typo.yaml: (top level): Additional properties are not allowed ('confgi' was unexpected)"),
     ("env_typo", HEAD.replace("EgoSearch-v0", "EgoSearch-v1"),
      "ablations/env_typo.yaml: env_id: 'EgoSearch-v1' is not one of ['EgoSearch-v0', 'EgoSearchNoHead-v0', "
-     "'EgoSearchMemory-v0', 'EgoSearchNoHeadMemory-v0', 'EgoSearchMap-v0', 'EgoSearchNoHeadMap-v0']"),
+     "'EgoSearchMemory-v0', 'EgoSearchNoHeadMemory-v0', 'EgoSearchMap-v0', 'EgoSearchNoHeadMap-v0', "
+     "'EgoSearchModular-v0', 'EgoSearchNoHeadModular-v0']"),
     ("generated_no_split", HEAD.replace("layout: kitchen_living", "layout: generated"),
      "ablations/generated_no_split.yaml: train_env: layout: generated needs home_seeds: [first, stop)"),
     ("split_without_generated", HEAD.replace("everywhere}", "everywhere, home_seeds: [0, 10]}"),
@@ -261,7 +262,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
          "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, frontier, frontier_head_off, actor"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "random", "--env-id", "Foo-v0", "--out", "o.csv"],
          "egosearch evaluate: error: --env-id='Foo-v0'; allowed: EgoSearch-v0, EgoSearchNoHead-v0, "
-         "EgoSearchMemory-v0, EgoSearchNoHeadMemory-v0, EgoSearchMap-v0, EgoSearchNoHeadMap-v0"),
+         "EgoSearchMemory-v0, EgoSearchNoHeadMemory-v0, EgoSearchMap-v0, EgoSearchNoHeadMap-v0, "
+         "EgoSearchModular-v0, EgoSearchNoHeadModular-v0"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "oracle", "--out", "o.csv"],
          "egosearch evaluate: error: s.csv: no such scenario file"),
         (["train", "--variant", "hed_on", "--out-dir", str(tmp_path / "run")],

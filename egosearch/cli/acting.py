@@ -14,6 +14,7 @@ from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
+from egosearch.sim.envs import BODY_ENV_IDS
 
 
 def set_acting_threads(threads: int) -> None:
@@ -48,9 +49,16 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
         actor = ActorPolicy(weights)
-        env_id = env_id or actor.trained_env_id() or "EgoSearch-v0"
-        actor.check_env(env_id)
+        trained = actor.trained_env_id()
         note_profile(weights, actor, reference_profile(out))
+        if trained in BODY_ENV_IDS and env_id in (None, BODY_ENV_IDS[trained]):
+            # a modular searcher's decisions act step by step in the body env (ModularPolicy), so that
+            # traces, the video and the replanner see every body step
+            from egosearch.searchers.modular import ModularPolicy  # local: it loads the physics
+
+            return (lambda env: ModularPolicy(actor, env)), BODY_ENV_IDS[trained]
+        env_id = env_id or trained or "EgoSearch-v0"
+        actor.check_env(env_id)
         return (lambda env: actor), env_id
     raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, actor")
 

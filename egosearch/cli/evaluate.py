@@ -8,7 +8,7 @@ from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.runs.evaluate import evaluate, write_episodes
 from egosearch.runs.metrics import spl
 from egosearch.runs.trace import TraceRecorder
-from egosearch.sim.envs import ENV_IDS
+from egosearch.sim.envs import ALL_ENV_IDS
 from egosearch.sim.scenarios import read_scenarios
 
 
@@ -19,8 +19,8 @@ def run(args) -> None:
     check_suffix("--traces", args.traces, (".npz",), "a trace file")
     check_seed("--seed", args.seed)
     check_threads(args.threads)
-    if args.env_id and args.env_id not in ENV_IDS:
-        raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ENV_IDS)}")
+    if args.env_id and args.env_id not in ALL_ENV_IDS:
+        raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
     set_acting_threads(args.threads)
     make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,
                                            out=args.out)

@@ -160,6 +160,8 @@ def rollout_plan(env, policy, obs: dict, T: int) -> list[AgentState]:
     """s_0..s_T from the current state (Algorithm 1 lines 1-7); the env is left as it was.
     The rollout stops early where the abstract episode ends (success or T_max)."""
     snap = env.snapshot()
+    # a policy that keeps state of its own (the modular searcher's map and plan) is put back too
+    policy_snap = policy.snapshot() if hasattr(policy, "snapshot") else None
     plan = [env.state.copy()]
     o = obs
     try:
@@ -170,6 +172,8 @@ def rollout_plan(env, policy, obs: dict, T: int) -> list[AgentState]:
                 break
     finally:
         env.restore(snap)
+        if policy_snap is not None:
+            policy.restore(policy_snap)
     return plan
 
 

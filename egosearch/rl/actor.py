@@ -14,7 +14,7 @@ import torch
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.registry import actor_loader
-from egosearch.sim.envs import ENV_IDS, env_space_dims
+from egosearch.sim.envs import ALL_ENV_IDS, env_space_dims
 
 
 class AgentPolicy:
@@ -87,7 +87,7 @@ class ActorPolicy:
         whose sizes it fits (None when no single id does)."""
         if self.env_id:
             return self.env_id
-        fitting = [env_id for env_id in ENV_IDS if self.fits(env_id)]
+        fitting = [env_id for env_id in ALL_ENV_IDS if self.fits(env_id)]
         return fitting[0] if len(fitting) == 1 else None
 
     def check_env(self, env_id: str) -> None:

@@ -189,6 +189,12 @@ class FrontierPolicy:
         go overrides only this choice and keeps the mapping, planning and walking."""
         return np.unravel_index(int(np.argmin(np.where(frontier, dist, np.inf))), dist.shape)
 
+    def scan_head(self) -> tuple[float, float]:
+        """Where the head looks (pitch, yaw in rad) while no target is known: this searcher sweeps the yaw
+        across the view and the pitch between far and near surfaces; a searcher that learns how to move its
+        head overrides only this."""
+        return -0.25 - 0.3 * (1 + math.sin(0.2 * self.steps)) / 2, 1.1 * math.sin(0.45 * self.steps)
+
     # -- acting -------------------------------------------------------------------------------
     def act(self, obs: dict) -> np.ndarray:
         env, s, spec = self.env, self.env.state, self.env.spec_agent
@@ -248,9 +254,8 @@ class FrontierPolicy:
                 want_yaw = float(np.clip(wrap_angle(look - theta), *spec.yaw_limits))
                 horizontal = math.hypot(self.target[0] - s.x, self.target[1] - s.y)
                 want_pitch = math.atan2(self.target[2] - s.camera_height, max(horizontal, 0.1))
-            else:  # scan: sweep the yaw across the view, the pitch between far and near surfaces
-                want_yaw = 1.1 * math.sin(0.45 * self.steps)
-                want_pitch = -0.25 - 0.3 * (1 + math.sin(0.2 * self.steps)) / 2
+            else:
+                want_pitch, want_yaw = self.scan_head()
             want_pitch = float(np.clip(want_pitch, *spec.pitch_limits))
             action += [(want_pitch - s.pitch) / spec.max_pitch_rate, (want_yaw - s.head_yaw) / spec.max_yaw_rate]
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
