@@ -133,7 +133,8 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
     if not isinstance(variant, Variant):
         variant = load_variant(variant)
     config = load_config(profile, {**variant.config, **(overrides or {})})
-    return ResolvedVariant(variant, profile, config, observed_env_id(variant.env_id, config.target_memory))
+    env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
+    return ResolvedVariant(variant, profile, config, env_id)
 
 
 def check_learner_config(variant: Variant, learner_profile: str) -> None:

@@ -183,3 +183,35 @@ def test_the_replanners_look_ahead_leaves_the_modular_searcher_as_it_was():
         return poses
 
     assert episode(look_ahead=True) == episode(look_ahead=False)
+
+
+def test_the_modular_searcher_field_trains_in_the_modular_env_of_the_variants_head():
+    from egosearch.rl.config import load_config
+    from egosearch.sim.envs import observed_env_id
+    from egosearch.variants import resolve_variant
+
+    assert observed_env_id("EgoSearch-v0", False, True) == "EgoSearchModular-v0"
+    assert observed_env_id("EgoSearchNoHead-v0", False, True) == "EgoSearchNoHeadModular-v0"
+    assert observed_env_id("EgoSearchModular-v0", False, False) == "EgoSearchModular-v0"
+    assert resolve_variant("head_off", "cpu", {"modular_searcher": True, "target_memory": False}).env_id == \
+        "EgoSearchNoHeadModular-v0"
+    assert resolve_variant("head_off", "cpu").env_id == "EgoSearchNoHeadMemory-v0"
+    with pytest.raises(ValueError, match="target_memory"):
+        load_config("cpu", {"modular_searcher": True})  # the cpu profile remembers the target in the observation
+    with pytest.raises(ValueError, match="demo_episodes"):
+        load_config("cpu", {"modular_searcher": True, "target_memory": False, "demo_episodes": 10})
+
+
+def test_a_run_stored_before_the_field_is_the_same_run_as_the_variant_that_names_it(tmp_path):
+    import json
+    from pathlib import Path
+
+    from egosearch.rl.run_files import check_same_run
+    from egosearch.variants import resolve_variant
+
+    stored = Path(__file__).resolve().parent.parent / "results/cpu/train/head_on_modular/seed0/done.json"
+    done = json.loads(stored.read_text())
+    assert "modular_searcher" not in done["config"]
+    resolved = resolve_variant("head_on_modular", "cpu", {"seed": 0})
+    check_same_run("finished run", stored, done, "head_on_modular", resolved.env_id, resolved.variant.train_env,
+                   resolved.config)

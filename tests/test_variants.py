@@ -50,5 +50,6 @@ def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
     got = {f.name: f.default for f in dataclasses.fields(LearnerConfig)} | stored["config"]
     # runs from before target_memory was a learner field name the memory in their env id
     got["target_memory"] = got["target_memory"] or any(m in stored["env_id"] for m in ("Memory", "Map"))
+    got["modular_searcher"] = got["modular_searcher"] or "Modular" in stored["env_id"]
     differ = {k: (got[k], v) for k, v in want.items() if k not in NOT_LEARNING and got[k] != v}
     assert not differ, f"{run}: stored, variant file: {differ}"

@@ -208,6 +208,18 @@ class LearnerConfig:
     CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
     ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
     profile never."""
+    modular_searcher: bool = False
+    """Paper: False (the policy acts at every body step: its steps, turns and head). True: a modular
+    searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the
+    ``head_on_modular`` lever): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
+    its variant's head (EgoSearch-v0 -> EgoSearchModular-v0, EgoSearchNoHead-v0 ->
+    EgoSearchNoHeadModular-v0; ``egosearch.searchers.modular``): it decides only where to explore (a
+    point on its own floor map, walked to as the nearest reachable frontier) and how to sweep the head,
+    at most every 10 body steps, and the frontier searcher maps, plans and walks the body. Its
+    observation adds that map. So the env steps of ``total_env_steps`` and every schedule count
+    decisions. This CHANGES WHAT IS LEARNED AND THE OBSERVATION, at evaluation too (the claims about
+    the body's steps cannot be read on it); the same as naming that id in the variant file. Not with
+    ``target_memory`` (the frontier searcher remembers where it saw the target) nor demonstrations."""
     encoder_stride2_layers: int = 1
     """CURL: 1 (the first conv has stride 2, the rest stride 1). "sac_drq" only: the first this
     many convs have stride 2 (smaller maps, far fewer FLOPs)."""
@@ -552,6 +564,10 @@ class LearnerConfig:
             bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
         if self.bc_weight > 0 and self.bc_decay_steps == 0:
             bad("bc_decay_steps", ">= 1 with bc_weight > 0 (the env steps over which the term decays)")
+        if self.modular_searcher and self.target_memory:
+            bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
+        if self.modular_searcher and self.demo_episodes:
+            bad("demo_episodes", "0 with modular_searcher (the demonstrations are the frontier searcher's body steps)")
         if (self.demo_episodes or self.critic_warmup_updates) and self.algorithm != "sac_drq":
             bad("demo_episodes" if self.demo_episodes else "critic_warmup_updates",
                 f"0 for algorithm {self.algorithm} (only sac_drq learns from demonstrations)")

@@ -54,7 +54,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
     if episodes < 1:
         raise ValueError(f"episodes={episodes}; allowed: >= 1")
     out_path = Path(out_path)
-    observed = observed_env_id(env_id, cfg.target_memory)
+    observed = observed_env_id(env_id, cfg.target_memory, cfg.modular_searcher)
     env = make_train_env(observed, train_env_kwargs(cfg, env_kwargs))
     cpu0, wall0 = time.process_time(), time.perf_counter()
     try:

@@ -215,6 +215,8 @@ def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str
                               f"not {env_kwargs_key(env_kwargs)}; use another out_dir")
     # runs saved before these fields existed ran without them, i.e. as their defaults
     theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
+    # runs saved before modular_searcher was a field named the modular searcher in their env id only
+    theirs.setdefault("modular_searcher", "Modular" in str(saved.get("env_id")))
     mine = cfg.to_dict()
     diff = sorted(k for k in set(mine) | set(theirs) if k not in RESUMABLE_FIELDS and mine.get(k) != theirs.get(k))
     if diff:

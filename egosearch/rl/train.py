@@ -196,7 +196,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     call resumes from that checkpoint.
     """
     cfg = cfg.validate()
-    env_id = observed_env_id(env_id, cfg.target_memory)
+    env_id = observed_env_id(env_id, cfg.target_memory, cfg.modular_searcher)
     env_kwargs = dict(env_kwargs or {})
     out_dir = Path(out_dir)
     variant = variant or env_id

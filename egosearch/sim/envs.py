@@ -64,9 +64,12 @@ def env_space_dims(env_id: str) -> dict[str, int]:
     return space_dims(**ENV_IDS[env_id])
 
 
-def observed_env_id(env_id: str, target_memory: bool) -> str:
+def observed_env_id(env_id: str, target_memory: bool, modular_searcher: bool = False) -> str:
     """The id a policy trains and is evaluated in: ``env_id``, or with ``target_memory`` (a learner
-    config field that changes the observation) its ``*Memory-v0`` form of the same head."""
+    config field that changes the observation) its ``*Memory-v0`` form of the same head, with
+    ``modular_searcher`` (one that changes what is learned) its ``*Modular-v0`` form."""
+    if modular_searcher and env_id in ENV_IDS:
+        return "EgoSearchModular-v0" if ENV_IDS[env_id]["head"] else "EgoSearchNoHeadModular-v0"
     if not target_memory or env_id not in ENV_IDS or ENV_IDS[env_id].get("target_memory"):
         return env_id
     return "EgoSearchMemory-v0" if ENV_IDS[env_id]["head"] else "EgoSearchNoHeadMemory-v0"
