@@ -184,15 +184,16 @@ def test_an_empty_measure_is_not_testable():
     assert got["sign"][0] == "not testable here"
 
 
-def _write_trace(path, episodes, head=True):
+def _write_trace(path, episodes, head=True, learns=None):
     cols = {k: [] for k in ("scenario_id", "step", "x", "y", "theta", "head_yaw", "pitch", "visible", "success",
                             "gaze_kind", "opening_distance")}
     for sid, ep in episodes.items():
         for k in cols:
             cols[k] += list(ep[k]) if k != "scenario_id" else [sid] * len(ep)
     path.parent.mkdir(parents=True, exist_ok=True)
+    facts = {} if learns is None else {"learns": np.asarray(learns)}
     np.savez_compressed(path, **{k: np.asarray(v) for k, v in cols.items()}, step_seconds=np.asarray(0.5),
-                        head=np.asarray(head))
+                        head=np.asarray(head), **facts)
 
 
 def test_trace_files_to_claims_and_the_readme_block(tmp_path):
@@ -277,3 +278,30 @@ def test_a_pair_without_traces_is_one_line_before_any_work(tmp_path):
     assert not (tmp_path / "out").exists()
     assert main(["report", "behaviour", str(path), "--pairs", "head_on", "--out-prefix", str(tmp_path)]) == 2
     assert main(["report", "behaviour", str(path), "--pairs", "head_on:head_on", "--out-prefix", str(tmp_path)]) == 2
+
+
+def test_the_body_claims_are_not_read_on_a_searcher_whose_body_steps_are_not_learned(tmp_path):
+    """A modular searcher's traces say it learns decisions: its speed, backward steps and body turns are the
+    frontier searcher's, so those claims are declared unread on its pair; success is read as on any pair."""
+    from egosearch.report.behaviour import CLAIMS, NOT_LEARNED
+
+    traces = tmp_path / "traces"
+    paths = []
+    for variant, learns in (("head_on", None), ("head_off", None), ("head_on_modular", "decisions"),
+                            ("head_off_modular", "decisions")):
+        paths.append(traces / variant / "seed0" / "kitchen_living" / "everywhere" / "h1.65.npz")
+        _write_trace(paths[-1], {0: HAND, 3: HAND}, head="head_on" in variant, learns=learns)
+    assert set(behaviour_episodes(paths).groupby("variant")["learns"].first().items()) == {
+        ("head_on", "steps"), ("head_off", "steps"), ("head_on_modular", "decisions"),
+        ("head_off_modular", "decisions")}
+    written = behaviour_report(paths, tmp_path / "out" / "behaviour", n_resamples=200,
+                               pairs=[("head_on", "head_off"), ("head_on_modular", "head_off_modular")])
+    claims = pd.read_csv(written[3])
+    modular = claims[claims["searchers"] == "head_on_modular / head_off_modular"].set_index("claim")
+    learned = claims[claims["searchers"] == "head_on / head_off"].set_index("claim")
+    body = [c.claim for c in CLAIMS if c.body]
+    assert len(body) == 3 and (modular.loc[body, "detail"] == NOT_LEARNED).all()
+    assert (modular.loc[body, "verdict"] == "not testable here").all()
+    assert not (learned["detail"] == NOT_LEARNED).any()
+    success = next(c.claim for c in CLAIMS if c.statistic == "success")
+    assert modular.loc[success, "n_scenarios"] == 2 and modular.loc[success, "detail"] != NOT_LEARNED

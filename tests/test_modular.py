@@ -148,13 +148,17 @@ class ObservationDecides:
 
 def test_the_per_step_policy_on_the_body_env_is_the_decision_env_step_for_step():
     from egosearch.runs.evaluate import evaluate
+    from egosearch.runs.trace import TraceRecorder
     from egosearch.searchers.modular import ModularPolicy
 
     scenarios = generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=3, seed=8)
     high = ObservationDecides()
     decisions = evaluate("EgoSearchModular-v0", lambda env: high, scenarios, seed=0)
-    steps = evaluate(BODY_ENV_IDS["EgoSearchModular-v0"], lambda env: ModularPolicy(high, env), scenarios, seed=0)
+    recorder = TraceRecorder()
+    steps = evaluate(BODY_ENV_IDS["EgoSearchModular-v0"], lambda env: ModularPolicy(high, env), scenarios, seed=0,
+                     recorder=recorder)
     assert decisions == steps
+    assert recorder.meta["learns"] == "decisions"  # the claims about the body's steps are not read on it
     assert len({r["steps"] for r in steps}) > 1  # three different episodes, not one repeated
 
 

@@ -178,6 +178,7 @@ def behaviour_episodes(paths: Iterable[PathLike]) -> pd.DataFrame:
         for scenario_id, ep in steps.groupby("scenario_id", sort=True):
             rows.append({"variant": where["variant"], "seed": where["seed"], "cell": cell,
                          "scenario_id": int(scenario_id), "head": bool(facts.get("head", True)),
+                         "learns": str(facts.get("learns", "steps")),
                          **episode_behaviour(ep, float(facts["step_seconds"]))})
     if not rows:
         raise ValueError("no trace files given")
@@ -362,23 +363,26 @@ class Claim:
     """+1: the sentence says the number is above 0; -1: below."""
     paper_size: float | None = None
     """The size the sentence states, in the measure's unit; None where it states only a direction."""
+    body: bool = False
+    """The sentence is about how the body steps and turns: not read on a searcher whose body steps are the
+    frontier searcher's (a modular searcher, whose traces say ``learns`` "decisions")."""
 
 
 CLAIMS: tuple[Claim, ...] = (
     Claim("the character tends to move slower around cabinets", "Section 6.3",
           "head-on body speed within 1 m of a cabinet interior or shelf minus elsewhere (m/s)",
-          "speed_near_minus_elsewhere", "on", -1),
+          "speed_near_minus_elsewhere", "on", -1, body=True),
     Claim("and look carefully at the interior part where objects are likely to be placed", "Section 6.3",
           "head-on unbroken look into cabinet interiors and shelves minus one at other surfaces (steps)",
           "dwell_opening_minus_surface", "on", +1),
     Claim("The character also utilizes backward steps to have a better view of the surface in front of it",
           "Section 6.3", "head-on share of backward steps in the 5 steps up to the first sight minus elsewhere",
-          "backward_before_sight_minus_other", "on", +1),
+          "backward_before_sight_minus_other", "on", +1, body=True),
     Claim("the agent with head movements shows a 20% higher success rate than the agent without head movements",
           "Figure 6", "success, head on minus head off, paired by scenario", "success", "contrast", +1,
           PAPER_HEAD_GAIN),
     Claim("To look around the environment, the agent needs to rotate its entire body around", "Section 6.2",
-          "body turn per step, head on minus head off (rad)", "body_turn_per_step", "contrast", -1),
+          "body turn per step, head on minus head off (rad)", "body_turn_per_step", "contrast", -1, body=True),
 )
 CLAIM_COLUMNS = ("searchers", "claim", "source", "measure", "paper_size", "value", "ci_low", "ci_high", "n_scenarios",
                  "n_seeds", "sign", "size", "verdict", "detail")
@@ -431,16 +435,24 @@ def pair_label(pair: Pair) -> str:
     return f"{pair[0]} / {pair[1]}"
 
 
-def claims_frame(summary: pd.DataFrame, pairs: Iterable[Pair] = DEFAULT_PAIRS) -> pd.DataFrame:
+NOT_LEARNED = ("not read: the body's steps are the frontier searcher's (a modular searcher learns where to explore "
+               "and how to sweep the head)")
+"""The detail of a body claim on a searcher whose body steps are not learned."""
+
+
+def claims_frame(summary: pd.DataFrame, pairs: Iterable[Pair] = DEFAULT_PAIRS,
+                 walked: Iterable[str] = ()) -> pd.DataFrame:
     """One row per pair and paper sentence (pairs in their order, the sentences in :data:`CLAIMS`' order
     within each): the number behind it, its 95% interval and two verdicts, read from that interval: the
     sign (:func:`sign_verdict`: holds / not shown / opposite) and, where the sentence states a number, the
     size (:func:`size_verdict`: the paper's number inside the interval or not); ``not testable here`` when
     the traces cannot give the number. Columns :data:`CLAIM_COLUMNS`."""
-    return pd.DataFrame([row for pair in pairs for row in _pair_claims(summary, *pair)], columns=list(CLAIM_COLUMNS))
+    walked = frozenset(walked)
+    return pd.DataFrame([row for pair in pairs for row in _pair_claims(summary, *pair, walked=walked)],
+                        columns=list(CLAIM_COLUMNS))
 
 
-def _pair_claims(summary: pd.DataFrame, head_on: str, head_off: str) -> list[dict]:
+def _pair_claims(summary: pd.DataFrame, head_on: str, head_off: str, walked: frozenset = frozenset()) -> list[dict]:
     out = []
     for c in CLAIMS:
         variant = head_on if c.side == "on" else f"{head_on} - {head_off}"
@@ -451,6 +463,10 @@ def _pair_claims(summary: pd.DataFrame, head_on: str, head_off: str) -> list[dic
                "paper_size": math.nan if c.paper_size is None else c.paper_size, "value": math.nan,
                "ci_low": math.nan, "ci_high": math.nan, "n_scenarios": 0, "n_seeds": "", "sign": NOT_TESTABLE,
                "size": size, "verdict": NOT_TESTABLE}
+        if c.body and (head_on in walked or c.side == "contrast" and head_off in walked):
+            row["detail"] = NOT_LEARNED
+            out.append(row)
+            continue
         if hit.empty:
             row["detail"] = (f"no traces of {head_off} on the scenarios {head_on} ran" if c.side == "contrast"
                              else f"no traces of {head_on}")
@@ -586,7 +602,7 @@ def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, pairs: Ite
     out = output_base(out_prefix, "behaviour")
     episodes = behaviour_episodes(paths)
     summary = summarise(episodes, pairs, n_resamples=n_resamples)
-    claims = claims_frame(summary, pairs)
+    claims = claims_frame(summary, pairs, walked=set(episodes.loc[episodes["learns"] == "decisions", "variant"]))
     written = [out.with_name(out.name + "_episodes.csv"), out.with_name(out.name + ".csv"),
                out.with_name(out.name + ".md"), out.with_name(out.name + "_claims.csv"),
                out.with_name(out.name + "_claims.md")]

@@ -28,7 +28,7 @@ def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0, r
     obs, info = env.reset(seed=seed, options={"scenario": scenario})
     policy.reset(seed=seed)
     if recorder is not None:
-        recorder.start(env, scenario, info)
+        recorder.start(env, scenario, info, learns=getattr(policy, "learns", "steps"))
     total = 0.0
     done = False
     while not done:

@@ -187,7 +187,9 @@ class TraceRecorder:
         self.meta: dict = {}
         self._probes: dict[str, HomeProbe] = {}
 
-    def start(self, env, scenario, info: dict) -> None:
+    def start(self, env, scenario, info: dict, learns: str = "steps") -> None:
+        """``learns``: what the policy decides, "steps" (every body step) or "decisions" (a modular searcher:
+        where to explore and the head's sweep, its body steps the frontier searcher's)."""
         base = env.unwrapped
         if scenario.layout not in self._probes:
             self._probes[scenario.layout] = HomeProbe(scenario.layout)
@@ -198,7 +200,7 @@ class TraceRecorder:
                                               reachable=True)
         self._scenario_id, self._layout = scenario.scenario_id, scenario.layout
         self.meta.update(env_id=env.spec.id if env.spec is not None else "", head=bool(base.spec_agent.head),
-                         step_seconds=_step_seconds(), max_depth=float(base.sensor.max_depth))
+                         step_seconds=_step_seconds(), max_depth=float(base.sensor.max_depth), learns=learns)
         self._add(base, None, info, collided=False)
 
     def step(self, env, action, info: dict) -> None:

@@ -191,6 +191,9 @@ class ModularPolicy:
     searcher's map, plan and pending decision across the replanner's look-ahead (paper Algorithm 1); the
     high level is memoryless (the map is its memory)."""
 
+    learns = "decisions"
+    """What its policy decides (traces record it): where to explore and the head's sweep, not the body's steps."""
+
     def __init__(self, high_level, env):
         self.high_level = high_level
         self.searcher = GoalFrontierPolicy(env)
