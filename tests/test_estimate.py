@@ -57,7 +57,8 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
     """Its CPU time also paid for the teacher's episodes and the cloning: counted whole, 4,000 env steps in 600
     CPU-s would put the benchmark's pairing with a training at 1/20 of itself. Hand-worked: 60,000 env steps in
     1,000 CPU-s, of which 250 went to the demonstrations and 150 to the cloning: 60,000 / 600 = 100. A run that
-    recorded no cloning time is left out; one with demonstrations in replay and no cloning pays only them."""
+    recorded no cloning time is left out; one with demonstrations in replay and no cloning pays only them. A
+    modular searcher's run is left out too: its env steps are decisions."""
     import json
 
     from egosearch.cli.estimate import stored_training_rates
@@ -69,16 +70,23 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
             ("cloned/seed0", 4000, 600.0, 1500, {"demonstrations": {"cpu_s": 355.0}, "config": {"bc_updates": 12000}}),
             ("finetuned/seed0", 60_000, 1000.0, 1500, {"demonstrations": {"cpu_s": 250.0},
                                                        "imitation": {"cpu_s": 150.0}, "config": {"bc_updates": 9}}),
-            ("replayed/seed0", 30_000, 550.0, 1500, {"demonstrations": {"cpu_s": 250.0}, "config": {"bc_updates": 0}})):
+            ("replayed/seed0", 30_000, 550.0, 1500, {"demonstrations": {"cpu_s": 250.0}, "config": {"bc_updates": 0}}),
+            ("modular/seed0", 30_000, 2400.0, 0, None)):
         run = results / "train" / job
         run.mkdir(parents=True)
         (run / "curve.csv").write_text(f"env_steps,success_rate\n0,0.1\n{steps},0.5\n")
-        (run / "config.json").write_text(json.dumps({"config": {"demo_episodes": demos}}))
+        env_id = "EgoSearchModular-v0" if job.startswith("modular") else "EgoSearchMemory-v0"
+        (run / "config.json").write_text(json.dumps({"env_id": env_id, "config": {"demo_episodes": demos}}))
         if done is not None:
             (run / "done.json").write_text(json.dumps(done))
         jobs.append({"rule": "train", "job": job, "wall_s": cpu_s, "cpu_s": cpu_s})
     assert stored_training_rates({"jobs": jobs}, results) == {"scratch/seed0": 100.0, "finetuned/seed0": 100.0,
                                                               "replayed/seed0": 100.0}
+    # a modular searcher's training is priced per decision from its own record: 2,400 CPU-s / 30,000 = 0.08
+    from egosearch.cli.estimate import modular_cpu_s_per_step
+
+    assert modular_cpu_s_per_step({"jobs": jobs}, results) == pytest.approx(0.08)
+    assert modular_cpu_s_per_step({"jobs": jobs[:1]}, results) is None
 
 
 def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_path, monkeypatch):

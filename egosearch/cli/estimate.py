@@ -81,13 +81,14 @@ def stored_training_rates(record: dict, results: Path) -> dict[str, float]:
     the learner benchmark's machine), by job key. A training that learned from the classical searcher
     counts the CPU time of its RL phase only (its run's, less the teacher's episodes and the cloning that
     its ``done.json`` records); one that recorded no cloning time is left out: its env steps per
-    CPU-second would mix the teacher's cost into the learner's rate."""
+    CPU-second would mix the teacher's cost into the learner's rate. So is a modular searcher's: its env step
+    is a decision (up to 10 body steps and the walker's planning), not the learner benchmark's unit."""
     jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN]
     steps = env_steps_of(results, [r["job"] for r in jobs])
     out = {}
     for row in jobs:
         outside = cpu_s_outside_rl(results / "train" / row["job"])
-        if row["job"] not in steps or outside is None:
+        if row["job"] not in steps or outside is None or modular_run(results / "train" / row["job"]):
             continue
         cost = job_cost_s(row) - outside
         if cost > 0:
@@ -112,6 +113,25 @@ def cpu_s_outside_rl(run_dir: Path) -> float | None:
         return float(done["demonstrations"]["cpu_s"]) + imitation
     except (OSError, ValueError, KeyError):
         return None
+
+
+def modular_cpu_s_per_step(record: dict, results: Path) -> float | None:
+    """The median CPU seconds per env step (a decision) of the stored modular searchers' trainings, None
+    when none is stored."""
+    jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN and modular_run(results / "train" / r["job"])]
+    steps = env_steps_of(results, [r["job"] for r in jobs])
+    costs = [job_cost_s(r) / steps[r["job"]] for r in jobs if steps.get(r["job"])]
+    return statistics.median(costs) if costs else None
+
+
+def modular_run(run_dir: Path) -> bool:
+    """Whether the training in ``run_dir`` is a modular searcher's (its config.json's env id or
+    ``modular_searcher``): one env step per decision."""
+    try:
+        stored = json.loads((run_dir / "config.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return "Modular" in str(stored.get("env_id", "")) or bool(stored.get("config", {}).get("modular_searcher"))
 
 
 def learned_from_teacher(run_dir: Path) -> bool:
@@ -260,6 +280,11 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
                       for s in seeds for home in config["homes"] for placement in config["placements"]
                       for height in workflow_heights(config))
         per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
+        if resolve_variant(variant, profile).config.modular_searcher:
+            # a decision costs several body steps and the walker's planning: priced from the stored modular runs
+            per_decision = modular_cpu_s_per_step(record, results)
+            per_training = steps * per_decision if per_decision else float("nan")
+            where = "the stored modular searchers' machines (their CPU time per decision)"
         hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
         print(f"{target} of {variant} against {reference}: {len(trainings)} training(s) of {steps} env steps, about "
               f"{per_training / 3600:.1f} h each on {where}, and {n_evals} evaluations of about "
