@@ -271,7 +271,8 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
             rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
             where = f"{machine_key(bench.get('machine'))} (the stored learner benchmark; `egosearch estimate all` " \
                     "calibrates this machine)"
-        steps = resolve_variant(variant, profile).config.total_env_steps
+        config_of_variant = resolve_variant(variant, profile).config
+        steps = config_of_variant.total_env_steps
         trainings = [s for s in seeds if not (results / "train" / variant / f"seed{s}" / "done.json").exists()]
         evals = [r["wall_s"] for r in record.get("jobs", []) if r.get("rule") == "eval"]
         per_eval = statistics.median(evals) if evals else 0.0
@@ -280,7 +281,7 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
                       for s in seeds for home in config["homes"] for placement in config["placements"]
                       for height in workflow_heights(config))
         per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
-        if resolve_variant(variant, profile).config.modular_searcher:
+        if config_of_variant.modular_searcher:
             # a decision costs several body steps and the walker's planning: priced from the stored modular runs
             per_decision = modular_cpu_s_per_step(record, results)
             per_training = steps * per_decision if per_decision else float("nan")
