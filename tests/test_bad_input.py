@@ -40,8 +40,8 @@ BAD_VARIANT_FILES = [
      "ablations/steps_float.yaml: config: total_env_steps='2.5e4' is not an int"),
     ("steps_below_warmup", HEAD + "config: {total_env_steps: 500}\n",
      "ablations/steps_below_warmup.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=500 is "
-     "out of range; allowed: >= 4000, the env step of the first update (after init_steps=4000 random steps, an "
-     "update every 4 steps): fewer train no update"),
+     "out of range; allowed: >= 1000, the env step of the first update (after init_steps=1000 random steps, an "
+     "update every 1 steps): fewer train no update"),
     ("cloning_without_teacher", HEAD + "config: {bc_updates: 5000}\n",
      "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=5000 is "
      "out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations)"),
@@ -508,7 +508,7 @@ GEN = [ev("head_on", "generated_heldout"), "--bounds", ev("random", "generated_h
 CURVE, CELL = "{t}/train/head_on/seed0/curve.csv", "{t}/eval/head_on/seed0/kitchen_living/no_low_cabinets/h1.05.csv"
 EMPTY_EVAL = "{t}/emptyeval/cand/seed0/kitchen_living/everywhere/h1.05.csv"
 CHECKPOINT = ("egosearch train: error: --out-dir: {t}/run/done.json belongs to variant='head_on' "
-              "env_id='EgoSearchMemory-v0', not variant={variant} env_id={env}; use another out_dir")
+              "env_id='EgoSearchModular-v0', not variant={variant} env_id={env}; use another out_dir")
 STORED = r"\((tracked by git|listed in the results' provenance\.json)[^)]*\)"
 
 ISSUE_CASES = [
@@ -547,7 +547,7 @@ ISSUE_CASES = [
      ["evaluate", "--scenarios", S3, "--policy", "oracle", "--threads", "-3", "--out", "{t}/o.csv"],
      "egosearch evaluate: error: --threads=-3: a number of threads (0: all cores) must be >= 0"),
     ("train_into_another_variants_run", "traceback", ["train", "--variant", "head_off", "--out-dir", "{t}/run"],
-     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadModular-v0'")),
     ("train_into_a_run_of_another_profile", "traceback",
      ["train", "--variant", "head_on", "--profile", "smoke", "--out-dir", "{t}/run"],
      CHECKPOINT.format(t="{t}", variant="'head_on'", env="'EgoSearch-v0'")),
@@ -557,7 +557,7 @@ ISSUE_CASES = [
      "(now 5); use another out_dir"),
     ("train_work_dir_beside_another_run", "silent",
      ["train", "--variant", "head_off", "--work-dir", "{t}/partial", "--out-dir", "{t}/run"],
-     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadModular-v0'")),
     ("scenarios_seed_negative", "cryptic", ["scenarios", "--seed", "-7", "--out", "{t}/s.csv"],
      "egosearch scenarios: error: --seed=-7: a seed must be >= 0"),
     ("binary_scenario_csv", "cryptic", ["evaluate", "--scenarios", "{t}/bin.csv", "--policy", "oracle", "--out",

@@ -12,13 +12,17 @@ from egosearch.rl.config import load_config
 from egosearch.rl.demos import DEMO_SEED_BASE, collect_demonstrations, load_demonstrations, summary_path
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.variants import load_variant
 
 ENV = {"layout": "kitchen_living", "placement": "everywhere"}
+FROM_SCRATCH = load_variant("head_on_from_scratch").config
+"""The learner that demonstrations serve: the cpu profile before it became a modular searcher (the pins of its
+stored variant)."""
 
 
 @pytest.fixture(scope="module")
 def demos(tmp_path_factory):
-    cfg = load_config("cpu", {"seed": 3})
+    cfg = load_config("cpu", {**FROM_SCRATCH, "seed": 3})
     path = tmp_path_factory.mktemp("demos") / "head_on.replay.npz"
     summary = collect_demonstrations("EgoSearch-v0", cfg, ENV, 3, path, seed=1, progress=False)
     return cfg, path, summary
@@ -27,7 +31,7 @@ def demos(tmp_path_factory):
 def test_the_stored_transitions_are_the_teachers_own_steps(demos):
     cfg, path, summary = demos
     assert json.loads(summary_path(path).read_text()) == json.loads(json.dumps(summary))
-    assert summary["env_id"] == "EgoSearchMemory-v0"  # the cpu profile's observation: the target memory
+    assert summary["env_id"] == "EgoSearchMemory-v0"  # the from-scratch learner's observation: the target memory
     assert summary["teacher_head"] and summary["episodes"] == 3
     assert list(summary["env_kwargs"]["train_heights"]) == [cfg.train_height_min, 1.8]
     replay = load_demonstrations(path, cfg)
@@ -63,7 +67,7 @@ def test_demonstrations_sample_as_the_learners_replay_with_n_step_returns(demos)
 
 def test_the_head_off_body_learns_from_the_head_fixed_searcher(tmp_path):
     """head_off's demonstrations: the frontier searcher holding its camera fixed, in the head-off env."""
-    cfg = load_config("cpu", {"seed": 3})
+    cfg = load_config("cpu", {**FROM_SCRATCH, "seed": 3})
     path = tmp_path / "head_off.replay.npz"
     summary = collect_demonstrations("EgoSearchNoHead-v0", cfg, ENV, 2, path, seed=1, progress=False)
     assert not summary["teacher_head"] and "NoHead" in summary["env_id"]

@@ -122,6 +122,15 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     assert "| `head_on` | 0 | 300,000 | 2,000 | 1 | 150 | – | – |" in text       # no benchmark
     assert "| `head_on` | 1 | 300,000 | 3,000 | 1 | 100 | 1,500 | 200 |" in text
     assert "| `head_on` | 2 | 300,000 | 2,000 | 1 | 150 | – | – |" in text       # resumed: its job saw a quarter
+    # a modular searcher's env step is a decision: its rates say so, and the body-step targets are not read on it
+    record = json.loads((bench / "learner.json").read_text())
+    record["result"]["cpu_profile_steps"] = "decisions"
+    (bench / "learner.json").write_text(json.dumps(record))
+    (train / "config.json").write_text(json.dumps({"env_id": "EgoSearchModular-v0", "config": {}}))
+    text = block_speed(tmp_path, "p")
+    assert "**`env_steps_per_core_s_cpu_profile` 151.2**: decisions per core-second of a 4,000-decision" in text
+    assert "of 200: not met" not in text and "not comparable" in text and "of 170" not in text
+    assert "| `head_on` | 0 | 300,000 decisions | 2,000 |" in text and "| `head_on` | 1 | 300,000 | 3,000 |" in text
 
 
 def test_bench_out_stores_the_result_with_its_machine_and_load(tmp_path, capsys):

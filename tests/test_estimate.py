@@ -16,16 +16,20 @@ RECORD = REPO / "results" / "cpu" / "provenance.json"
 @pytest.mark.skipif(not RECORD.exists(), reason="no stored cpu run")
 def test_the_estimate_simulates_the_schedule_and_scales_trainings_to_the_machine(monkeypatch):
     monkeypatch.chdir(REPO)
+    from egosearch.cli.estimate import steps_of_profile, stored_training_rates
+
     record = json.loads(RECORD.read_text())
-    slow = estimate_all(record, RECORD.parent, 2, "cpu", rate=100.0)
-    fast = estimate_all(record, RECORD.parent, 2, "cpu", rate=200.0)
+    # rates in the profile's own unit (decisions for a modular searcher), about the recorded ones
+    base = min(stored_training_rates(record, RECORD.parent, steps_of_profile("cpu")).values())
+    slow = estimate_all(record, RECORD.parent, 2, "cpu", rate=base)
+    fast = estimate_all(record, RECORD.parent, 2, "cpu", rate=2 * base)
     # waiting and imperfect packing: the schedule is never shorter than CPU time / cores
     assert slow["hours_as_recorded"] >= slow["hours_cpu_over_cores"]
     assert slow["hours_at_slowest_recorded_rate"] >= slow["hours_as_recorded"]
     assert fast["hours_here"] < slow["hours_here"]
     # the trainings, scaled, still dominate: the slowest jobs are trainings
     assert all(name.startswith("train/") for name, _ in fast["slowest_jobs_here"])
-    one_core = estimate_all(record, RECORD.parent, 1, "cpu", rate=200.0)
+    one_core = estimate_all(record, RECORD.parent, 1, "cpu", rate=2 * base)
     assert one_core["hours_here"] > fast["hours_here"]
 
 
@@ -46,9 +50,13 @@ def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypat
     monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
     assert "egosearch estimate all" in estimate.training_time_line(200_000, "cpu")
     here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
-    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0}))
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "decisions"}))
     assert estimate.training_time_line(180_000, "cpu").startswith("estimate: about 0.5 h of CPU time")
-    (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0}))
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0,
+                                                    "steps": "decisions"}))
+    assert "no calibration" in estimate.training_time_line(180_000, "cpu")
+    # a calibration of the profile before it was a modular searcher timed body steps, not its decisions
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
     assert estimate.training_time_line(180_000, "smoke") is None
 
@@ -82,11 +90,12 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
         jobs.append({"rule": "train", "job": job, "wall_s": cpu_s, "cpu_s": cpu_s})
     assert stored_training_rates({"jobs": jobs}, results) == {"scratch/seed0": 100.0, "finetuned/seed0": 100.0,
                                                               "replayed/seed0": 100.0}
-    # a modular searcher's training is priced per decision from its own record: 2,400 CPU-s / 30,000 = 0.08
-    from egosearch.cli.estimate import modular_cpu_s_per_step
+    # a modular searcher's rate counts decisions, apart: 30,000 / 2,400 CPU-s = 12.5, i.e. 0.08 CPU-s each
+    from egosearch.cli.estimate import DECISIONS, stored_cpu_s_per_step
 
-    assert modular_cpu_s_per_step({"jobs": jobs}, results) == pytest.approx(0.08)
-    assert modular_cpu_s_per_step({"jobs": jobs[:1]}, results) is None
+    assert stored_training_rates({"jobs": jobs}, results, DECISIONS) == {"modular/seed0": 12.5}
+    assert stored_cpu_s_per_step({"jobs": jobs}, results, DECISIONS) == pytest.approx(0.08)
+    assert stored_cpu_s_per_step({"jobs": jobs[:1]}, results, DECISIONS) is None
 
 
 def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_path, monkeypatch):
@@ -104,11 +113,13 @@ def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_pa
     (results / "bench").mkdir(parents=True)
     bench = {"result": {"updates_per_s_cpu_profile": 50.0, "env_steps_per_core_s_cpu_profile": 100.0}}
     (results / "bench" / "learner.json").write_text(json.dumps(bench))
-    cfg = load_config("cpu", {"demo_episodes": 100, "bc_updates": 500, "dagger_rounds": 1, "dagger_episodes": 20})
-    assert "no stored measurement" in estimate.training_time_line(200_000, "cpu", cfg)
+    cfg = load_config("cpu", {"modular_searcher": False, "demo_episodes": 100, "bc_updates": 500,
+                              "dagger_rounds": 1, "dagger_episodes": 20})
+    # the calibration times the profile's decisions, this training's env steps are body steps: no stored one here
+    line = estimate.training_time_line(200_000, "cpu", cfg)
+    assert "no stored training's env steps are body steps" in line and "teacher's 100 episodes" in line
     run = results / "train" / "cloned" / "seed0"
     run.mkdir(parents=True)
     (run / "done.json").write_text(json.dumps({"demonstrations": {"episodes": 1500, "cpu_s": 375.0}}))
     # 100 + 20 episodes x 0.25 s = 30 s, 1000 cloning steps / 50 per s = 20 s; x 100 / 50 = 100 s
     assert estimate.teacher_cost_s(cfg, results, bench, 50.0) == pytest.approx(100.0)
-    assert "plus about 0.0 h for the teacher's 100 episodes" in estimate.training_time_line(200_000, "cpu", cfg)

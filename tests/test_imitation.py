@@ -14,6 +14,7 @@ from egosearch.rl.demos import collect_demonstrations, load_demonstrations
 from egosearch.rl.run_files import CHECKPOINT_NAME
 from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import train
+from egosearch.variants import load_variant
 
 ENV = {"layout": "kitchen_living", "placement": "everywhere"}
 SMALL = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2,
@@ -211,7 +212,8 @@ def test_figure6_marks_where_a_trainings_imitation_ends(tmp_path):
     from egosearch.report.figures import imitation_phases
 
     def phases(**fields):
-        cfg = load_config("cpu", fields).to_dict()
+        # the from-scratch learner's schedule (its stored variant's pins): the modular searcher takes no teacher
+        cfg = load_config("cpu", {**load_variant("head_on_from_scratch").config, **fields}).to_dict()
         (tmp_path / "config.json").write_text(json.dumps({"config": cfg}))
         return [step for step, _ in imitation_phases(tmp_path / "curve.csv")]
 

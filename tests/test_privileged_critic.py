@@ -18,6 +18,7 @@ from egosearch.scene.parts import Part
 from egosearch.sim.agent import AgentState
 from egosearch.sim.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
 from egosearch.sim.envs import env_space_dims, observed_env_id
+from egosearch.variants import load_variant
 
 DRQ = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 4, "encoder_num_layers": 2,
        "encoder_stride2_layers": 2, "aug_pad": 1}
@@ -98,14 +99,15 @@ def test_critic_reads_the_state_and_the_actor_does_not():
 
 
 def test_training_with_a_privileged_critic_gives_an_actor_that_acts_without_it(tmp_path):
-    cfg = load_config("cpu", {"total_env_steps": 240, "init_steps": 80, "num_envs": 4, "eval_every": 240,
-                              "eval_episodes": 1, "checkpoint_every": 240, "log_every": 80,
-                              "replay_capacity": 1000, "critic_privileged_state": True})
+    # the from-scratch learner (body steps; its stored variant's pins), shrunk
+    cfg = load_config("cpu", {**load_variant("head_on_from_scratch").config, "total_env_steps": 240, "init_steps": 80,
+                              "num_envs": 4, "eval_every": 240, "eval_episodes": 1, "checkpoint_every": 240,
+                              "log_every": 80, "replay_capacity": 1000, "critic_privileged_state": True})
     assert train_env_kwargs(cfg, {})["privileged_state"] is True
     done = train("EgoSearch-v0", cfg, tmp_path, progress=False)
     assert done["updates"] == 240 // 4 - 79 // 4
     policy = ActorPolicy(tmp_path / "actor.pt")
-    # the cpu profile observes the last-seen target memory, so the actor's mask vector is that env's
+    # the from-scratch learner observes the last-seen target memory, so the actor's mask vector is that env's
     assert policy.trained_env_id() == observed_env_id("EgoSearch-v0", cfg.target_memory)
     dims = env_space_dims(policy.trained_env_id())
     obs = {"depth": np.zeros((5, 100, 100), np.uint8), "mask": np.zeros(dims["mask"], np.float32),

@@ -56,9 +56,10 @@ def test_the_budget_study_reads_its_settings_against_the_profiles_reference():
     out = run(["-n", "-p", "-R", "budget", "budget"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
-    assert "--chosen head_on " in text
+    # the cpu profile's study walks its from-scratch learner's settings (config budget: reference)
+    assert "--chosen head_on_from_scratch " in text
     for seed in (0, 1, 2):
-        assert f"--run head_on=results/cpu/train/head_on/seed{seed}/curve.csv" in text
+        assert f"--run head_on_from_scratch=results/cpu/train/head_on_from_scratch/seed{seed}/curve.csv" in text
     assert "--run head_on_kitchen_living=results/cpu/train/head_on_kitchen_living/seed0/curve.csv" in text
     assert "head_on_kitchen_living/seed1/" not in text
     smoke = run(["-n", "-p", "budget", "--config", "profile=smoke"])
@@ -218,3 +219,15 @@ def test_a_screen_compares_one_seed_against_the_references_same_seed():
     assert "eval/head_off/seed1/" in text and "eval/head_on/seed1/" in text and "/seed0/" not in text
     missing = run(["-n", "screen", "--config", "profile=smoke"])
     assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr
+
+
+def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
+    """Its pair is a modular searcher: the claims are read both ways (the pair that learned every body step is
+    stored); the other profiles read the top level's pairs."""
+    from egosearch.report.workflow_jobs import claims_pairs
+
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    assert claims_pairs({**config, "profile": "cpu"}) == [
+        ["head_on", "head_off"], ["head_on_from_scratch", "head_off_from_scratch"], ["frontier", "frontier_head_off"]]
+    assert claims_pairs({**config, "profile": "smoke"}) == config["claims_pairs"] == [
+        ["head_on", "head_off"], ["frontier", "frontier_head_off"]]

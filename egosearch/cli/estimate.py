@@ -30,8 +30,10 @@ from egosearch.report.schedule import (
 from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
 from egosearch.workflow.dag import dag_jobs
 
-CALIBRATION_ENV_STEPS = 4000
-"""The calibration: a real cpu-profile training of this many env steps (what ``bench learner`` times)."""
+DECISIONS, BODY_STEPS = "decisions", "body steps"
+"""What an env step of a training counts (``LearnerConfig.env_step_unit``)."""
+
+
 CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "egosearch" / "learner_rate.json"
 """This machine's last calibration, so that ``snakemake all`` can print the estimate without a minute's wait."""
 
@@ -59,10 +61,15 @@ def run(args) -> None:
         if not rate:
             raise FileNotFoundError(f"--from-bench: {bench_path} holds no learner benchmark "
                                     "(egosearch bench learner --out writes one)")
+        if steps_of_bench(bench) != steps_of_profile(args.profile):
+            raise ValueError(f"--from-bench: {bench_path} timed the cpu profile's {steps_of_bench(bench)}, but the "
+                             f"{args.profile} profile's env steps are {steps_of_profile(args.profile)} "
+                             "(egosearch bench learner --out times today's profile)")
         how = f"recorded in {bench_path}"
         where = f"on {machine_key(bench.get('machine'))}"
     if rate is None:
-        print(f"calibrating: a {CALIBRATION_ENV_STEPS}-step cpu-profile training (about a minute) ...", flush=True)
+        print("calibrating: a short cpu-profile training (about a minute, as `egosearch bench learner` times) ...",
+              flush=True)
         rate, how = calibrate(), "measured now"
     estimate = estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path,
                             where=where)
@@ -76,19 +83,34 @@ def run(args) -> None:
         print(json.dumps({k: v for k, v in estimate.items() if k != "lines"}))
 
 
-def stored_training_rates(record: dict, results: Path) -> dict[str, float]:
+def steps_of_profile(profile: str) -> str:
+    """What an env step of ``profile``'s trainings counts (:data:`DECISIONS` at a modular searcher's
+    profile, the cpu profile's since it became one; else :data:`BODY_STEPS`)."""
+    from egosearch.rl.config import load_config  # local: the estimate's other paths never need a config
+
+    return load_config(profile, {}).env_step_unit
+
+
+def steps_of_bench(bench: dict) -> str:
+    """What the learner benchmark's ``env_steps_per_core_s_cpu_profile`` counts (records made before the
+    cpu profile became a modular searcher say nothing: body steps)."""
+    return bench.get("result", {}).get("cpu_profile_steps", BODY_STEPS)
+
+
+def stored_training_rates(record: dict, results: Path, steps_kind: str = BODY_STEPS) -> dict[str, float]:
     """Every stored training's env steps per CPU-second of its learner (lever screens too: one may share
-    the learner benchmark's machine), by job key. A training that learned from the classical searcher
+    the learner benchmark's machine), by job key, of the trainings whose env step is ``steps_kind``
+    (:data:`DECISIONS`: the modular searchers'). A training that learned from the classical searcher
     counts the CPU time of its RL phase only (its run's, less the teacher's episodes and the cloning that
     its ``done.json`` records); one that recorded no cloning time is left out: its env steps per
-    CPU-second would mix the teacher's cost into the learner's rate. So is a modular searcher's: its env step
-    is a decision (up to 10 body steps and the walker's planning), not the learner benchmark's unit."""
+    CPU-second would mix the teacher's cost into the learner's rate."""
     jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN]
     steps = env_steps_of(results, [r["job"] for r in jobs])
     out = {}
     for row in jobs:
         outside = cpu_s_outside_rl(results / "train" / row["job"])
-        if row["job"] not in steps or outside is None or modular_run(results / "train" / row["job"]):
+        if (row["job"] not in steps or outside is None
+                or (DECISIONS if modular_run(results / "train" / row["job"]) else BODY_STEPS) != steps_kind):
             continue
         cost = job_cost_s(row) - outside
         if cost > 0:
@@ -115,13 +137,12 @@ def cpu_s_outside_rl(run_dir: Path) -> float | None:
         return None
 
 
-def modular_cpu_s_per_step(record: dict, results: Path) -> float | None:
-    """The median CPU seconds per env step (a decision) of the stored modular searchers' trainings, None
-    when none is stored."""
-    jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN and modular_run(results / "train" / r["job"])]
-    steps = env_steps_of(results, [r["job"] for r in jobs])
-    costs = [job_cost_s(r) / steps[r["job"]] for r in jobs if steps.get(r["job"])]
-    return statistics.median(costs) if costs else None
+def stored_cpu_s_per_step(record: dict, results: Path, steps_kind: str) -> float | None:
+    """The median CPU seconds per env step of the stored trainings whose env step is ``steps_kind``, on
+    whatever machines they ran, None when none is stored: the price of a variant whose steps the
+    calibration (the profile's kind) does not measure."""
+    rates = stored_training_rates(record, results, steps_kind)
+    return statistics.median(1.0 / r for r in rates.values()) if rates else None
 
 
 def modular_run(run_dir: Path) -> bool:
@@ -142,9 +163,13 @@ def learned_from_teacher(run_dir: Path) -> bool:
         return False
 
 
-def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict) -> tuple[float, str] | None:
+def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict,
+                    steps_kind: str = BODY_STEPS) -> tuple[float, str] | None:
     """A stored training's rate over the learner benchmark's, on the same kind of machine (CPU and
-    vector unit), and that machine; None when the record holds no training from the benchmark's machine."""
+    vector unit), and that machine; None when the record holds no training from the benchmark's machine,
+    or the benchmark timed another kind of env step than ``rates`` count."""
+    if steps_of_bench(bench) != steps_kind:
+        return None
     machine = bench.get("machine", {})
     same = [rates[row["job"]] for row in record.get("jobs", [])
             if row.get("rule") == TRAIN and row.get("job") in rates and row.get("machine")
@@ -159,26 +184,29 @@ def calibrate() -> float:
     """This machine's env steps per CPU-second in a short real cpu-profile training (~a minute),
     remembered in :data:`CALIBRATION_CACHE` for this machine."""
     # local: loads torch and the simulator, which an estimate from a given --rate never needs
-    from egosearch.rl.bench import training_throughput
+    from egosearch.rl.bench import cpu_profile_run_steps, training_throughput
 
-    rate = float(training_throughput("cpu", env_steps=CALIBRATION_ENV_STEPS)["env_steps_per_core_s"])
+    rate = float(training_throughput("cpu", env_steps=cpu_profile_run_steps())["env_steps_per_core_s"])
     try:
         CALIBRATION_CACHE.parent.mkdir(parents=True, exist_ok=True)
         CALIBRATION_CACHE.write_text(json.dumps({"machine": machine_key({"cpu": cpu_model(), "vector_unit":
-                                                 cpu_vector_unit(), "cores": os.cpu_count()}), "rate": rate}))
+                                                 cpu_vector_unit(), "cores": os.cpu_count()}), "rate": rate,
+                                                 "steps": steps_of_profile("cpu")}))
     except OSError:
         pass  # a read-only home: the next estimate calibrates again
     return rate
 
 
 def cached_rate() -> float | None:
-    """This machine's last calibration (None when it has none, or it was another machine's)."""
+    """This machine's last calibration (None when it has none, it was another machine's, or it timed
+    another kind of env step than the cpu profile's today)."""
     try:
         cached = json.loads(CALIBRATION_CACHE.read_text())
     except (OSError, ValueError):
         return None
     here = machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
-    return float(cached["rate"]) if cached.get("machine") == here and cached.get("rate") else None
+    same = cached.get("machine") == here and cached.get("steps", BODY_STEPS) == steps_of_profile("cpu")
+    return float(cached["rate"]) if same and cached.get("rate") else None
 
 
 def print_before_a_run(profile: str, cores: int) -> None:
@@ -210,7 +238,8 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
     benchmark gives ``rate`` (left out when None). Returns the figures and the lines to print."""
     jobs = dag_jobs("all", cores, config={"profile": profile})
     stored = durations_from_provenance(record, jobs)
-    all_rates = stored_training_rates(record, results)
+    kind = steps_of_profile(profile)
+    all_rates = stored_training_rates(record, results, kind)
     rates = {j.job: all_rates[j.job] for j in jobs if j.record_rule == TRAIN and j.job in all_rates}
     as_recorded = simulate(jobs, cores, stored)
     slowest_rate = min(rates.values()) if rates else None
@@ -218,7 +247,8 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
     in_dag = {(j.record_rule, j.job) for j in jobs}
     cpu_over_cores = sum(job_cost_s(r) for r in record.get("jobs", []) if (r["rule"], r["job"]) in in_dag) / cores
     bench_path = Path(bench) if bench else results / "bench" / "learner.json"
-    ratio = benchmark_ratio(record, all_rates, json.loads(bench_path.read_text())) if bench_path.is_file() else None
+    ratio = (benchmark_ratio(record, all_rates, json.loads(bench_path.read_text()), kind)
+             if bench_path.is_file() else None)
     k = ratio[0] if ratio else 1.0
     here = None
     if rate is not None:
@@ -228,7 +258,7 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
         f"{cores} cores with snakemake's greedy rule):"]
     if here is not None:
         lines += [
-            f"  {where}: about {_hours(here.makespan)} (learner benchmark {rate:.0f} env steps per "
+            f"  {where}: about {_hours(here.makespan)} (learner benchmark {rate:.0f} {kind} per "
             f"CPU-second, {rate_source}"
             + (f"; a training runs at {k:.2f} x its benchmark, as on {ratio[1]} in the stored run" if ratio else
                "; no stored training shares the benchmark record's machine: trainings taken at the benchmark's rate")
@@ -236,12 +266,12 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
             "  slowest jobs here: " + ", ".join(f"{name} {_hours(s)}" for name, s in here.slowest(5))]
     lines += [
         f"  as the stored run recorded it: {_hours(as_recorded.makespan)}"
-        + (f"; every training at the slowest recorded rate ({slowest_rate:.0f} env steps per CPU-second): "
+        + (f"; every training at the slowest recorded rate ({slowest_rate:.0f} {kind} per CPU-second): "
            f"{_hours(at_slowest.makespan)}" if at_slowest else ""),
         f"  (the old figure, CPU time / {cores}: {_hours(cpu_over_cores)}, assumes perfect packing and no waiting)",
         "  " + stored.note() + " Only trainings are scaled to this machine.",
     ]
-    return {"cores": cores, "profile": profile, "hours_here": here.makespan / 3600 if here else None,
+    return {"cores": cores, "profile": profile, "steps": kind, "hours_here": here.makespan / 3600 if here else None,
             "hours_as_recorded": as_recorded.makespan / 3600,
             "hours_at_slowest_recorded_rate": at_slowest.makespan / 3600 if at_slowest else None,
             "hours_cpu_over_cores": cpu_over_cores / 3600, "bench_rate": rate,
@@ -265,8 +295,11 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         bench_path = results / "bench" / "learner.json"
         bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
-        ratio = benchmark_ratio(record, stored_training_rates(record, results), bench)
+        kind = steps_of_profile(profile)
+        ratio = benchmark_ratio(record, stored_training_rates(record, results, kind), bench, kind)
         rate, where = cached_rate(), "this machine (its last calibration)"
+        if rate is None and steps_of_bench(bench) != kind:
+            bench = {}  # it timed the profile before it became what it is
         if rate is None:
             rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
             where = f"{machine_key(bench.get('machine'))} (the stored learner benchmark; `egosearch estimate all` " \
@@ -281,11 +314,12 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
                       for s in seeds for home in config["homes"] for placement in config["placements"]
                       for height in workflow_heights(config))
         per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
-        if config_of_variant.modular_searcher:
-            # a decision costs several body steps and the walker's planning: priced from the stored modular runs
-            per_decision = modular_cpu_s_per_step(record, results)
-            per_training = steps * per_decision if per_decision else float("nan")
-            where = "the stored modular searchers' machines (their CPU time per decision)"
+        variant_kind = config_of_variant.env_step_unit
+        if variant_kind != kind or not rate:
+            # no calibration of this kind of env step: priced from the stored runs of its kind
+            per_step = stored_cpu_s_per_step(record, results, variant_kind)
+            per_training = steps * per_step if per_step else float("nan")
+            where = f"the stored trainings' machines (their CPU time per env step, {variant_kind})"
         hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
         print(f"{target} of {variant} against {reference}: {len(trainings)} training(s) of {steps} env steps, about "
               f"{per_training / 3600:.1f} h each on {where}, and {n_evals} evaluations of about "
@@ -301,20 +335,31 @@ def training_time_line(steps: int, profile: str, config=None) -> str | None:
     classical searcher, the teacher's episodes and the cloning steps are added (:func:`teacher_cost_s`)."""
     if profile != "cpu":
         return None
-    rate = cached_rate()
-    if rate is None:
-        return "estimate: this machine has no calibration yet (`egosearch estimate all` makes one in a minute)"
     results = Path("results") / profile
-    ratio, bench = None, {}
+    kind = steps_of_profile(profile)
+    ratio, bench, record = None, {}, {}
     try:
         bench = json.loads((results / "bench" / "learner.json").read_text(encoding="utf-8"))
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
-        ratio = benchmark_ratio(record, stored_training_rates(record, results), bench)
+        ratio = benchmark_ratio(record, stored_training_rates(record, results, kind), bench, kind)
     except (OSError, ValueError, KeyError):
         pass
+    if config is not None and config.env_step_unit != kind:
+        # the calibration times the profile's kind of env step, not this training's
+        other = BODY_STEPS if kind == DECISIONS else DECISIONS
+        per_step = stored_cpu_s_per_step(record, results, other)
+        line = (f"estimate: about {_hours(steps * per_step)} of CPU time for {steps} env steps ({other}), as the "
+                "stored trainings of its kind ran on their machines" if per_step else
+                f"estimate: none (no stored training's env steps are {other}, as this one's)")
+        if getattr(config, "demo_episodes", 0):
+            line += f", plus the teacher's {config.demo_episodes} episodes and the cloning (not priced here)"
+        return line
+    rate = cached_rate()
+    if rate is None:
+        return "estimate: this machine has no calibration yet (`egosearch estimate all` makes one in a minute)"
     k = ratio[0] if ratio else 1.0
     line = (f"estimate: about {_hours(steps / (k * rate))} of CPU time for {steps} env steps on this machine "
-            f"(calibrated at {rate:.0f} env steps per CPU-second"
+            f"(calibrated at {rate:.0f} {kind} per CPU-second"
             + (f", a training at {k:.2f} x that as in the stored run" if ratio else "") + ")")
     if config is not None and getattr(config, "demo_episodes", 0):
         extra = teacher_cost_s(config, results, bench, rate)

@@ -183,6 +183,16 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
     return phases
 
 
+def counts_decisions(curve_path: PathLike) -> bool:
+    """Whether the training beside ``curve_path`` is a modular searcher's, whose env steps are decisions (its
+    ``config.json``'s ``modular_searcher``, or its env id for runs stored before that field)."""
+    try:
+        stored = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return bool(stored.get("config", {}).get("modular_searcher")) or "Modular" in str(stored.get("env_id", ""))
+
+
 def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,
             confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
             random_files: Iterable[PathLike] | None = None) -> list[Path]:
@@ -195,7 +205,7 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     prefix gets ``fig6.*``) and returns the paths. ValueError on no curves / no evaluated rows.
     ``random_files`` (see :func:`figure6_frame`) add the random searcher as a dashed line. A training that
     learned from the classical searcher marks where its imitation phase ends (:func:`imitation_phases`;
-    its step-0 point is the cloned policy).
+    its step-0 point is the cloned policy). A modular searcher's curve counts decisions (the x axis says so).
     """
     df = figure6_frame(curves, labels, confidence, n_resamples, seed, random_files=random_files)
     base = output_base(out_prefix, "fig6")
@@ -217,14 +227,18 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
             if band.any():
                 ax.fill_between(x, g["low"].to_numpy(), g["high"].to_numpy(), where=band, color=colour,
                                 alpha=0.2, linewidth=0, interpolate=False)
-        phases = {}
+        phases, decisions = {}, []
         for variant_paths in curves.values():
             paths = [variant_paths] if isinstance(variant_paths, (str, os.PathLike)) else list(variant_paths)
             for step, label in (imitation_phases(paths[0]) if paths else []):
                 phases.setdefault((step, label), None)
+            decisions += [counts_decisions(p) for p in paths]
         for (step, label), style in zip(phases, (":", "-.", (0, (1, 3)), (0, (3, 1, 1, 1)))):
             ax.axvline(step, color="#333333", linestyle=style, linewidth=0.9, label=label)
-        ax.set_xlabel("Environment steps")
+        # a modular searcher's env step is a decision of where to go, several body steps each
+        ax.set_xlabel("Decisions" if decisions and all(decisions) else
+                      "Environment steps (decisions of a modular searcher)" if any(decisions) else
+                      "Environment steps")
         ax.set_ylabel("Success rate")
         ax.set_ylim(0, 1.02)
         ax.set_xlim(left=0)

@@ -122,10 +122,11 @@ def block_provenance(root: Path, profile: str) -> str:
             f"{e['cores']} cores (`egosearch estimate all`): **{e['hours_as_recorded']:.1f} h** as the stored run "
             "recorded each job"
             + (f"; {e['hours_at_slowest_recorded_rate']:.1f} h with every training at the slowest recorded rate "
-               f"({e['slowest_recorded_rate']:.0f} env steps per CPU-second; the stored trainings ran at "
-               f"{rates[0]:.0f} to {rates[-1]:.0f})" if e.get("hours_at_slowest_recorded_rate") else "")
+               f"({e['slowest_recorded_rate']:.0f} {e.get('steps', 'env steps')} per CPU-second; the stored "
+               f"trainings ran at {rates[0]:.0f} to {rates[-1]:.0f})"
+               if e.get("hours_at_slowest_recorded_rate") else "")
             + (f"; {e['hours_here']:.1f} h on a machine whose learner benchmark gives {e['bench_rate']:.0f} "
-               f"({e['rate_source']})" if e.get("hours_here") else "")
+               f"{e.get('steps', 'env steps')} per CPU-second ({e['rate_source']})" if e.get("hours_here") else "")
             + f". The jobs' CPU time / {e['cores']}, the lower bound this page used to give: "
             f"{e['hours_cpu_over_cores']:.1f} h. `egosearch estimate all --cores N` calibrates for your machine "
             f"in a minute (from `{estimate_path.relative_to(root)}`).")

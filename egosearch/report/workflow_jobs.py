@@ -41,6 +41,13 @@ def workflow_heights(config: dict) -> list[str]:
     return [f"{h:g}" for h in config["heights"]]
 
 
+def claims_pairs(config: dict) -> list[list[str]]:
+    """The pairs the claims are read on at the config's profile: its own ``claims_pairs``, else the top
+    level's."""
+    profile = config.get("profiles", {}).get(config.get("profile"), {})
+    return profile.get("claims_pairs", config.get("claims_pairs", []))
+
+
 def variants_of_all(config: dict | None = None) -> list[str]:
     """The variants `snakemake all` trains, in the DAG's order (comparisons train others)."""
     config = config or workflow_config()

@@ -16,7 +16,8 @@ Keys:
 - ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
   thread count (one);
 - ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
-  the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details);
+  the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details), counted in
+  ``cpu_profile_steps`` ("decisions" since the profile is a modular searcher, "body steps" before);
 - ``*_avx2`` (on a CPU with AVX-512): the cpu profile's rows again in a process whose oneDNN may
   use AVX2 at most (``ONEDNN_MAX_CPU_ISA=AVX2``), for what a CPU without AVX-512 pays;
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
@@ -127,6 +128,15 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
             "env_steps_per_core_s": round(env_steps / cpu, 1), "threads": torch_threads(cfg.num_threads)}
 
 
+def cpu_profile_run_steps(quick: bool = False) -> int:
+    """Env steps of the benchmark's real cpu-profile training: about a minute of it (about 4,000 body steps;
+    a modular searcher's decision walks several, so fewer decisions), or a few seconds with ``quick``."""
+    cfg = load_config("cpu", {})
+    if cfg.env_step_unit == "decisions":
+        return 8 * cfg.num_envs if quick else 600
+    return 400 * cfg.num_envs if quick else 4000
+
+
 def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
     ``cpu_profile_run=False`` leaves out the cpu profile's training run (a GPU check times a real
@@ -147,8 +157,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     cpu_cfg = load_config("cpu", {})
     cpu_threads = torch_threads(cpu_cfg.num_threads)
     runs["cpu_profile"] = time_updates("cpu", threads=cpu_threads, updates=2 * n)
-    throughput = (training_throughput("cpu", env_steps=400 * cpu_cfg.num_envs if quick else 4000)
-                  if cpu_profile_run else None)
+    throughput = training_throughput("cpu", env_steps=cpu_profile_run_steps(quick)) if cpu_profile_run else None
     # oneDNN picks its kernels once per process, so the AVX2-limited rows need a process of their own
     avx2 = (_avx2_limited_cpu_profile(quick, cpu_profile_run)
             if cpu_vector_unit() == "AVX-512" and resolve_device("auto").type == "cpu" else None)
@@ -165,6 +174,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
                                                   / result["updates_per_s_table2"], 2)
     if throughput is not None:
         result["env_steps_per_core_s_cpu_profile"] = throughput["env_steps_per_core_s"]
+        result["cpu_profile_steps"] = cpu_cfg.env_step_unit  # a modular searcher's env step is a decision
         result["cpu_profile_run"] = throughput
     if avx2 is not None:
         result.update({f"{key}_avx2": value for key, value in avx2.items()})
@@ -189,7 +199,7 @@ def cpu_profile_rows(quick: bool, cpu_profile_run: bool) -> dict:
     rows = {"updates_per_s_cpu_profile": round(1.0 / r["median_s"], 2)}
     if cpu_profile_run:
         rows["env_steps_per_core_s_cpu_profile"] = training_throughput(
-            "cpu", env_steps=400 * load_config("cpu", {}).num_envs if quick else 4000)["env_steps_per_core_s"]
+            "cpu", env_steps=cpu_profile_run_steps(quick))["env_steps_per_core_s"]
     return rows
 
 

@@ -14,6 +14,7 @@ import re
 import sys
 from pathlib import Path
 
+from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
@@ -61,6 +62,14 @@ def coerce_numbers(value, schema: dict, root: dict | None = None):
     return value
 
 
+def every_claims_pairs(config: dict) -> list[tuple[str, list[list[str]]]]:
+    """(where in the config, pairs) for the top level's ``claims_pairs`` and each profile's own: all are
+    checked, whichever profile runs, so that a typo waits for no other profile's run."""
+    return [("claims_pairs", config.get("claims_pairs", []))] + [
+        (f"profiles/{name}/claims_pairs", profile["claims_pairs"])
+        for name, profile in config.get("profiles", {}).items() if "claims_pairs" in profile]
+
+
 def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     """Coerce numbers in place, then validate; ``ConfigError`` names the key and the value."""
     import jsonschema
@@ -72,10 +81,11 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     except jsonschema.ValidationError as err:
         where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
         raise ConfigError(f"config {where}: {err.message}") from None
-    for pair in config.get("claims_pairs", []):
-        if pair[0] == pair[1]:
-            raise ConfigError(f"config claims_pairs: {pair} is one searcher twice; a pair is [head moving, head "
-                              "fixed]")
+    for where, pairs in every_claims_pairs(config):
+        for pair in pairs:
+            if pair[0] == pair[1]:
+                raise ConfigError(f"config {where}: {pair} is one searcher twice; a pair is [head moving, head "
+                                  "fixed]")
     if config.get("fresh_scenario_seed") == config["scenario_seed"]:
         raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
                           "scenario_seed; the fresh-set check needs sets never stored")
@@ -85,13 +95,14 @@ def workflow_variants(config: dict, compare: bool | str = False,
                       directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
     """Every variant the run may train, read and checked against the run's learner profile:
     ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference, the variants of
-    ``claims_pairs`` and, when set (or when
+    every ``claims_pairs`` (the top level's and each profile's) and, when set (or when
     ``compare`` names a target that compares, "compare" or "screen"), ``variant``."""
     target = compare if isinstance(compare, str) else "compare"
     budget_config = config["profiles"][config["profile"]].get("budget", {})
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
-    claims = [name for pair in config.get("claims_pairs", []) for name in pair if name not in CLASSICAL_SEARCHERS]
+    claims = [name for _, pairs in every_claims_pairs(config) for pair in pairs for name in pair
+              if name not in CLASSICAL_SEARCHERS]
     names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
                                + generalise["variants"] + claims))
     if compare and not config.get("variant"):

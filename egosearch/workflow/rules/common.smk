@@ -8,7 +8,7 @@ from pathlib import Path
 
 from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
-from egosearch.workflow.check import CLASSICAL_SEARCHERS
+from egosearch.workflow.check import CLASSICAL_SEARCHERS, claims_pairs
 
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"

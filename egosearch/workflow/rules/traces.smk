@@ -10,7 +10,7 @@ SEARCH_CELLS = [("everywhere", HEIGHTS[-1])]
 # The pairs the claims are read on (config claims_pairs): variants with every seed, the classical
 # searchers with BOUND_SEEDS. The first pair is Figure 6's (the head moving, and held fixed): the
 # pictured searches are its.
-CLAIMS_PAIRS = [tuple(pair) for pair in config["claims_pairs"]]
+CLAIMS_PAIRS = [tuple(pair) for pair in claims_pairs(config)]
 TRACE_VARIANTS = list(CLAIMS_PAIRS[0])
 TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height}.npz"
                for v in dict.fromkeys(v for pair in CLAIMS_PAIRS for v in pair)
