@@ -226,7 +226,7 @@ def test_figure_6_counts_a_modular_searchers_steps_as_decisions(tmp_path):
     stored before the field), environment steps otherwise."""
     import json
 
-    from egosearch.report.figures import counts_decisions
+    from egosearch.report.data import counts_decisions
 
     runs = {"field": {"env_id": "EgoSearch-v0", "config": {"modular_searcher": True}},
             "env_id": {"env_id": "EgoSearchNoHeadModular-v0", "config": {}},

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from egosearch.core.machine import cpu_model, cpu_vector_unit
 from egosearch.core.outputs import check_outputs, check_overwrites
+from egosearch.report.data import counts_decisions
 from egosearch.report.schedule import (
     TRAIN,
     durations_from_provenance,
@@ -146,13 +147,8 @@ def stored_cpu_s_per_step(record: dict, results: Path, steps_kind: str) -> float
 
 
 def modular_run(run_dir: Path) -> bool:
-    """Whether the training in ``run_dir`` is a modular searcher's (its config.json's env id or
-    ``modular_searcher``): one env step per decision."""
-    try:
-        stored = json.loads((run_dir / "config.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return False
-    return "Modular" in str(stored.get("env_id", "")) or bool(stored.get("config", {}).get("modular_searcher"))
+    """Whether the training in ``run_dir`` is a modular searcher's: one env step per decision."""
+    return counts_decisions(run_dir / "curve.csv")
 
 
 def learned_from_teacher(run_dir: Path) -> bool:

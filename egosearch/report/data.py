@@ -15,6 +15,7 @@ learn the seed and which scenario file an episode came from.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 from collections.abc import Iterable
@@ -208,3 +209,13 @@ def output_base(out_prefix: PathLike, default_name: str) -> Path:
 def suffixed(base: Path, ext: str) -> Path:
     """``base`` with ``ext`` added to its name: ``out/h1.65`` -> ``out/h1.65.csv`` (``with_suffix`` drops ``.65``)."""
     return base.with_name(base.name + ext)
+
+
+def counts_decisions(curve_path: str | os.PathLike) -> bool:
+    """Whether the training beside ``curve_path`` is a modular searcher's, whose env steps are decisions (its
+    ``config.json``'s ``modular_searcher``, or its env id for runs stored before that field)."""
+    try:
+        stored = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return bool(stored.get("config", {}).get("modular_searcher")) or "Modular" in str(stored.get("env_id", ""))

@@ -21,7 +21,15 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
-from egosearch.report.data import output_base, read_curves, read_episodes, read_fullbody, seed_from_path, suffixed
+from egosearch.report.data import (
+    counts_decisions,
+    output_base,
+    read_curves,
+    read_episodes,
+    read_fullbody,
+    seed_from_path,
+    suffixed,
+)
 from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, scenario_seed_matrix, two_level_ci, wilson_ci
 
 PathLike = str | os.PathLike
@@ -181,16 +189,6 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
     if cfg.get("bc_weight") and cfg.get("bc_decay_steps", 0) <= cfg["total_env_steps"]:
         phases.append((int(cfg["bc_decay_steps"]), "cloning term reaches 0"))
     return phases
-
-
-def counts_decisions(curve_path: PathLike) -> bool:
-    """Whether the training beside ``curve_path`` is a modular searcher's, whose env steps are decisions (its
-    ``config.json``'s ``modular_searcher``, or its env id for runs stored before that field)."""
-    try:
-        stored = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return False
-    return bool(stored.get("config", {}).get("modular_searcher")) or "Modular" in str(stored.get("env_id", ""))
 
 
 def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,

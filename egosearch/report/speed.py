@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from egosearch.report.figures import counts_decisions
+from egosearch.report.data import counts_decisions
 from egosearch.report.provenance import WHOLE_RUN_SHARE
 from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import claims_pairs, variants_of_all, workflow_config
