@@ -21,16 +21,19 @@ from egosearch.rl.train import train
 from egosearch.runs.evaluate import evaluate
 from egosearch.searchers.policies import RandomPolicy
 from egosearch.sim.scenarios import generate_scenarios
+from egosearch.variants import load_variant
 
 STEPS = 12_000
 
 
 @pytest.mark.slow
 def test_cpu_learner_beats_the_random_searcher_in_kitchen_living(tmp_path):
-    # curriculum_steps 10x the run: the start radius grows only from 1.0 to 2.1 m
-    cfg = load_config("cpu", {"total_env_steps": STEPS, "curriculum_steps": 10 * STEPS, "init_steps": 2000,
-                              "eval_every": STEPS, "eval_episodes": 2, "checkpoint_every": STEPS,
-                              "log_every": 2000, "num_threads": 1, "seed": 0,
+    # the learner that acts at every body step (the cpu profile's before its modular searcher: its stored
+    # variant's pins); curriculum_steps 10x the run: the start radius grows only from 1.0 to 2.1 m
+    cfg = load_config("cpu", {**load_variant("head_on_from_scratch").config, "total_env_steps": STEPS,
+                              "curriculum_steps": 10 * STEPS, "init_steps": 2000, "eval_every": STEPS,
+                              "eval_episodes": 2, "checkpoint_every": STEPS, "log_every": 2000, "num_threads": 1,
+                              "seed": 0,
                               "obs_downsample": 4, "target_memory": False})
     train("EgoSearch-v0", cfg, tmp_path, env_kwargs={"layout": "kitchen_living", "placement": "no_low_cabinets"},
           variant="near", progress=False)
