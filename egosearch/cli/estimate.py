@@ -29,11 +29,8 @@ from egosearch.report.schedule import (
     simulate,
 )
 from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
+from egosearch.rl.config import BODY_STEPS, DECISIONS, load_config
 from egosearch.workflow.dag import dag_jobs
-
-DECISIONS, BODY_STEPS = "decisions", "body steps"
-"""What an env step of a training counts (``LearnerConfig.env_step_unit``)."""
-
 
 CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "egosearch" / "learner_rate.json"
 """This machine's last calibration, so that ``snakemake all`` can print the estimate without a minute's wait."""
@@ -87,8 +84,6 @@ def run(args) -> None:
 def steps_of_profile(profile: str) -> str:
     """What an env step of ``profile``'s trainings counts (:data:`DECISIONS` at a modular searcher's
     profile, the cpu profile's since it became one; else :data:`BODY_STEPS`)."""
-    from egosearch.rl.config import load_config  # local: the estimate's other paths never need a config
-
     return load_config(profile, {}).env_step_unit
 
 

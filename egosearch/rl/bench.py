@@ -44,7 +44,7 @@ import torch
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit, own_cpu_seconds
 from egosearch.rl.common import resolve_device
-from egosearch.rl.config import load_config
+from egosearch.rl.config import DECISIONS, load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
@@ -132,7 +132,7 @@ def cpu_profile_run_steps(quick: bool = False) -> int:
     """Env steps of the benchmark's real cpu-profile training: about a minute of it (about 4,000 body steps;
     a modular searcher's decision walks several, so fewer decisions), or a few seconds with ``quick``."""
     cfg = load_config("cpu", {})
-    if cfg.env_step_unit == "decisions":
+    if cfg.env_step_unit == DECISIONS:
         return 8 * cfg.num_envs if quick else 600
     return 400 * cfg.num_envs if quick else 4000
 

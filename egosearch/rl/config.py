@@ -45,6 +45,10 @@ _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "
                       "tanh": "Tanh"}
 
 
+DECISIONS, BODY_STEPS = "decisions", "body steps"
+"""What one env step of a training counts (:attr:`LearnerConfig.env_step_unit`)."""
+
+
 @dataclass
 class LearnerConfig:
     """Hyper-parameters of one training run, whichever learner ``algorithm`` names (paper 4.2 and
@@ -618,7 +622,7 @@ class LearnerConfig:
     def env_step_unit(self) -> str:
         """What one env step of a training with this config is: "decisions" (a modular searcher's; up to
         10 body steps and the walker's planning each) or "body steps". Rates of the two never mix."""
-        return "decisions" if self.modular_searcher else "body steps"
+        return DECISIONS if self.modular_searcher else BODY_STEPS
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-python dict (JSON / ``torch.load(weights_only=True)`` safe)."""
