@@ -20,7 +20,7 @@ import jsonschema
 import yaml
 
 from egosearch.rl.config import LearnerConfig, load_config
-from egosearch.sim.envs import observed_env_id
+from egosearch.sim.envs import REFERENCE_SEARCHERS, observed_env_id
 from egosearch.sim.home_pool import check_home_split
 
 #: ``ablations/`` of the working directory (where Snakemake runs), else of this checkout.
@@ -99,6 +99,9 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
         raise VariantError(f"{path}: {where}: {err.message}") from None
     if data["name"] != path.stem:
         raise VariantError(f"{path}: name={data['name']!r} must equal the file name {path.stem!r}")
+    if data["name"] in REFERENCE_SEARCHERS:
+        raise VariantError(f"{path}: name={data['name']!r} is a reference searcher's, whose evaluations sit in the "
+                           f"same folders: name the variant otherwise (taken: {', '.join(REFERENCE_SEARCHERS)})")
     _check_objects(data["train_env"].get("objects") or [], path)
     _check_homes(data["train_env"], path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),

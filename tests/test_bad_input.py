@@ -54,6 +54,10 @@ BAD_VARIANT_FILES = [
      "ablations/config_list.yaml: config: [1, 2] is not of type 'object'"),
     ("wrong_name", HEAD.replace("NAME", "head_on"),
      "ablations/wrong_name.yaml: name='head_on' must equal the file name 'wrong_name'"),
+    ("modular_random", HEAD,
+     "ablations/modular_random.yaml: name='modular_random' is a reference searcher's, whose evaluations sit in the "
+     "same folders: name the variant otherwise (taken: random, oracle, frontier, frontier_head_off, modular_random, "
+     "modular_random_head_off)"),
     ("object_typo", HEAD.replace("everywhere}", "everywhere, objects: [mug, spoon]}"),
      "ablations/object_typo.yaml: train_env/objects: 'spoon' unknown; allowed: book, cereal_box, duck, glasses_case, "
      "keys, mug, mustard_bottle, phone, remote, soda_can, teddy"),
@@ -259,7 +263,11 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["evaluate", "--scenarios", "s.csv", "--weights", "missing.pt", "--out", "o.csv"],
          "egosearch evaluate: error: missing.pt: no such actor file"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "banana", "--out", "o.csv"],
-         "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, frontier, frontier_head_off, actor"),
+         "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, frontier, frontier_head_off, "
+         "modular_random, modular_random_head_off, actor"),
+        (["evaluate", "--scenarios", "s.csv", "--policy", "modular_random", "--weights", "a.pt", "--out", "o.csv"],
+         "egosearch evaluate: error: --weights=a.pt is only read with --policy actor, not --policy modular_random: "
+         "drop one of them"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "random", "--env-id", "Foo-v0", "--out", "o.csv"],
          "egosearch evaluate: error: --env-id='Foo-v0'; allowed: EgoSearch-v0, EgoSearchNoHead-v0, "
          "EgoSearchMemory-v0, EgoSearchNoHeadMemory-v0, EgoSearchMap-v0, EgoSearchNoHeadMap-v0, "

@@ -193,7 +193,7 @@ def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
 
     cfg = load_config("paper", {"device": "cuda"})
     torch.manual_seed(0)
-    eager = SacCurlAgent(cfg, 5, device="cuda")
+    eager = SacCurlAgent(replace(cfg, cuda_graph=False), 5, device="cuda")  # the paper profile graphs by default
     for opt in eager.optimisers.values():
         for group in opt.param_groups:
             group["capturable"] = True
@@ -321,6 +321,30 @@ def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):
     assert done_cpu.returncode == 0, done_cpu.stderr[-2000:]
     mu_cpu = np.array(json.loads(done_cpu.stdout.strip().splitlines()[-1]))
     assert np.allclose(mu_cpu, mu_cuda[0].cpu().numpy(), atol=1e-2)
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_the_default_profiles_modular_searcher_trains_on_cuda_and_its_actor_walks_on_the_cpu(tmp_path):
+    """The ``cpu`` profile (the default) is a modular searcher: on a machine with CUDA its training runs there
+    (the decision env, the searcher's map in the observation, the privileged critic, one update per decision),
+    and the actor it leaves walks the body env on the CPU as evaluation runs it."""
+    from egosearch.cli.acting import policy_factory
+    from egosearch.runs.evaluate import evaluate
+    from egosearch.sim.scenarios import generate_scenarios
+
+    cfg = load_config("cpu", {"device": "cuda", "total_env_steps": 64, "init_steps": 16, "eval_every": 64,
+                              "eval_episodes": 1, "checkpoint_every": 64, "log_every": 32, "curriculum_steps": 32})
+    assert cfg.modular_searcher and cfg.critic_privileged_state
+    done = train("EgoSearchModular-v0", cfg, tmp_path, {"layout": "kitchen_living"}, progress=False)
+    assert done["env_steps"] == 64 and done["updates"] > 0 and done["machine"]["gpu"] == torch.cuda.get_device_name()
+    state = torch.load(tmp_path / "actor.pt", weights_only=True)
+    assert all(v.device.type == "cpu" for v in state["state_dict"].values())
+    make_policy, env_id = policy_factory("actor", str(tmp_path / "actor.pt"), 0)
+    assert env_id == "EgoSearch-v0"
+    rows = evaluate(env_id, make_policy, generate_scenarios("kitchen_living", "everywhere", 1.05, n=2, seed=4), seed=0)
+    assert len(rows) == 2 and all(1 <= r["steps"] <= 100 for r in rows)
+    _report("modular_cpu_profile", {"env_steps": done["env_steps"], "updates": done["updates"]})
 
 
 def test_an_actor_trained_on_cuda_loads_and_acts_on_this_machine():

@@ -133,6 +133,67 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     assert "| `head_on` | 0 | 300,000 decisions | 2,000 |" in text and "| `head_on` | 1 | 300,000 | 3,000 |" in text
 
 
+def test_every_machine_measured_is_a_row_of_the_speed_block_and_a_line_of_provenance(tmp_path):
+    """A machine's own benchmark and estimate (``bench/hosts/<machine>/``) beside the benchmark machine's."""
+    from egosearch.report.readme import block_provenance
+    from egosearch.report.speed import block_speed
+
+    bench = tmp_path / "results" / "p" / "bench"
+    host = bench / "hosts" / "y-cpu-avx2-4-cores"
+    host.mkdir(parents=True)
+    result = {"updates_per_s_table2": 4.2, "updates_per_s_cpu_profile": 26.7, "cpu_profile_steps": "decisions",
+              "env_steps_per_core_s_cpu_profile": 14.6, "env_steps_per_core_s_cpu_profile_avx2": 13.5}
+    (bench / "learner.json").write_text(json.dumps(_record(result, "egosearch bench learner")))
+    assert "every machine measured" not in block_speed(tmp_path, "p")        # one machine: no table of one row
+    other = _record({**result, "env_steps_per_core_s_cpu_profile": 9.1, "updates_per_s_cpu_profile": 17.0},
+                    "egosearch bench learner", other=0.0)
+    other["machine"] = {"cpu": "Y CPU", "vector_unit": "AVX2", "cores": 4}
+    (host / "learner.json").write_text(json.dumps(other))
+    text = block_speed(tmp_path, "p")
+    assert "| X CPU, 2 cores | the stored run's benchmark machine | 2026-01-02 (0.02) | 14.6 decisions (13.5) | " \
+           "26.7 | 4.2 | – |" in text
+    assert "| Y CPU (AVX2), 4 cores | `results/p/bench/hosts/y-cpu-avx2-4-cores/` | 2026-01-02 (0.00) | 9.1 " \
+           "decisions (13.5) | 17.0 | 4.2 | – |" in text
+    (host / "estimate_all.json").write_text(json.dumps({
+        "date_utc": "2026-01-03T00:00:00+00:00", "machine": other["machine"], "cores": 2, "steps": "decisions",
+        "hours_here": 4.25, "bench_rate": 9.0, "rate_source": "measured now"}))
+    assert "| 17.0 | 4.2 | 4.2 h on 2 cores (calibrated at 9.0 decisions per CPU-second, measured now) |" in \
+        block_speed(tmp_path, "p")
+    # the provenance block names it beside the stored run's own estimate
+    (tmp_path / "results" / "p" / "provenance.json").write_text(json.dumps({
+        "profile": "p", "commit": "0123456789", "date_utc": "2026-01-02T03:04:05", "machine": {"cpu": "X CPU"},
+        "jobs": [], "wall_s_all_jobs_summed": 0.0}))
+    (bench / "estimate_all.json").write_text(json.dumps({
+        "cores": 2, "steps": "decisions", "hours_as_recorded": 3.6, "hours_cpu_over_cores": 2.7}))
+    assert ("The same DAG calibrated on the other machines measured (docs/speed.md): Y CPU (AVX2), 4 cores: 4.2 h on "
+            "2 cores (calibrated at 9.0 decisions per CPU-second on 2026-01-03; "
+            "`results/p/bench/hosts/y-cpu-avx2-4-cores/estimate_all.json`).") in block_provenance(tmp_path, "p")
+
+
+def test_a_records_machine_placeholder_is_this_machines_folder(tmp_path, monkeypatch):
+    from egosearch.core import machine
+
+    assert machine.machine_folder_name({"cpu": "Intel(R) Xeon(R) Processor", "vector_unit": "AVX-512",
+                                        "cores": 2}) == "intel-xeon-processor-avx-512-2-cores"
+    assert machine.machine_folder_name({}) == "unknown-cores"
+    assert machine.machine_folder_name({"cpu": "Intel(R) Xeon(R) Processor", "vector_unit": "AVX-512", "cores": 16,
+                                        "gpu": "NVIDIA H100 80GB HBM3"}) == \
+        "intel-xeon-processor-avx-512-16-cores-nvidia-h100-80gb-hbm3"
+    monkeypatch.setattr(machine, "cpu_model", lambda: "AMD EPYC")
+    monkeypatch.setattr(machine, "cpu_vector_unit", lambda: None)
+    monkeypatch.setattr(machine.os, "cpu_count", lambda: 16)
+    assert machine.with_machine("r/hosts/{machine}/learner.json") == "r/hosts/amd-epyc-16-cores/learner.json"
+    assert machine.with_machine("r/learner.json") == "r/learner.json" and machine.with_machine(None) is None
+    # the estimate's record says when, at which commit and where it was calibrated
+    monkeypatch.chdir(REPO)
+    out = tmp_path / "{machine}" / "estimate_all.json"
+    assert main(["estimate", "all", "--rate", "10", "--out", str(out)]) == 0
+    record = json.loads((tmp_path / "amd-epyc-16-cores" / "estimate_all.json").read_text())
+    assert record["command"] == f"egosearch estimate all --cores 2 --profile cpu --rate 10 --out " \
+        f"{tmp_path / 'amd-epyc-16-cores' / 'estimate_all.json'}" and record["machine"]["cores"] == 16
+    assert record["date_utc"] and record["commit"] and record["bench_rate"] == 10
+
+
 def test_bench_out_stores_the_result_with_its_machine_and_load(tmp_path, capsys):
     out = tmp_path / "bench" / "env.json"
     assert main(["bench", "env", "--frames", "20", "--steps", "20", "--out", str(out)]) == 0

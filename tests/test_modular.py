@@ -236,3 +236,38 @@ def test_figure_6_counts_a_modular_searchers_steps_as_decisions(tmp_path):
         (tmp_path / name / "config.json").write_text(json.dumps(stored))
     assert [counts_decisions(tmp_path / name / "curve.csv") for name in runs] == [True, True, False]
     assert not counts_decisions(tmp_path / "missing" / "curve.csv")
+
+
+@pytest.mark.parametrize("kind, body_env, dim", [("modular_random", "EgoSearch-v0", 4),
+                                                 ("modular_random_head_off", "EgoSearchNoHead-v0", 2)])
+def test_the_random_decision_floor_walks_the_modular_searcher_on_uniform_decisions(kind, body_env, dim):
+    """`--policy modular_random[_head_off]`: the modular searcher's walk with each decision drawn at random (the
+    floor a trained high level is read against): decisions of the head's size, spread over [-1, 1], the same
+    episodes for the same seed and other decisions for another."""
+    from egosearch.cli.acting import policy_factory
+    from egosearch.runs.evaluate import evaluate
+
+    scenarios = generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=2, seed=8)
+    decided = []
+
+    def recording(make):
+        def make_policy(env):
+            policy = make(env)
+            decide = policy.searcher.decide
+            policy.searcher.decide = lambda d: (decided.append(np.asarray(d).copy()), decide(d))[1]
+            return policy
+        return make_policy
+
+    make, env_id = policy_factory(kind, None, seed=0)
+    assert env_id == body_env
+    first = evaluate(env_id, recording(make), scenarios, seed=0)
+    ours = np.array(decided)
+    assert ours.shape[1] == dim and len(ours) > 4
+    assert ours.min() < -0.5 and ours.max() > 0.5 and np.all(np.abs(ours) <= 1)
+    decided.clear()
+    assert evaluate(env_id, recording(make), scenarios, seed=0) == first
+    assert np.array_equal(np.array(decided), ours)
+    decided.clear()
+    make_other, _ = policy_factory(kind, None, seed=1)
+    evaluate(env_id, recording(make_other), scenarios, seed=1)
+    assert not np.array_equal(np.array(decided)[:3], ours[:3])

@@ -766,3 +766,30 @@ def test_gpu_projection_by_hand(tmp_path):
     assert "as the profile does" in block_gpu_projection(tmp_path, "cpu")
     (tmp_path / GPU_CHECK / "gpu_check.json").unlink()
     assert projection(tmp_path) is None and "Not measured yet" in block_gpu_projection(tmp_path, "cpu")
+
+
+def test_the_cuda_tests_of_a_later_tree_and_a_gpu_hosts_benchmark_are_read_from_their_files(tmp_path):
+    """docs/gpu.md's last part: the summary line of a quiet pytest log, the report's figures, and only the
+    benchmark records of machines with a GPU."""
+    import json
+
+    from egosearch.report.gpu import CPU_PROFILE_GPU_CHECK, _cpu_profile_lines
+
+    assert _cpu_profile_lines(tmp_path) == []                       # nothing stored: nothing said
+    check = tmp_path / CPU_PROFILE_GPU_CHECK
+    check.mkdir(parents=True)
+    (check / "cuda_tests.log").write_text("......                [100%]\n6 passed, 1 deselected in 53.59s\n")
+    (check / "cuda_report.json").write_text(json.dumps({"modular_cpu_profile": {"env_steps": 64, "updates": 49}}))
+    hosts = tmp_path / "results" / "cpu" / "bench" / "hosts"
+    for name, gpu, rate in (("a", "Some GPU", 11.7), ("b", None, 14.8)):
+        (hosts / name).mkdir(parents=True)
+        machine = {"cpu": "X", "cores": 16, **({"gpu": gpu} if gpu else {})}
+        (hosts / name / "learner.json").write_text(json.dumps({
+            "date_utc": "2026-01-02T00:00:00", "machine": machine,
+            "result": {"updates_per_s_cpu_profile": 58.2, "env_steps_per_core_s_cpu_profile": rate,
+                       "cpu_profile_steps": "decisions"}}))
+    lines = _cpu_profile_lines(tmp_path)
+    assert lines[0].endswith("`results/cpu/gpu_check/cuda_tests.log`): 6 passed, 1 deselected.")
+    assert "(64 decisions, 49 updates)" in lines[1]
+    assert len(lines) == 3 and "(Some GPU, 16 cores, 2026-01-02;" in lines[2] and "**11.7 decisions per core-second**" \
+        in lines[2]

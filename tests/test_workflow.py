@@ -231,3 +231,19 @@ def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
         ["head_on", "head_off"], ["head_on_from_scratch", "head_off_from_scratch"], ["frontier", "frontier_head_off"]]
     assert claims_pairs({**config, "profile": "smoke"}) == config["claims_pairs"] == [
         ["head_on", "head_off"], ["frontier", "frontier_head_off"]]
+
+
+def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_random_decisions():
+    """At the cpu profile (a modular searcher): head_on against modular_random, head_off against
+    modular_random_head_off, every seed against the floor's one, on the stored sets; nothing at a profile
+    whose pair acts at every body step."""
+    out = run(["-n", "-p", "decisions_floor", "-R", "decisions_floor_compare"])
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    for variant, floor in (("head_on", "modular_random"), ("head_off", "modular_random_head_off")):
+        assert f"--out results/cpu/compare/{variant}_vs_{floor}.csv" in text
+        assert f"results/cpu/eval/{floor}/seed0/bedroom_bath/everywhere/h1.65.csv" in text
+        assert f"results/cpu/eval/{variant}/seed2/kitchen_living/no_low_cabinets/h0.45.csv" in text
+    assert f"eval/{floor}/seed1/" not in text
+    smoke = run(["-n", "-p", "decisions_floor", "--config", "profile=smoke"])
+    assert smoke.returncode == 0 and "report compare" not in smoke.stdout + smoke.stderr

@@ -14,7 +14,7 @@ from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
-from egosearch.sim.envs import BODY_ENV_IDS
+from egosearch.sim.envs import BODY_ENV_IDS, MODULAR_FLOORS, REFERENCE_SEARCHERS, modular_decision_dim
 
 
 def set_acting_threads(threads: int) -> None:
@@ -30,12 +30,16 @@ def check_threads(threads: int) -> None:
     at_least("--threads", threads, 0, "a number of threads (0: all cores)")
 
 
+MODULAR_RANDOM = {floor: BODY_ENV_IDS[env] for env, floor in MODULAR_FLOORS.items()}
+"""The body env each modular floor walks in (:data:`egosearch.searchers.MODULAR_FLOORS`)."""
+
+
 def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
     """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
     trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
     here, before any episode, and so are weights given to a policy that has none; an actor trained at
     another learner profile than the results ``out`` is written beside gets a note."""
-    if weights and kind in ("oracle", "random", "frontier", "frontier_head_off"):
+    if weights and kind in REFERENCE_SEARCHERS:
         # the oracle, random and frontier searchers would run and the weights be ignored without a word
         raise ValueError(f"--weights={weights} is only read with --policy actor, not --policy {kind}: drop one of "
                          "them")
@@ -45,6 +49,14 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), env_id or "EgoSearch-v0"
     if kind in ("frontier", "frontier_head_off"):
         return FrontierPolicy, env_id or ("EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0")
+    if kind in MODULAR_RANDOM:
+        from egosearch.searchers.modular import ModularPolicy  # local: it loads the physics
+
+        def random_decisions(env):
+            head = env.unwrapped.spec_agent.head
+            return ModularPolicy(RandomPolicy(modular_decision_dim(head), seed=seed), env)
+
+        return random_decisions, env_id or MODULAR_RANDOM[kind]
     if kind == "actor":
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
@@ -60,7 +72,8 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         env_id = env_id or trained or "EgoSearch-v0"
         actor.check_env(env_id)
         return (lambda env: actor), env_id
-    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, actor")
+    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, "
+                     f"{', '.join(MODULAR_RANDOM)}, actor")
 
 
 STORED_PROFILE = "cpu"

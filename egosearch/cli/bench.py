@@ -9,6 +9,7 @@ from pathlib import Path
 import torch
 
 from egosearch.cli.checks import at_least
+from egosearch.core.machine import with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.bench import bench_learner, gpu_check
 from egosearch.scene.layouts import get_scene
@@ -27,6 +28,7 @@ READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "
 
 
 def run(args) -> None:
+    args.out = with_machine(args.out)
     check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
     check_overwrites(files={"--out": args.out}, dirs={"--out-dir": args.out_dir}, force=args.force)
     for name, what in READ_BY.items():

@@ -17,7 +17,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from egosearch.core.machine import cpu_model, cpu_vector_unit
+from egosearch.core.machine import cpu_model, cpu_vector_unit, measured_on, with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report.data import counts_decisions
 from egosearch.report.schedule import (
@@ -37,6 +37,7 @@ CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cac
 
 
 def run(args) -> None:
+    args.out = with_machine(args.out)
     if args.cores < 1:
         raise ValueError(f"--cores={args.cores}: the estimate needs at least 1 core")
     if args.rate is not None and not args.rate > 0:
@@ -75,10 +76,21 @@ def run(args) -> None:
         print(line)
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text(json.dumps(estimate, indent=1) + "\n", encoding="utf-8")
+        # when, where and how: an estimate calibrated on one machine is that machine's (docs/speed.md's table)
+        made = {"command": _command(args), **measured_on()}
+        Path(args.out).write_text(json.dumps({**made, **estimate}, indent=1) + "\n", encoding="utf-8")
         print(f"wrote {args.out}", file=sys.stderr)
     if args.json:
         print(json.dumps({k: v for k, v in estimate.items() if k != "lines"}))
+
+
+def _command(args) -> str:
+    """The estimate's command as a user would type it again (what it was calibrated or given)."""
+    words = ["egosearch estimate", args.what, f"--cores {args.cores}", f"--profile {args.profile}"]
+    words += [f"--rate {args.rate:g}"] if args.rate is not None else []
+    words += ["--from-bench"] if args.from_bench else []
+    words += [f"--bench {args.bench}"] if args.bench else []
+    return " ".join(words + [f"--out {args.out}"])
 
 
 def steps_of_profile(profile: str) -> str:

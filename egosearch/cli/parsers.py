@@ -50,11 +50,13 @@ def add_evaluate(sub) -> None:
     p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
-                                                     "target), random, or frontier / frontier_head_off (the "
-                                                     "classical searcher, head moving or fixed)")
+                                                     "target), random, frontier / frontier_head_off (the "
+                                                     "classical searcher, head moving or fixed), or "
+                                                     "modular_random / modular_random_head_off (the modular "
+                                                     "searcher's walk with random decisions)")
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier, "
-                                    "EgoSearchNoHead-v0 for frontier_head_off")
+                                    "EgoSearchNoHead-v0 for frontier_head_off and modular_random_head_off")
     p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
@@ -143,9 +145,15 @@ def add_bench(sub) -> None:
     p.add_argument("--baseline-seconds", type=float,
                    help="gpu: also train this long with the update launched eagerly (cuda_graph false; in "
                         "<out-dir>/baseline), for the ratio on one machine; default 0: none")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--out", help="also write the result as JSON with the command, date, commit, CPU and the machine's "
-                                 "load (e.g. results/cpu/bench/learner.json, which the docs' Speed page reads)")
+    add_record_outputs(p, "print one JSON object", "the result as JSON with the command, date, commit, CPU and the "
+                       "machine's load", "learner.json", "which the docs' Speed page reads")
+
+
+def add_record_outputs(p, json_help: str, what: str, name: str, reader: str) -> None:
+    """--json, --out (a record of one machine's measurement; {machine} becomes its folder) and --force."""
+    p.add_argument("--json", action="store_true", help=json_help)
+    p.add_argument("--out", help=f"also write {what} (e.g. results/cpu/bench/{name}, {reader}; {{machine}} in it "
+                                 f"becomes this machine's folder name: results/cpu/bench/hosts/{{machine}}/{name})")
     add_force(p)
 
 
@@ -164,10 +172,8 @@ def add_estimate(sub) -> None:
                    help="take the rate recorded in --bench instead of calibrating (the README's figure)")
     p.add_argument("--bench", help="the learner benchmark record whose machine's ratio of a real training to the "
                                    "benchmark is used (default results/<profile>/bench/learner.json)")
-    p.add_argument("--json", action="store_true", help="also print the figures as one JSON object")
-    p.add_argument("--out", help="also write the figures as JSON (results/cpu/bench/estimate_all.json is what the "
-                                 "README reads)")
-    add_force(p)
+    add_record_outputs(p, "also print the figures as one JSON object", "the figures as JSON, with the command, "
+                       "date, commit and machine", "estimate_all.json", "which the README reads")
 
 
 def add_video(sub) -> None:

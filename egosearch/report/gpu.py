@@ -18,6 +18,9 @@ from egosearch.report.workflow_jobs import job_cost_s, job_study, variants_of_al
 
 GPU_CHECK = Path("results") / "paper" / "gpu_check"
 """Where the GPU check is stored, under the project root."""
+CPU_PROFILE_GPU_CHECK = Path("results") / "cpu" / "gpu_check"
+"""Where the CUDA tests of a later tree are stored, the default (``cpu``) profile's modular searcher among them:
+``cuda_tests.log`` and ``cuda_report.json`` as above (``pytest -q``: the summary line, no test names)."""
 
 
 def _missing(root: Path) -> str:
@@ -203,4 +206,42 @@ def block_gpu(root: Path, profile: str) -> str:
          f"profile's motion generators and seeds), {p['other_h']:.1f} h on {p['cores']} cores;",
          f"- **about {p['total_h']:.0f} h in all**, an estimate from the measured rates, not a measured run."],
     ]
+    sections.append(_cpu_profile_lines(root))
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"
+
+
+def _cpu_profile_lines(root: Path) -> list[str]:
+    """The CUDA tests rerun on a later tree (:data:`CPU_PROFILE_GPU_CHECK`), and the learner benchmark made on
+    that machine (a ``bench/hosts/`` record with a GPU)."""
+    log, report = root / CPU_PROFILE_GPU_CHECK / "cuda_tests.log", root / CPU_PROFILE_GPU_CHECK / "cuda_report.json"
+    if not log.exists():
+        return []
+    summary = re.findall(r"^=*\s*(\d+ (?:passed|failed).*?) in [\d.]+s", log.read_text(encoding="utf-8"), flags=re.M)
+    lines = [f"**The CUDA tests on a later tree** (`{CPU_PROFILE_GPU_CHECK}/cuda_tests.log`): "
+             + (summary[-1] if summary else "no summary line") + "."]
+    r = json.loads(report.read_text(encoding="utf-8")) if report.exists() else {}
+    if "modular_cpu_profile" in r:
+        m = r["modular_cpu_profile"]
+        lines.append(f"- the default `cpu` profile's modular searcher trained on CUDA in the decision env "
+                     f"({m['env_steps']} decisions, {m['updates']} updates), and its actor walked the body env on the "
+                     "CPU as evaluation runs it")
+    for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu profile")):
+        if key in r:
+            u = r[key]
+            lines.append(f"- one update, CUDA against CPU ({label}): largest relative difference of a tensor's "
+                         f"change {u['max_relative_update_difference']:.1e}, of a loss "
+                         f"{u['max_relative_metric_difference']:.1e}")
+    for learner in sorted((root / "results" / "cpu" / "bench" / "hosts").glob("*/learner.json")):
+        record = json.loads(learner.read_text(encoding="utf-8"))
+        gpu = record.get("machine", {}).get("gpu")
+        if not gpu:
+            continue
+        res = record["result"]
+        lines.append(f"- `egosearch bench learner` there ({gpu}, {record['machine'].get('cores')} cores, "
+                     f"{record['date_utc'][:10]}; `{learner.relative_to(root)}`): the `cpu` profile's update "
+                     f"{res.get('updates_per_s_cpu_profile')} updates/s on the GPU, its short training "
+                     f"**{res.get('env_steps_per_core_s_cpu_profile')} "
+                     f"{'decisions' if res.get('cpu_profile_steps') == 'decisions' else 'env steps'} per "
+                     "core-second** (the envs and the frontier searcher's planning stay on the CPU; the CPU "
+                     "machines' rates are in [Speed](speed.md))")
+    return lines

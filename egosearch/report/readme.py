@@ -26,7 +26,7 @@ import pandas as pd
 
 from egosearch.report.behaviour import block_claims
 from egosearch.report.gpu import block_gpu, block_gpu_projection
-from egosearch.report.speed import block_speed
+from egosearch.report.speed import HOSTS, block_speed, machine_words
 from egosearch.report.stats import cell_contrast
 from egosearch.report.tables import BOTH_HOMES, PAPER_TABLE1
 from egosearch.report.workflow_jobs import job_cost_s, job_study, workflow_config
@@ -84,11 +84,6 @@ def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def _machine_words(m: dict) -> str:
-    return (f"{m.get('cpu') or '?'}" + (f" ({m['vector_unit']})" if m.get("vector_unit") else "")
-            + f", {m.get('cores') or '?'} cores")
-
-
 def block_provenance(root: Path, profile: str) -> str:
     path = root / "results" / profile / "provenance.json"
     if not path.exists():
@@ -102,7 +97,7 @@ def block_provenance(root: Path, profile: str) -> str:
     for job in record["jobs"]:
         summed[job_study(job, config)] += job_cost_s(job)
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
-             f"{record['date_utc'][:16].replace('T', ' ')} UTC on {_machine_words(machine)}, "
+             f"{record['date_utc'][:16].replace('T', ' ')} UTC on {machine_words(machine)}, "
              f"torch {machine.get('torch', '?')}.",
              f"- {len(record['jobs'])} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed: "
              + ", ".join(f"{rule} {seconds / 60:.1f} min" for rule, seconds in sorted(per_rule.items())) + "."]
@@ -111,7 +106,7 @@ def block_provenance(root: Path, profile: str) -> str:
         known = [m for m in machines if m.get("cpu")]
         unknown = sum(m["jobs"] for m in machines if not m.get("cpu"))
         lines.append("- The jobs ran on: " + "; ".join(
-            f"{_machine_words(m)} ({m['jobs']} jobs, {m['wall_s'] / 3600:.1f} h)" for m in known)
+            f"{machine_words(m)} ({m['jobs']} jobs, {m['wall_s'] / 3600:.1f} h)" for m in known)
             + (f"; {unknown} jobs name no machine (recorded before jobs did)" if unknown else "") + ".")
     estimate_path = root / "results" / profile / "bench" / "estimate_all.json"
     if estimate_path.exists():
@@ -130,6 +125,10 @@ def block_provenance(root: Path, profile: str) -> str:
             + f". The jobs' CPU time / {e['cores']}, the lower bound this page used to give: "
             f"{e['hours_cpu_over_cores']:.1f} h. `egosearch estimate all --cores N` calibrates for your machine "
             f"in a minute (from `{estimate_path.relative_to(root)}`).")
+        hosts = _host_estimates(root, profile)
+        if hosts:
+            lines.append("- The same DAG calibrated on the other machines measured (docs/speed.md): " + "; ".join(hosts)
+                         + ".")
     else:
         lines.append(
             f"- Lower bound of `snakemake --cores {cores} all` from a fresh clone (its jobs' summed CPU time / "
@@ -142,6 +141,19 @@ def block_provenance(root: Path, profile: str) -> str:
     if record.get("note"):
         lines.append(f"- Note kept in the record: {record['note']}")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
+def _host_estimates(root: Path, profile: str) -> list[str]:
+    """Each ``bench/hosts/<machine>/estimate_all.json`` as words: the machine, the hours, the calibration."""
+    out = []
+    for path in sorted((root / "results" / profile / "bench" / HOSTS).glob("*/estimate_all.json")):
+        e = json.loads(path.read_text(encoding="utf-8"))
+        if e.get("hours_here") is None:
+            continue
+        out.append(f"{machine_words(e.get('machine', {}))}: {e['hours_here']:.1f} h on {e['cores']} cores "
+                   f"(calibrated at {e['bench_rate']:.1f} {e.get('steps', 'env steps')} per CPU-second on "
+                   f"{e.get('date_utc', '?')[:10]}; `{path.relative_to(root)}`)")
+    return out
 
 
 BY_LENGTH = "_by_length"

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from egosearch.core.machine import MACHINE_PLACEHOLDER, machine_folder_name
 from egosearch.report.data import counts_decisions
 from egosearch.report.provenance import WHOLE_RUN_SHARE
 from egosearch.report.tables import BOUNDS
@@ -173,10 +174,65 @@ def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
                         "step is a decision (several body steps each), so its rates count decisions."]
 
 
+HOSTS = "hosts"
+"""``results/<profile>/bench/hosts/<machine>/`` (:func:`egosearch.core.machine.machine_folder_name`): the
+learner benchmark (``learner.json``) and the estimate calibrated there (``estimate_all.json``) of a machine
+other than the stored run's benchmark machine."""
+
+
+def machine_words(m: dict) -> str:
+    """A machine record as words: ``Intel(R) Xeon(R) Processor (AVX-512), 2 cores`` (and its GPU, if any)."""
+    return (f"{m.get('cpu') or '?'}" + (f" ({m['vector_unit']})" if m.get("vector_unit") else "")
+            + f", {m.get('cores') or '?'} cores" + (f", {m['gpu']}" if m.get("gpu") else ""))
+
+
+def _hosts_lines(root: Path, profile: str) -> list[str]:
+    """The learner benchmark and the simulated ``all`` on every machine measured: the stored run's benchmark
+    machine (``bench/learner.json``, its estimate ``bench/estimate_all.json``) and each under ``bench/hosts/``."""
+    bench = root / "results" / profile / "bench"
+    hosts = sorted((bench / HOSTS).glob("*/learner.json"))
+    if not hosts:
+        return []
+    rows = [(bench / "learner.json", bench / "estimate_all.json", "the stored run's benchmark machine")]
+    rows += [(path, path.with_name("estimate_all.json"), f"`{path.parent.relative_to(root)}/`") for path in hosts]
+    lines = ["The learner benchmark on every machine measured, each otherwise idle (other processes' cores in "
+             "brackets), and `snakemake --cores N all` simulated there (`egosearch estimate all`, trainings scaled "
+             "by the calibration it ran on that machine):", "",
+             "| machine | records | measured | cpu-profile training per core-second (AVX2) | cpu-profile "
+             "updates/s | Table 2 updates/s | `all` simulated |",
+             "|---|---|---|---|---|---|---|"]
+    for learner, estimate, where in rows:
+        if not learner.exists():
+            continue
+        record = json.loads(learner.read_text(encoding="utf-8"))
+        r = record["result"]
+        unit = "decisions" if r.get("cpu_profile_steps") == "decisions" else "env steps"
+        rate = r.get("env_steps_per_core_s_cpu_profile")
+        avx2 = r.get("env_steps_per_core_s_cpu_profile_avx2")
+        other = record.get("other_load_cores")
+        cost = "–"
+        if estimate.exists():
+            e = json.loads(estimate.read_text(encoding="utf-8"))
+            if e.get("hours_here") is not None:
+                cost = (f"{e['hours_here']:.1f} h on {e['cores']} cores (calibrated at {e['bench_rate']:.1f} "
+                        f"{e.get('steps', 'env steps')} per CPU-second, {e['rate_source']})")
+        lines.append(f"| {machine_words(record.get('machine', {}))} | {where} | {record.get('date_utc', '?')[:10]} "
+                     f"({'?' if other is None else f'{other:.2f}'}) | "
+                     f"{'–' if rate is None else f'{rate} {unit}'}"
+                     + (f" ({avx2})" if avx2 is not None else "") + f" | {r.get('updates_per_s_cpu_profile', '–')} | "
+                     f"{r.get('updates_per_s_table2', '–')} | {cost} |")
+    folder = f"results/{profile}/bench/{HOSTS}/{MACHINE_PLACEHOLDER}"
+    return lines + ["", f"Another machine's row: on it, otherwise idle, `egosearch bench learner --json --out "
+                        f"{folder}/learner.json` and `egosearch estimate all --cores 2 --out "
+                        f"{folder}/estimate_all.json` "
+                        f"(`{MACHINE_PLACEHOLDER}` becomes the machine's folder, such as "
+                        f"`{machine_folder_name({'cpu': 'AMD EPYC', 'vector_unit': 'AVX-512', 'cores': 2})}`)."]
+
+
 def block_speed(root: Path, profile: str) -> str:
     config = workflow_config()
     # the profile's pair, and the pairs its claims are also read on (at the cpu profile, the from-scratch one)
     paired = [v for pair in claims_pairs({**config, "profile": profile}) for v in pair if v not in BOUNDS]
-    sections = [_env_lines(root, profile), _learner_lines(root, profile),
+    sections = [_env_lines(root, profile), _learner_lines(root, profile), _hosts_lines(root, profile),
                 _training_lines(root, profile, list(dict.fromkeys(variants_of_all(config) + paired)))]
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"

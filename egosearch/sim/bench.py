@@ -10,15 +10,13 @@ from __future__ import annotations
 import contextlib
 import os
 import platform
-import subprocess
 import time
 from collections.abc import Callable
-from datetime import datetime, timezone
 
 import numpy as np
 
 import egosearch.sim.envs  # noqa: F401  (registers the ids)
-from egosearch.core.machine import cpu_model, cpu_seconds_all, cpu_vector_unit, gpu_model, own_cpu_seconds
+from egosearch.core.machine import cpu_seconds_all, measured_on, own_cpu_seconds
 from egosearch.scene.layouts import get_scene
 from egosearch.scene.meshes import triangle_count
 from egosearch.sim.scenarios import MAX_STEPS
@@ -116,23 +114,6 @@ def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: 
             "pinned_core": core, "cpu": platform.processor() or platform.machine()}
 
 
-def _git(*args: str) -> str | None:
-    try:
-        return subprocess.run(["git", *args], capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return None
-
-
-def gpu_fields(gpu: str | None) -> dict:
-    """The GPU part of a machine record: nothing on a machine without one (records stay as they were)."""
-    if gpu is None:
-        return {}
-    import torch
-
-    return {"gpu": gpu, "torch": str(torch.__version__), "cuda": torch.version.cuda,
-            "gpu_memory_gib": round(torch.cuda.get_device_properties(0).total_memory / 2**30, 1)}
-
-
 def recorded(command: str, run: Callable[[], dict]) -> dict:
     """``run()``'s result with what it was measured on: the command, date, commit, CPU and core count,
     and how busy the machine was. A speed figure means little without the load beside it: the load
@@ -143,15 +124,9 @@ def recorded(command: str, run: Callable[[], dict]) -> dict:
     result = run()
     wall = time.perf_counter() - wall0
     busy1, own = cpu_seconds_all(), own_cpu_seconds() - own0
-    status = _git("status", "--porcelain", "--untracked-files=no")
     return {
         "command": command,
-        "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        # a copy of the tree (a device, a cluster node) is told its commit: its .git, if any, may be stale
-        "commit": os.environ.get("EGOSEARCH_COMMIT") or _git("rev-parse", "HEAD") or "unknown",
-        "commit_dirty": bool(status) if status is not None else None,
-        "machine": {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count(),
-                    **gpu_fields(gpu_model())},
+        **measured_on(),
         "load_average_before": load_before,
         "load_average_after": [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None,
         "other_load_cores": (round(max(0.0, busy1 - busy0 - own) / wall, 2)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
+from egosearch.sim.envs import MODULAR_FLOORS, REFERENCE_SEARCHERS
 from egosearch.workflow.check import CLASSICAL_SEARCHERS, claims_pairs
 
 # Optional (`--use-conda`): the software every rule runs with.
@@ -194,3 +195,21 @@ def fresh_files(kind):
     root = f"{RESULTS}/fresh/eval" if kind == "fresh" else f"{RESULTS}/eval"
     return expand(f"{root}/{REF}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
                   seed=SEEDS, home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def decisions_floors():
+    """(variant, floor) for each variant of the profile's first claims pair that is a modular searcher: its
+    floor is the same walk with random decisions (MODULAR_FLOORS), on the same stored sets."""
+    from egosearch.variants import resolve_variant
+
+    pairs = claims_pairs({**config, "profile": PROFILE})
+    learner = PROF["learner"]
+    out = []
+    for variant in pairs[0] if pairs else []:
+        env_id = resolve_variant(CHECKED_VARIANTS[variant], learner).env_id
+        if env_id in MODULAR_FLOORS:
+            out.append((variant, MODULAR_FLOORS[env_id]))
+    return out
+
+
+DECISIONS_FLOORS = decisions_floors()

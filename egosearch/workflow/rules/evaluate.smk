@@ -20,13 +20,15 @@ rule evaluate:
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
-# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in egosearch.report.tables), not variants.
+# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in egosearch.report.tables), not variants; so are
+# eval/modular_random/... (REFERENCE_SEARCHERS: the modular searcher's floor, read by the decisions_floor rule).
 ruleorder: bound > evaluate
 
 
 rule bound:
     """A reference searcher on one Table 1 cell: the random searcher, the classical frontier searcher
-    (head moving or held fixed) or the privileged oracle (it knows the target)."""
+    (head moving or held fixed), the privileged oracle (it knows the target) or the modular searcher's
+    walk with random decisions (head moving or fixed)."""
     input:
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
@@ -36,7 +38,7 @@ rule bound:
     benchmark:
         "results/{profile}/benchmarks/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     wildcard_constraints:
-        bound="random|oracle|frontier|frontier_head_off",
+        bound="|".join(REFERENCE_SEARCHERS),
     threads: 1
     resources:
         mem_mb=1500,

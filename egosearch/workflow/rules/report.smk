@@ -222,3 +222,30 @@ rule provenance:
     shell:
         "egosearch report provenance --force --profile {params.profile} --results {params.results} --out {output} "
         "> {log} 2>&1"
+
+
+rule decisions_floor:
+    """What a modular searcher's learned decisions add: the profile's pair (head on, head off) against the
+    same walk with random decisions, per cell and per shortest-path bin. Nothing to do at a profile whose
+    pair acts at every body step."""
+    input:
+        [f"{RESULTS}/compare/{variant}_vs_{floor}.csv" for variant, floor in DECISIONS_FLOORS],
+
+
+rule decisions_floor_compare:
+    """One variant of the pair against its floor (all its seeds against the floor's one)."""
+    input:
+        reference=ancient(lambda wc: bound_files([wc.floor])),
+        candidate=ancient(lambda wc: eval_files(wc.variant)),
+    output:
+        cells=f"{RESULTS}/compare/{{variant}}_vs_{{floor}}.csv",
+        by_length=f"{RESULTS}/compare/{{variant}}_vs_{{floor}}_by_length.csv",
+    log:
+        f"{RESULTS}/logs/report/decisions_floor_{{variant}}_vs_{{floor}}.log",
+    wildcard_constraints:
+        floor="|".join(MODULAR_FLOORS.values()),
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
+        "--out {output.cells} > {log} 2>&1"
