@@ -159,6 +159,16 @@ def test_every_machine_measured_is_a_row_of_the_speed_block_and_a_line_of_proven
         "hours_here": 4.25, "bench_rate": 9.0, "rate_source": "measured now"}))
     assert "| 17.0 | 4.2 | 4.2 h on 2 cores (calibrated at 9.0 decisions per CPU-second, measured now) |" in \
         block_speed(tmp_path, "p")
+    # a finished run set beside the simulation of its own jobs
+    (bench / "schedule_check.json").write_text(json.dumps({
+        "command": "egosearch estimate check --log r.log", "date_utc": "2026-01-04T00:00:00",
+        "machine": other["machine"],
+        "target": "all", "cores": 2, "jobs": 139, "elapsed_s": 3000.0, "predicted_s": 2700.0,
+        "own_times_simulated_s": 3060.0, "own_times_over_cores_s": 2950.0, "record_note": "139 of 139 jobs timed"}))
+    assert ("139 jobs of `all` on 2 cores took **50.0 min**; predicted from the record before the run **45.0 min** "
+            "(0.90 x; 139 of 139 jobs timed); its own job times laid out by the simulation 51.0 min (1.02 x); their "
+            "sum / 2, the old lower bound, 49.2 min (`results/p/bench/schedule_check.json`).") in \
+        block_speed(tmp_path, "p")
     # the provenance block names it beside the stored run's own estimate
     (tmp_path / "results" / "p" / "provenance.json").write_text(json.dumps({
         "profile": "p", "commit": "0123456789", "date_utc": "2026-01-02T03:04:05", "machine": {"cpu": "X CPU"},

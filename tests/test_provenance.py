@@ -56,6 +56,11 @@ def test_every_job_names_its_machine_and_the_header_lists_them_all(tmp_path, mon
     (results / "eval" / "v" / "seed0" / "h1.65.csv").write_text("scenario_id,success\n0,0\n")
     later = {j["job"]: j["machine"]["cpu"] for j in provenance.write_provenance("p", results, record)["jobs"]}
     assert later == {"v/seed0": "Far Away CPU", "v/seed0/h1.05": "This CPU", "v/seed0/h1.65": "Later CPU"}
+    # the evaluation run again there (a forced rerun: its benchmark rewritten) is that machine's now
+    monkeypatch.setattr(provenance, "this_machine", lambda: {"cpu": "Rerun CPU", "vector_unit": None, "cores": 2})
+    (results / "benchmarks" / "eval" / "v" / "seed0" / "h1.05.tsv").write_text("s\tcpu_time\n3.5\t3.4\n")
+    rerun = {j["job"]: j["machine"]["cpu"] for j in provenance.write_provenance("p", results, record)["jobs"]}
+    assert rerun == {"v/seed0": "Far Away CPU", "v/seed0/h1.05": "Rerun CPU", "v/seed0/h1.65": "Later CPU"}
 
 
 def test_a_job_recorded_before_records_named_machines_is_not_given_one(tmp_path):

@@ -239,6 +239,9 @@ def test_the_smoke_dag_trains_before_it_evaluates():
         assert j.record_rule == "eval"
         variant, seed = j.job.split("/")[:2]
         assert f"train/{variant}/{seed}" in j.deps
+        # each job's own wildcards (the schedule check matches a run's log against them)
+        assert j.wildcards["variant"] == variant and f"seed{j.wildcards['seed']}" == seed
+        assert j.job.endswith(f"/{j.wildcards['placement']}/h{j.wildcards['height']}")
     assert all(d in by_id for j in jobs for d in j.deps)
     assert all(1 <= j.threads <= 2 for j in jobs)
     assert {j.rule for j in jobs if j.job is None} >= {"all", "provenance"}

@@ -15,11 +15,13 @@ import math
 import os
 import statistics
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from egosearch.core.machine import cpu_model, cpu_vector_unit, measured_on, with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report.data import counts_decisions
+from egosearch.report.run_log import dag_id, read_run_log
 from egosearch.report.schedule import (
     TRAIN,
     durations_from_provenance,
@@ -36,22 +38,53 @@ CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cac
 """This machine's last calibration, so that ``snakemake all`` can print the estimate without a minute's wait."""
 
 
+CHECK_ONLY = {"log": "--log", "record": "--record", "target": "--target"}
+"""Options that ``estimate check`` reads and ``estimate all`` does not (and the reverse below)."""
+ALL_ONLY = {"rate": "--rate", "from_bench": "--from-bench", "bench": "--bench"}
+
+
 def run(args) -> None:
     args.out = with_machine(args.out)
     if args.cores < 1:
         raise ValueError(f"--cores={args.cores}: the estimate needs at least 1 core")
+    unread = ALL_ONLY if args.what == "check" else CHECK_ONLY
+    for name, flag in unread.items():
+        if getattr(args, name) not in (None, False):
+            # an option the command never reads would leave a record that seems to say it was used
+            raise ValueError(f"{flag} is read by `estimate {'all' if args.what == 'check' else 'check'}` only, not "
+                             f"by `estimate {args.what}`")
+    if args.what == "check" and not args.log:
+        raise ValueError("estimate check needs --log: a finished run's .snakemake/log/<date>.snakemake.log")
     if args.rate is not None and not args.rate > 0:
         raise ValueError(f"--rate={args.rate}: env steps per CPU-second must be a positive number")
     if args.rate is not None and args.from_bench:
         raise ValueError("--rate and --from-bench both name the rate: give one")
     check_outputs(files={"--out": args.out})
-    check_overwrites(files={"--out": args.out}, inputs={"--bench": args.bench}, force=args.force)
+    check_overwrites(files={"--out": args.out}, inputs={"--bench": args.bench, "--log": args.log,
+                                                        "--record": args.record}, force=args.force)
     results = Path("results") / args.profile
-    record_path = results / "provenance.json"
+    record_path = Path(args.record) if args.record else results / "provenance.json"
     if not record_path.is_file():
         raise FileNotFoundError(f"{record_path} not found: the estimate scales the stored run's job times "
                                 "(run it in the project's root, at a profile with a stored run)")
     record = json.loads(record_path.read_text(encoding="utf-8"))
+    if args.what == "check":
+        figures = schedule_check(args.log, record, args.profile, args.target or "all", args.cores, record_path)
+    else:
+        figures = _estimate_all_here(args, record, results)
+    for line in figures["lines"]:
+        print(line)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        # when, where and how: an estimate calibrated on one machine is that machine's (docs/speed.md's table)
+        made = {"command": _command(args), **measured_on()}
+        Path(args.out).write_text(json.dumps({**made, **figures}, indent=1) + "\n", encoding="utf-8")
+        print(f"wrote {args.out}", file=sys.stderr)
+    if args.json:
+        print(json.dumps({k: v for k, v in figures.items() if k != "lines"}))
+
+
+def _estimate_all_here(args, record: dict, results: Path) -> dict:
     bench_path = Path(args.bench) if args.bench else results / "bench" / "learner.json"
     rate, how, where = args.rate, "given", "on this machine"
     if rate is None and args.from_bench:
@@ -70,18 +103,55 @@ def run(args) -> None:
         print("calibrating: a short cpu-profile training (about a minute, as `egosearch bench learner` times) ...",
               flush=True)
         rate, how = calibrate(), "measured now"
-    estimate = estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path,
-                            where=where)
-    for line in estimate["lines"]:
-        print(line)
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        # when, where and how: an estimate calibrated on one machine is that machine's (docs/speed.md's table)
-        made = {"command": _command(args), **measured_on()}
-        Path(args.out).write_text(json.dumps({**made, **estimate}, indent=1) + "\n", encoding="utf-8")
-        print(f"wrote {args.out}", file=sys.stderr)
-    if args.json:
-        print(json.dumps({k: v for k, v in estimate.items() if k != "lines"}))
+    return estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path,
+                        where=where)
+
+
+def schedule_check(log_path: str | Path, record: dict, profile: str, target: str, cores: int,
+                   record_path: str | Path = "the record") -> dict:
+    """A finished run against the simulation of its own jobs (:mod:`egosearch.report.run_log`): the jobs
+    the log says it ran, with their dependencies among them in ``target``'s DAG, laid out on the run's
+    cores (``cores`` where the log does not say; its profile where its jobs name one, else ``profile``)
+    at the wall times ``record`` held for them (what the
+    estimate would have predicted), and at the wall times the run itself logged (the schedule's model
+    alone); beside the elapsed time the log shows."""
+    run = read_run_log(log_path)
+    cores = run.cores or cores
+    # the run's own profile where its jobs name it (every rule's paths hold the profile wildcard)
+    named = [job.wildcards["profile"] for job in run.finished() if "profile" in job.wildcards]
+    profile = statistics.mode(named) if named else profile
+    ran = {dag_id(job, profile): job for job in run.finished()}
+    dag = dag_jobs(target, cores, config={"profile": profile})
+    keep = {job.id for job in dag if job.id in ran}
+    unknown = sorted(set(ran) - keep)
+    if not keep:
+        raise ValueError(f"{log_path}: none of the {len(ran)} jobs it ran is in the DAG of `{target}` at the "
+                         f"{profile} profile: give the run's --target and --profile")
+    jobs = [replace(job, deps=tuple(d for d in job.deps if d in keep)) for job in dag if job.id in keep]
+    from_record = durations_from_provenance(record, jobs)
+    predicted = simulate(jobs, cores, from_record)
+    own = simulate(jobs, cores, {job.id: ran[job.id].seconds for job in jobs})
+    elapsed = run.elapsed
+    lines = [
+        f"{Path(log_path).name}: {len(ran)} jobs finished on {cores} cores in {_minutes(elapsed)} "
+        f"(first start to last end{'; ' + run.command if run.command else ''})",
+        f"  predicted from {record_path}'s job times, simulated: {_minutes(predicted.makespan)} "
+        f"({predicted.makespan / elapsed:.2f} x the run; {from_record.note()})" if elapsed else "",
+        f"  the run's own job times, simulated: {_minutes(own.makespan)} ({own.makespan / elapsed:.2f} x the run: "
+        "the schedule's model alone)" if elapsed else "",
+        f"  the jobs' own times summed / {cores}: {_minutes(own.packing_bound)} (the old lower bound)",
+    ]
+    if unknown:
+        lines.append(f"  {len(unknown)} logged jobs are not in the DAG of `{target}` and were left out: "
+                     + ", ".join(unknown[:5]) + (" ..." if len(unknown) > 5 else ""))
+    return {"log": str(log_path), "target": target, "profile": profile, "cores": cores, "jobs": len(jobs),
+            "elapsed_s": elapsed, "predicted_s": predicted.makespan, "own_times_simulated_s": own.makespan,
+            "own_times_over_cores_s": own.packing_bound, "record": str(record_path),
+            "record_note": from_record.note(), "left_out": unknown, "lines": [line for line in lines if line]}
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds / 60:.1f} min"
 
 
 def _command(args) -> str:
@@ -89,7 +159,9 @@ def _command(args) -> str:
     words = ["egosearch estimate", args.what, f"--cores {args.cores}", f"--profile {args.profile}"]
     words += [f"--rate {args.rate:g}"] if args.rate is not None else []
     words += ["--from-bench"] if args.from_bench else []
-    words += [f"--bench {args.bench}"] if args.bench else []
+    for flag, value in (("--bench", args.bench), ("--log", args.log), ("--record", args.record),
+                        ("--target", args.target)):
+        words += [f"{flag} {value}"] if value else []
     return " ".join(words + [f"--out {args.out}"])
 
 

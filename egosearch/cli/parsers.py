@@ -161,7 +161,9 @@ def add_estimate(sub) -> None:
     about = ("how long `snakemake --cores N all` takes from a fresh clone on this machine: the DAG's schedule "
              "simulated from the stored run's job times, trainings scaled by a minute's calibration")
     p = sub.add_parser("estimate", help=about, description=about)
-    p.add_argument("what", choices=("all",), help="all: the target `snakemake all` builds")
+    p.add_argument("what", choices=("all", "check"),
+                   help="all: the target `snakemake all` builds; check: a finished run (--log) against the "
+                        "simulation of its own jobs")
     p.add_argument("--cores", type=int, default=2, help="the cores snakemake gets (--cores N; default 2)")
     p.add_argument("--profile", default="cpu", choices=("cpu", "paper"),
                    help="the profile whose stored run gives the job times (default cpu)")
@@ -172,6 +174,11 @@ def add_estimate(sub) -> None:
                    help="take the rate recorded in --bench instead of calibrating (the README's figure)")
     p.add_argument("--bench", help="the learner benchmark record whose machine's ratio of a real training to the "
                                    "benchmark is used (default results/<profile>/bench/learner.json)")
+    p.add_argument("--log", help="check: the run's Snakemake log (.snakemake/log/<date>.snakemake.log)")
+    p.add_argument("--record", help="check: the provenance record whose job times predict the run (default "
+                                    "results/<profile>/provenance.json; before a run rewrites it, keep a copy)")
+    p.add_argument("--target", help="check: the target the run built (default all): its DAG gives the jobs' "
+                                    "dependencies")
     add_record_outputs(p, "also print the figures as one JSON object", "the figures as JSON, with the command, "
                        "date, commit and machine", "estimate_all.json", "which the README reads")
 

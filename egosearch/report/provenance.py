@@ -144,10 +144,10 @@ def _job_key(job: dict) -> tuple[str, str]:
 def attach_machines(jobs: list[dict], results: Path, previous: dict | None) -> None:
     """Give each job the machine it ran on, where that is known: a training's from its ``done.json``
     (the trainer records it); a job the previous record already held, with the same wall time, keeps
-    the machine that record gave it (it has not run since); a job that is new since then ran in the
-    workflow run that is writing this record, on this machine (under a cluster executor: the node
-    that runs the provenance job, which may not be the job's). Otherwise ``None``: jobs recorded
-    before records named machines are not guessed."""
+    the machine that record gave it (it has not run since); a job that is new since then, or that ran
+    again (its wall time changed), ran in the workflow run that is writing this record, on this machine
+    (under a cluster executor: the node that runs the provenance job, which may not be the job's).
+    Otherwise ``None``: jobs recorded before records named machines are not guessed."""
     before = {_job_key(j): j for j in (previous or {}).get("jobs", [])}
     here = this_machine()
     for job in jobs:
@@ -162,7 +162,7 @@ def attach_machines(jobs: list[dict], results: Path, previous: dict | None) -> N
                 machine = None
         if machine is None and old is not None and old.get("wall_s") == job["wall_s"]:
             machine = old.get("machine")
-        elif machine is None and old is None:
+        elif machine is None:
             machine = here
         job["machine"] = machine
 

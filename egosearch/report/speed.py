@@ -229,10 +229,34 @@ def _hosts_lines(root: Path, profile: str) -> list[str]:
                         f"`{machine_folder_name({'cpu': 'AMD EPYC', 'vector_unit': 'AVX-512', 'cores': 2})}`)."]
 
 
+SCHEDULE_CHECKS = "schedule_check*.json"
+"""``results/<profile>/bench/schedule_check*.json``: ``egosearch estimate check --out`` of a finished run."""
+
+
+def _schedule_check_lines(root: Path, profile: str) -> list[str]:
+    """Each stored run set beside the simulation of its own jobs: its elapsed time, the prediction from the
+    record before it, and its own job times laid out by the simulation."""
+    lines = []
+    for path in sorted((root / "results" / profile / "bench").glob(SCHEDULE_CHECKS)):
+        c = json.loads(path.read_text(encoding="utf-8"))
+        elapsed = c["elapsed_s"]
+        lines.append(
+            f"- A real run against the simulation (`{c['command']}`, {c['date_utc'][:10]}, "
+            f"{machine_words(c.get('machine', {}))}): {c['jobs']} jobs of `{c['target']}` on {c['cores']} cores took "
+            f"**{elapsed / 60:.1f} min**; predicted from the record before the run **{c['predicted_s'] / 60:.1f} "
+            f"min** ({c['predicted_s'] / elapsed:.2f} x; {c['record_note']}); its own job times laid out by the "
+            f"simulation {c['own_times_simulated_s'] / 60:.1f} min ({c['own_times_simulated_s'] / elapsed:.2f} x); "
+            f"their sum / {c['cores']}, the old lower bound, {c['own_times_over_cores_s'] / 60:.1f} min "
+            f"(`{path.relative_to(root)}`).")
+    return ["Checks of the schedule simulation against finished runs (`egosearch estimate check`):", ""] + lines \
+        if lines else []
+
+
 def block_speed(root: Path, profile: str) -> str:
     config = workflow_config()
     # the profile's pair, and the pairs its claims are also read on (at the cpu profile, the from-scratch one)
     paired = [v for pair in claims_pairs({**config, "profile": profile}) for v in pair if v not in BOUNDS]
     sections = [_env_lines(root, profile), _learner_lines(root, profile), _hosts_lines(root, profile),
+                _schedule_check_lines(root, profile),
                 _training_lines(root, profile, list(dict.fromkeys(variants_of_all(config) + paired)))]
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"

@@ -121,11 +121,11 @@ def _collect(target: str, cores: int, config_items: list[str]) -> list[dict]:
         profile = workflow.config.get("profile")
         benchmarks = Path("results") / str(profile) / "benchmarks"
         jobs = sorted(dag.needrun_jobs(), key=dag.jobid)
-        ids, keys, taken = {}, {}, set()
+        ids, keys, taken, wildcards = {}, {}, set(), {}
         for job in jobs:
             key = keys[job] = _benchmark_key(str(job.benchmark), benchmarks) if job.benchmark else None
-            wildcards = {k: str(v) for k, v in job.wildcards_dict.items()}
-            ident = key or "/".join([job.rule.name, *(v for k, v in wildcards.items() if k != "profile")])
+            wildcards[job] = {k: str(v) for k, v in job.wildcards_dict.items()}
+            ident = key or "/".join([job.rule.name, *(v for k, v in wildcards[job].items() if k != "profile")])
             if ident in taken:
                 ident = f"{ident}#{dag.jobid(job)}"
             ids[job] = ident
@@ -141,7 +141,7 @@ def _collect(target: str, cores: int, config_items: list[str]) -> list[dict]:
                 "order": dag.jobid(job), "priority": job.priority,
                 "input_bytes": sum(_size(f) for f in job.input),
                 "temp_input_bytes": sum(_size(f) for f in job.input if f.is_flagged("temp")),
-                "wildcards": wildcards,
+                "wildcards": wildcards[job],
             })
         return rows
 
