@@ -6,6 +6,9 @@ machine: a minute of the learner benchmark (``egosearch bench learner``'s short 
 this machine's env steps per CPU-second, and the ratio between a stored training and the benchmark
 on the same kind of machine turns that into a training's rate. Every other job keeps the wall time
 the stored run recorded (evaluations and reports are a small share; the estimate says so).
+
+``egosearch estimate check`` holds the simulation to a finished run: the jobs its Snakemake log shows, laid out
+at the record's times and at their own, beside the run's elapsed time (:func:`schedule_check`).
 """
 
 from __future__ import annotations
