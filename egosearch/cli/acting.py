@@ -31,7 +31,7 @@ def check_threads(threads: int) -> None:
 
 
 MODULAR_RANDOM = {floor: BODY_ENV_IDS[env] for env, floor in MODULAR_FLOORS.items()}
-"""The body env each modular floor walks in (:data:`egosearch.searchers.MODULAR_FLOORS`)."""
+"""The body env each modular floor walks in (:data:`egosearch.sim.envs.MODULAR_FLOORS`)."""
 
 
 def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
