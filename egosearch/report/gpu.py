@@ -14,6 +14,7 @@ import json
 import re
 from pathlib import Path
 
+from egosearch.report.speed import HOSTS
 from egosearch.report.workflow_jobs import job_cost_s, job_study, variants_of_all, workflow_config
 
 GPU_CHECK = Path("results") / "paper" / "gpu_check"
@@ -231,7 +232,7 @@ def _cpu_profile_lines(root: Path) -> list[str]:
             lines.append(f"- one update, CUDA against CPU ({label}): largest relative difference of a tensor's "
                          f"change {u['max_relative_update_difference']:.1e}, of a loss "
                          f"{u['max_relative_metric_difference']:.1e}")
-    for learner in sorted((root / "results" / "cpu" / "bench" / "hosts").glob("*/learner.json")):
+    for learner in sorted((root / "results" / "cpu" / "bench" / HOSTS).glob("*/learner.json")):
         record = json.loads(learner.read_text(encoding="utf-8"))
         gpu = record.get("machine", {}).get("gpu")
         if not gpu:
