@@ -174,6 +174,28 @@ def test_reconstruction_loss_trains_a_decoder_and_the_encoder_and_resumes():
         load_config("smoke", {**DRQ, "encoder_aux_loss": "autoencoder"})
 
 
+def test_critic_layer_norm_normalises_each_hidden_layer_of_both_q_heads_only():
+    cfg = load_config("smoke", {**DRQ, "batch_size": 16, "critic_layer_norm": True})
+    torch.manual_seed(0)
+    agent = SacDrqAgent(cfg, 5)
+    for head in (agent.critic.q1, agent.critic.q2, agent.critic_target.q1):
+        norms = [m for m in head if isinstance(m, torch.nn.LayerNorm)]
+        assert len(norms) == cfg.critic_num_layers - 1
+        # each hidden layer's pre-activations come out with mean 0 and variance 1 per sample
+        x = torch.randn(7, head[0].in_features) * 50 + 3
+        hidden = head[1](head[0](x))
+        assert torch.allclose(hidden.mean(-1), torch.zeros(7), atol=1e-4)
+        assert torch.allclose(hidden.var(-1, unbiased=False), torch.ones(7), atol=1e-2)
+    assert agent.update(_fixed_batch(agent))["critic_loss"] > 0
+    plain = SacDrqAgent(load_config("smoke", {**DRQ, "batch_size": 16}), 5)
+    assert not any(isinstance(m, torch.nn.LayerNorm) for m in plain.critic.q1)
+    for target, source in ((plain, agent), (agent, plain)):
+        with pytest.raises(AgentStateError, match="critic_layer_norm"):
+            target.load_state_dict(source.state_dict())
+    with pytest.raises(ValueError, match="critic_layer_norm"):
+        load_config("smoke", {"critic_layer_norm": True})  # sac_curl's Q-heads do not take it
+
+
 def test_drq_training_with_lockstep_envs_resumes_and_writes_a_loadable_actor(tmp_path):
     cfg = load_config("smoke", {**DRQ, "num_envs": 3, "n_step": 3, "update_every": 3, "total_env_steps": 300,
                                 "checkpoint_every": 150, "eval_every": 150, "log_every": 50})

@@ -36,7 +36,8 @@ def check_agent_state(state: Any, fmt: str, kind: str, arch: dict[str, Any]) -> 
     if not isinstance(state, dict) or state.get("format") != fmt:
         raise AgentStateError(f"not a {kind} agent state "
                               f"(format={state.get('format') if isinstance(state, dict) else None!r})")
-    diff = sorted(k for k, v in arch.items() if state["arch"].get(k) != v)
+    # both ways: a key only one side records (an option off by default) differs too
+    diff = sorted(k for k in set(arch) | set(state["arch"]) if state["arch"].get(k) != arch.get(k))
     if diff:
         raise AgentStateError("agent state has a different architecture: " + ", ".join(diff))
 
@@ -75,13 +76,17 @@ def weight_init(m: nn.Module) -> None:
         nn.init.orthogonal_(m.weight.data[:, :, mid, mid], nn.init.calculate_gain("relu"))
 
 
-def mlp(in_dim: int, hidden_dim: int, out_dim: int, num_layers: int, act: str) -> nn.Sequential:
-    """``num_layers`` Linear layers (the last one is the output layer), ``act`` between."""
+def mlp(in_dim: int, hidden_dim: int, out_dim: int, num_layers: int, act: str,
+        layer_norm: bool = False) -> nn.Sequential:
+    """``num_layers`` Linear layers (the last one is the output layer), ``act`` between; with
+    ``layer_norm`` a LayerNorm before each of those activations (RLPD's critic)."""
     dims = [in_dim] + [hidden_dim] * (num_layers - 1) + [out_dim]
     layers: list[nn.Module] = []
     for i in range(num_layers):
         layers.append(nn.Linear(dims[i], dims[i + 1]))
         if i < num_layers - 1:
+            if layer_norm:
+                layers.append(nn.LayerNorm(dims[i + 1]))
             layers.append(activation(act))
     return nn.Sequential(*layers)
 

@@ -133,6 +133,12 @@ class LearnerConfig:
     """Table 2 "Critic: Hidden dim"."""
     critic_activation: str = "relu"
     """Table 2 "Critic: Activation function"."""
+    critic_layer_norm: bool = False
+    """Paper: False (Table 2's Q-functions are plain MLPs). True ("sac_drq" only): a LayerNorm after
+    every hidden Linear layer of each Q-function MLP, before its activation, as RLPD (Ball et al. 2023,
+    *Efficient online reinforcement learning with offline data*) found needed to keep a critic that
+    learns from demonstrations in every batch from extrapolating wildly. A change of the critic's
+    architecture: the ``head_on_imitation_finetune_critic_ln`` lever, no profile's default."""
 
     # ---- Table 2: encoder ---------------------------------------------------------------
     encoder_lr: float = 1e-3
@@ -486,6 +492,8 @@ class LearnerConfig:
             bad("encoder_aux_loss", ", ".join(ENCODER_AUX_LOSSES))
         if self.encoder_aux_loss != "none" and self.algorithm != "sac_drq":
             bad("encoder_aux_loss", f"none for algorithm {self.algorithm} (only sac_drq has a decoder)")
+        if self.critic_layer_norm and self.algorithm != "sac_drq":
+            bad("critic_layer_norm", f"False for algorithm {self.algorithm} (only sac_drq's Q-functions take it)")
         if self.encoder_aux_weight < 0:
             bad("encoder_aux_weight", ">= 0")
         self._validate_demonstrations(bad)

@@ -83,8 +83,10 @@ class DrqCritic(nn.Module):
         super().__init__()
         self.proj = Projection(conv_dim, cfg.encoder_latent_dim, cfg.encoder_tanh)
         in_dim = cfg.encoder_latent_dim + extra_dim + action_dim
-        self.q1 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation)
-        self.q2 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation)
+        self.q1 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation,
+                      cfg.critic_layer_norm)
+        self.q2 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation,
+                      cfg.critic_layer_norm)
 
     def forward(self, h: torch.Tensor, extra: torch.Tensor, action: torch.Tensor):
         x = torch.cat([self.proj(h), extra, action], dim=-1)
@@ -124,6 +126,12 @@ class SacDrqAgent(SacDrqBase):
             # its own optimiser, so that agent states without a decoder keep their format
             self.optimisers["decoder"] = adam(self.decoder.parameters(), cfg.critic_lr,
                                               (cfg.critic_beta1, cfg.critic_beta2))
+
+    def arch(self) -> dict[str, Any]:
+        arch = super().arch()
+        if self.cfg.critic_layer_norm:  # recorded only when on, so that states and actors before it still match
+            arch["critic_layer_norm"] = True
+        return arch
 
     def make_critic(self, arch: dict[str, Any]) -> DrqCritic:
         return DrqCritic(self.encoder.out_dim, self.cfg, arch["extra_dim"] + self.state_dim, self.action_dim)
