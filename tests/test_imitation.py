@@ -5,13 +5,15 @@ from __future__ import annotations
 
 import json
 
+import gymnasium
 import numpy as np
 import pytest
 import torch
 
 from egosearch.rl.config import load_config
 from egosearch.rl.demos import collect_demonstrations, load_demonstrations
-from egosearch.rl.run_files import CHECKPOINT_NAME
+from egosearch.rl.actor import ActorPolicy
+from egosearch.rl.run_files import CHECKPOINT_NAME, START_ACTOR_NAME
 from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import train
 from egosearch.variants import load_variant
@@ -121,8 +123,20 @@ def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_
 
     monkeypatch.setattr(train_module._Run, "sample", counting)
     whole, resumed = tmp_path / "whole", tmp_path / "resumed"
-    train("EgoSearch-v0", cfg, whole, ENV, constant_evaluator, progress=False)
+    probe_obs = gymnasium.make("EgoSearchMemory-v0", **ENV).reset(seed=3)[0]  # target_memory: the env it trains in
+    evaluated = []
+
+    def recording_evaluator(policy) -> dict:
+        evaluated.append(policy.act(probe_obs))
+        return constant_evaluator(policy)
+
+    train("EgoSearch-v0", cfg, whole, ENV, recording_evaluator, progress=False)
     assert drawn and set(drawn) == {8}  # a quarter of 32 from the demonstrations, every update
+    # actor_start.pt is the clone that the step-0 evaluation ran (stored in float16), not the final actor
+    start, final = ActorPolicy(whole / START_ACTOR_NAME), ActorPolicy(whole / "actor.pt")
+    assert start.metadata["start"] and start.metadata["env_steps"] == 0 and final.metadata["env_steps"] == 300
+    np.testing.assert_allclose(start.act(probe_obs), evaluated[0], atol=2e-2)
+    assert np.abs(final.act(probe_obs) - start.act(probe_obs)).max() > 0.05
 
     class Stop(Exception):
         pass
@@ -135,8 +149,10 @@ def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_
         train("EgoSearch-v0", cfg, resumed, ENV, constant_evaluator, progress=False, on_step=stop)
     assert (resumed / CHECKPOINT_NAME).parent.joinpath("demos.replay.npz").exists()
     train("EgoSearch-v0", cfg, resumed, ENV, constant_evaluator, progress=False)
-    a, b = (torch.load(run / "actor.pt", weights_only=True)["state_dict"] for run in (whole, resumed))
-    assert all(torch.equal(a[k], b[k]) for k in a)
+    for name in ("actor.pt", START_ACTOR_NAME):
+        a, b = (torch.load(run / name, weights_only=True)["state_dict"] for run in (whole, resumed))
+        assert all(torch.equal(a[k], b[k]) for k in a)
+    a = torch.load(whole / "actor.pt", weights_only=True)["state_dict"]
 
     # a run stopped before its first checkpoint (while cloning, say) keeps its demonstrations and starts from them
     early = tmp_path / "early"

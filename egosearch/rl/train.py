@@ -16,6 +16,9 @@ leaves is run by :class:`egosearch.rl.actor.ActorPolicy`.
   never commit it);
 - ``actor.pt``: actor-only weights + metadata (variant, env_id, config), readable with
   ``torch.load(weights_only=True)``; load it with :class:`egosearch.rl.actor.ActorPolicy`;
+- ``actor_start.pt``: the same for the policy at step 0 (the clone after imitation, else the
+  untrained net; metadata ``start: True``), written before the step-0 evaluation: what the run's
+  learning starts from (runs stored before it have none);
 - ``ckpt/demos.replay.npz`` (+ ``ckpt/demos.json``): with ``cfg.demo_episodes``, the frontier
   searcher's transitions that the run learns from (:mod:`egosearch.rl.demos`), collected at the
   fresh start, deleted with the checkpoint; ``done.json`` keeps their summary;
@@ -63,6 +66,7 @@ from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (
     CHECKPOINT_FORMAT,
     CHECKPOINT_NAME,
+    START_ACTOR_NAME,
     CheckpointError,
     CsvLogger,
     atomic_json,
@@ -211,8 +215,8 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
             raise CheckpointError(f"cannot read {done_path} ({describe_error(err)})") from None
         check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
         return done
-    ours = {CHECKPOINT_NAME.name, "actor.pt", "done.json", "config.json", "curve.csv", "curve_episodes.csv",
-            "train.csv"}
+    ours = {CHECKPOINT_NAME.name, "actor.pt", START_ACTOR_NAME, "done.json", "config.json", "curve.csv",
+            "curve_episodes.csv", "train.csv"}
     for stale in [*out_dir.glob(".tmp*"), *(out_dir / CHECKPOINT_NAME.parent).glob(".tmp*")]:
         if stale.name.split(".", 2)[-1] in ours:  # temp files of a killed run of ours
             stale.unlink()
@@ -265,6 +269,7 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
     try:
         if run.step == 0 and run.curve.rows() == 0:
             run.imitate()
+            run.write_start_actor()
             last_row = run.evaluate(evaluate_fn)
         while run.step < cfg.total_env_steps:
             before = run.step
@@ -614,6 +619,20 @@ class _Run:
                 "episodes": self.episodes, "wall_s": round(self.wall(), 3),
                 "machine": self.machine(), "config": self.cfg.to_dict()}
 
+    def actor_meta(self) -> dict:
+        """What an actor file of this run records besides its weights."""
+        return {"variant": self.variant, "env_id": self.env_id, "env_kwargs": env_kwargs_key(self.env_kwargs),
+                "config": self.cfg.to_dict(), "env_steps": self.step,
+                "updates": self.agent.num_updates, "seed": self.cfg.seed, "torch": str(torch.__version__)}
+
+    def write_start_actor(self) -> None:
+        """``actor_start.pt``: the policy before RL (the clone after imitation, else the untrained net),
+        the one curve.csv's step-0 row evaluates, so that what RL adds can be measured on the stored
+        sets (``egosearch evaluate --actor .../actor_start.pt``). Written once, before the first
+        checkpoint: a run that resumes keeps it."""
+        atomic_write(self.out_dir / START_ACTOR_NAME,
+                     lambda f: torch.save(self.agent.actor_state({**self.actor_meta(), "start": True}), f))
+
     def finish(self, last_row: dict | None) -> dict:
         """Write actor.pt, then done.json (the run is complete), then drop the checkpoint."""
         if last_row is None:  # resumed exactly at the end: the last curve row is already written
@@ -623,9 +642,7 @@ class _Run:
                 rows = list(csv.DictReader(f))
             last_row = {k: float(v) for k, v in rows[-1].items()} if rows else {}
         cfg, agent, key = self.cfg, self.agent, env_kwargs_key(self.env_kwargs)
-        meta = {"variant": self.variant, "env_id": self.env_id, "env_kwargs": key,
-                "config": cfg.to_dict(), "env_steps": self.step,
-                "updates": agent.num_updates, "seed": cfg.seed, "torch": str(torch.__version__)}
+        meta = self.actor_meta()
         atomic_write(self.out_dir / "actor.pt", lambda f: torch.save(agent.actor_state(meta), f))
         summary = {"variant": self.variant, "env_id": self.env_id, "env_kwargs": key,
                    "env_steps": self.step, "updates": agent.num_updates,
