@@ -89,20 +89,43 @@ def test_table1_puts_the_policy_between_the_random_searcher_and_the_oracle(tmp_p
         cmd_table1(ours, tmp_path / "out2", variant="head_on", bounds=stray)
 
 
-def test_figure6_draws_the_random_searcher_as_a_dashed_level(tmp_path):
-    from egosearch.report.figures import RANDOM, figure6, figure6_frame
+def test_figure6_draws_the_random_and_classical_searchers_and_each_start_as_levels(tmp_path):
+    from matplotlib.figure import Figure
+
+    from egosearch.report import figures
+    from egosearch.report.figures import RANDOM, START_LABEL, figure6, figure6_frame
 
     curve = tmp_path / "train" / "head_on" / "seed0" / "curve.csv"
     curve.parent.mkdir(parents=True)
-    pd.DataFrame({"env_steps": [0, 100, 200], "success_rate": [0.0, 0.5, 0.75]}).to_csv(curve, index=False)
+    pd.DataFrame({"env_steps": [0, 100, 200], "success_rate": [0.25, 0.5, 0.75]}).to_csv(curve, index=False)
     rand = [_eval_csv(tmp_path, "random", "everywhere", h, s) for h, s in ((0.45, [1, 0, 0, 0]), (1.65, [0, 0, 0, 0]))]
-    df = figure6_frame({"head_on": [curve]}, random_files=rand, n_resamples=50)
+    classical = [_eval_csv(tmp_path, "frontier", "everywhere", 1.05, [1, 1, 1, 0])]
+    df = figure6_frame({"head_on": [curve]}, level_files=rand + classical, n_resamples=50)
     level = df[df["variant"] == RANDOM]
     assert list(level["env_steps"]) == [0, 100, 200] and (level["success_rate"] == 1 / 8).all()
-    png, _pdf, _csv = figure6({"head_on": [curve]}, tmp_path / "fig6", random_files=rand, n_resamples=50)
+    assert (df[df["variant"] == "frontier"]["success_rate"] == 3 / 4).all()
+    assert set(df[df["variant"] == "frontier"]["label"]) == {"classical searcher, head moving"}
+
+    drawn = []  # every horizontal line the figure draws: (label, height)
+    add_subplot = Figure.add_subplot
+
+    def recording_subplot(fig, *args, **kwargs):
+        ax = add_subplot(fig, *args, **kwargs)
+        plain = ax.axhline
+        ax.axhline = lambda y, **kw: (drawn.append((kw.get("label"), y)), plain(y, **kw))[1]
+        return ax
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(figures.Figure, "add_subplot", recording_subplot)
+        png, _pdf, _csv = figure6({"head_on": [curve]}, tmp_path / "fig6", level_files=rand + classical,
+                                  n_resamples=50)
     assert png.stat().st_size > 10_000
+    assert sorted(drawn) == sorted([("random searcher", 1 / 8), ("classical searcher, head moving", 3 / 4),
+                                    (START_LABEL, 0.25)])
     with pytest.raises(ValueError, match="may not be called 'random'"):
-        figure6_frame({"random": [curve]}, random_files=rand)
+        figure6_frame({"random": [curve]}, level_files=rand)
+    with pytest.raises(ValueError, match="no level's evaluation file"):
+        figure6_frame({"head_on": [curve]}, level_files=[_eval_csv(tmp_path, "oracle", "everywhere", 1.05, [1])])
 
 
 # --------------------------------------------------------------------------------------------- provenance

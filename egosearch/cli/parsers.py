@@ -239,7 +239,8 @@ def add_report(sub) -> None:
 
     r = reports.add_parser("fig6", help="Figure 6 (success vs env steps) from training curves")
     r.add_argument("files", nargs="+", help="curve.csv files: .../train/{variant}/seed{seed}/curve.csv")
-    r.add_argument("--random", nargs="*", help="evaluation CSVs of the random searcher: its level, dashed")
+    r.add_argument("--levels", nargs="*", help="evaluation CSVs of searchers that do not train (random, frontier, "
+                   "frontier_head_off: .../eval/SEARCHER/seedN/...): a horizontal line each")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
     add_force(r)
 

@@ -19,6 +19,7 @@ from egosearch.report import cli as report
 from egosearch.report.behaviour import behaviour_report, check_pairs, parse_pair, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
 from egosearch.report.data import parse_eval_path
+from egosearch.report.figures import FIG6_LEVELS
 from egosearch.report.fresh import fresh_report
 from egosearch.report.generalise import generalise_report
 from egosearch.report.pathlength import by_length_path
@@ -63,7 +64,7 @@ def report_inputs(args) -> dict[str, list[str]]:
     """``{option: the files it names}`` of the reports that read files."""
     if args.what == "budget":
         return {"--run": [f for spec in args.run for f in spec.partition("=")[2].split(":") if f]}
-    names = {"files": "the input files", "bounds": "--bounds", "random": "--random", "reference": "--reference",
+    names = {"files": "the input files", "bounds": "--bounds", "levels": "--levels", "reference": "--reference",
              "candidate": "--candidate", "scenarios": "--scenarios", "stored": "--stored", "fresh": "--fresh"}
     out = {}
     for name, option in names.items():
@@ -252,7 +253,7 @@ def _table2(args) -> None:
 
 
 def _fig6(args) -> None:
-    report.cmd_fig6(curves_by_variant(args.files), args.out_prefix, random_files=args.random)
+    report.cmd_fig6(curves_by_variant(args.files), args.out_prefix, level_files=args.levels)
 
 
 def _fig7(args) -> None:
@@ -406,9 +407,9 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
     bounds = [p for p in bound_eval_files(results, config["homes"], config["placements"], workflow_heights(config))
               if Path(p).exists()]
-    # Figure 6's random level: the cells the reference is evaluated in while training (as in the DAG).
+    # Figure 6's levels: the cells the reference is evaluated in while training (as in the DAG).
     train_env = load_variant(reference).train_env
-    fig6_random = [p for p in bounds if Path(p).parts[-5] == "random" and Path(p).parts[-2] == train_env["placement"]
+    fig6_levels = [p for p in bounds if Path(p).parts[-5] in FIG6_LEVELS and Path(p).parts[-2] == train_env["placement"]
                    and Path(p).parts[-3] in curve_homes(train_env)]
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
@@ -419,7 +420,7 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     if evals:
         report.cmd_table1(evals, figs / "table1", variant=reference, bounds=bounds)
     if curves:
-        report.cmd_fig6(curves, figs / "fig6", random_files=fig6_random)
+        report.cmd_fig6(curves, figs / "fig6", level_files=fig6_levels)
     if fullbody:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:

@@ -67,10 +67,10 @@ def cmd_table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike,
 
 
 def cmd_fig6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike,
-             labels: Mapping[str, str] | None = None, random_files: Iterable[PathLike] | None = None) -> list[Path]:
-    """Figure 6 from ``{variant: [curve.csv per seed]}``; ``random_files``: the random searcher's evaluations
-    on the training home's cells (a dashed line)."""
-    outs = figure6(curves, out_prefix, labels=labels, random_files=random_files)
+             labels: Mapping[str, str] | None = None, level_files: Iterable[PathLike] | None = None) -> list[Path]:
+    """Figure 6 from ``{variant: [curve.csv per seed]}``; ``level_files``: the random and classical searchers'
+    evaluations on the training home's cells (a horizontal line each)."""
+    outs = figure6(curves, out_prefix, labels=labels, level_files=level_files)
     _say(outs)
     return outs
 

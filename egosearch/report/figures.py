@@ -66,6 +66,14 @@ PLANNER_TITLES = {"actor": None, "oracle": "Planner: privileged oracle (knows th
 RANDOM = "random"
 """Figure 6's row name of the random searcher (a dashed line: the level a policy must rise above)."""
 RANDOM_LABEL = "random searcher"
+FIG6_LEVELS = {RANDOM: (RANDOM_LABEL, "--", "#555555"),
+               "frontier": ("classical searcher, head moving", "-.", "#000000"),
+               "frontier_head_off": ("classical searcher, head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "#777777")}
+"""Figure 6's levels, searchers that do not train (a horizontal line each: label, line style, colour): the
+floor a policy must rise above and the classical searcher its learning is read against. The row name is
+the searcher's, read from its evaluation files' path (``eval/{searcher}/seed{N}/...``)."""
+START_LABEL = "policy at step 0"
+"""Legend text of the dotted line at each curve's first point (its start: untrained, or cloned)."""
 FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "n_scenarios", "success_rate", "low", "high", "ci_unit")
 CI_TWO_LEVEL, CI_SEEDS, CI_WILSON = "scenarios, then seeds", "seeds", "episodes (Wilson)"
 FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
@@ -116,9 +124,20 @@ def _curve_episodes(curve_paths: list) -> pd.DataFrame | None:
     return pd.concat(frames, ignore_index=True) if frames else None
 
 
+def level_searcher(path: PathLike) -> str:
+    """The searcher whose evaluation file ``path`` is (``.../eval/{searcher}/seed{N}/{home}/{placement}/h*.csv``),
+    one of :data:`FIG6_LEVELS`; ValueError otherwise."""
+    parts = Path(path).parts
+    name = parts[-5] if len(parts) >= 5 else ""
+    if name not in FIG6_LEVELS:
+        raise ValueError(f"figure6: {path} is no level's evaluation file (.../eval/SEARCHER/seedN/HOME/PLACEMENT/"
+                         f"hH.csv, SEARCHER one of {', '.join(FIG6_LEVELS)})")
+    return name
+
+
 def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str, str] | None = None,
                   confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
-                  random_files: Iterable[PathLike] | None = None) -> pd.DataFrame:
+                  level_files: Iterable[PathLike] | None = None) -> pd.DataFrame:
     """Numbers behind Figure 6: per variant and evaluation step, the mean success rate over seeds and a
     95% band. Where every seed's run kept the episodes behind its curve (``curve_episodes.csv`` beside
     ``curve.csv``), the band is the two-level bootstrap over the evaluation's scenarios, then the seeds
@@ -126,9 +145,10 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     than 2 seeds were evaluated at that step).
 
     Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
-    ``random_files``: per-episode CSVs of the random searcher (``.../seed{N}/...``); their pooled
-    success rate and Wilson interval become rows of variant :data:`RANDOM`, one at every step of the
-    curves (it does not train: the same level throughout).
+    ``level_files``: per-episode CSVs of searchers that do not train (:data:`FIG6_LEVELS`: the random
+    searcher, the classical searchers; which one a file is comes from its path, :func:`level_searcher`);
+    each searcher's pooled success rate and Wilson interval become rows named after it, one at every
+    step of the curves (the same level throughout).
     """
     labels = {**FIG6_LABELS, **(labels or {})}
     if not curves:
@@ -156,15 +176,17 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
             rows.append({"variant": variant, "label": labels.get(variant, variant), "env_steps": int(step),
                          "n_seeds": int(v.size), "n_scenarios": n_scen, "success_rate": float(v.mean()),
                          "low": lo, "high": hi, "ci_unit": unit})
-    random_files = list(random_files or [])
-    if random_files:
-        if RANDOM in curves:
-            raise ValueError(f"figure6: a variant may not be called {RANDOM!r}, the random searcher's row")
-        eps = read_episodes(random_files)
+    by_level: dict[str, list] = {}
+    for path in level_files or []:
+        by_level.setdefault(level_searcher(path), []).append(path)
+    for name in sorted(by_level, key=list(FIG6_LEVELS).index):
+        if name in curves:
+            raise ValueError(f"figure6: a variant may not be called {name!r}, the {FIG6_LEVELS[name][0]}'s row")
+        eps = read_episodes(by_level[name])
         k, n = int(eps["success"].astype(int).sum()), len(eps)
         lo, hi = wilson_ci(k, n, confidence)
         for step in sorted({r["env_steps"] for r in rows}):
-            rows.append({"variant": RANDOM, "label": RANDOM_LABEL, "env_steps": step,
+            rows.append({"variant": name, "label": FIG6_LEVELS[name][0], "env_steps": step,
                          "n_seeds": int(eps["seed"].nunique()), "n_scenarios": n, "success_rate": k / n,
                          "low": lo, "high": hi, "ci_unit": CI_WILSON})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
@@ -193,7 +215,7 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
 
 def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labels: Mapping[str, str] | None = None,
             confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
-            random_files: Iterable[PathLike] | None = None) -> list[Path]:
+            level_files: Iterable[PathLike] | None = None) -> list[Path]:
     """Figure 6: evaluation success rate vs environment steps, one line per variant (mean over seeds) with a
     bootstrap band over seeds where at least 2 seeds were evaluated.
 
@@ -201,26 +223,33 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     ``head_on`` -> "with head movement", ``head_off`` -> "without head movement"). Writes
     ``{prefix}.png`` (300 dpi), ``{prefix}.pdf`` and ``{prefix}.csv`` (the plotted numbers; a directory
     prefix gets ``fig6.*``) and returns the paths. ValueError on no curves / no evaluated rows.
-    ``random_files`` (see :func:`figure6_frame`) add the random searcher as a dashed line. A training that
-    learned from the classical searcher marks where its imitation phase ends (:func:`imitation_phases`;
-    its step-0 point is the cloned policy). A modular searcher's curve counts decisions (the x axis says so).
+    ``level_files`` (see :func:`figure6_frame`) add the random and classical searchers as horizontal lines,
+    and each curve's start (its step-0 point: the untrained or cloned policy) is a dotted line in its colour,
+    so that what learning adds reads against both. A training that learned from the classical searcher
+    marks where its imitation phase ends (:func:`imitation_phases`). A modular searcher's curve counts
+    decisions (the x axis says so).
     """
-    df = figure6_frame(curves, labels, confidence, n_resamples, seed, random_files=random_files)
+    df = figure6_frame(curves, labels, confidence, n_resamples, seed, level_files=level_files)
     base = output_base(out_prefix, "fig6")
     df.to_csv(suffixed(base, ".csv"), index=False, float_format="%.6g")
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(3.5, 2.5))
         ax = fig.add_subplot()
-        level = df[df["variant"] == RANDOM]
-        if not level.empty:
-            ax.axhline(level["success_rate"].iloc[0], color="#555555", linestyle="--", linewidth=1.1,
-                       label=RANDOM_LABEL)
-        for i, (_variant, g) in enumerate(df[df["variant"] != RANDOM].groupby("variant", sort=False)):
+        for name, (level_label, style, level_colour) in FIG6_LEVELS.items():
+            level = df[df["variant"] == name]
+            if not level.empty:
+                ax.axhline(level["success_rate"].iloc[0], color=level_colour, linestyle=style, linewidth=1.1,
+                           label=level_label)
+        trained = df[~df["variant"].isin(list(FIG6_LEVELS))]
+        for i, (_variant, g) in enumerate(trained.groupby("variant", sort=False)):
             colour = OKABE_ITO[i % len(OKABE_ITO)]
             x, y = g["env_steps"].to_numpy(), g["success_rate"].to_numpy()
             n_seeds = int(g["n_seeds"].max())
             label = g["label"].iloc[0] + (f" ({n_seeds} seeds)" if n_seeds > 1 else "")
             ax.plot(x, y, color=colour, label=label, marker="o" if len(x) == 1 else None, markersize=3)
+            if len(x) > 1:  # where learning starts from: a level, so the rise reads at a glance
+                ax.axhline(y[0], color=colour, linestyle=":", linewidth=0.9,
+                           label=START_LABEL if i == 0 else None)
             band = g["low"].notna().to_numpy()
             if band.any():
                 ax.fill_between(x, g["low"].to_numpy(), g["high"].to_numpy(), where=band, color=colour,
@@ -242,8 +271,8 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
         ax.set_xlim(left=0)
         ax.yaxis.set_major_locator(MultipleLocator(0.2))
         ax.xaxis.set_major_formatter(FuncFormatter(_steps_formatter))
-        # Above the axes: inside, any corner would hide a curve at some profile's success rates.
-        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.01), borderaxespad=0.0)
+        # Beside the axes: inside, any corner would hide a curve or a level at some profile's success rates.
+        ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), borderaxespad=0.0)
         outs = save_figure(fig, base)
     return [*outs, suffixed(base, ".csv")]
 

@@ -133,14 +133,15 @@ def bound_files(bounds=BOUNDS, placements=None, homes=None):
     return bound_eval_files(RESULTS, homes or HOMES, placements or PLACEMENTS, HEIGHTS, bounds, BOUND_SEEDS)
 
 
-def fig6_random_files():
-    """The random searcher on the Table 1 cells the reference is evaluated in during training (Figure 6's
-    curves): its level in that figure."""
+def fig6_level_files():
+    """The random and classical searchers (head moving and head fixed) on the Table 1 cells the reference
+    is evaluated in during training (Figure 6's curves): their levels in that figure."""
     from egosearch.sim.home_pool import curve_homes
 
     train_env = VARIANTS[REF].train_env
     homes = [h for h in curve_homes(train_env) if h in HOMES]
-    return bound_files(["random"], [train_env["placement"]], homes) if train_env["placement"] in PLACEMENTS and homes else []
+    levels = [b for b in ("random", "frontier", "frontier_head_off") if b in BOUNDS]
+    return bound_files(levels, [train_env["placement"]], homes) if train_env["placement"] in PLACEMENTS and homes else []
 
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top

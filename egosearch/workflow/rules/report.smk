@@ -56,11 +56,11 @@ rule table2_paper:
 
 
 rule fig6:
-    """Success rate vs environment steps, head on vs head off (paper Figure 6); the random
-    searcher a dashed line."""
+    """Success rate vs environment steps, head on vs head off (paper Figure 6); the random and
+    classical searchers and each policy's start a horizontal line."""
     input:
         curves=ancient([curve_files(v) for v in VARIANTS]),
-        random=ancient(fig6_random_files()),
+        levels=ancient(fig6_level_files()),
     output:
         expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
     log:
@@ -72,7 +72,7 @@ rule fig6:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report fig6 --force {input.curves} --random {input.random} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report fig6 --force {input.curves} --levels {input.levels} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig7:
