@@ -30,7 +30,6 @@ from egosearch.report.speed import HOSTS, block_speed, machine_words
 from egosearch.report.stats import cell_contrast
 from egosearch.report.tables import BOTH_HOMES, PAPER_TABLE1
 from egosearch.report.workflow_jobs import job_cost_s, job_study, workflow_config
-from egosearch.report.workflow_jobs import variants_of_all as variants_of_all  # re-exported for older callers
 
 BLOCK = re.compile(r"(<!-- egosearch:begin (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- egosearch:end (?P=name) -->)",
                    re.DOTALL)

@@ -2,7 +2,7 @@
 
 A policy has ``reset(seed=None)`` (called at the start of every episode) and
 ``act(obs) -> np.ndarray`` (a normalised action in [-1, 1]). The learned actor lives in
-:mod:`egosearch.rl.train` (``ActorPolicy``) and follows the same interface.
+:mod:`egosearch.rl.actor` (``ActorPolicy``) and follows the same interface.
 """
 
 from __future__ import annotations
