@@ -291,6 +291,34 @@ def test_profiles_are_valid_and_paper_is_table2():
     assert {f for f, v in paper.to_dict().items() if v != LearnerConfig().to_dict()[f]} == {"cuda_graph"}
 
 
+def test_the_configs_forms_of_r_d_are_the_envs():
+    from egosearch.rl.config import DISTANCE_REWARDS
+    from egosearch.sim.env import DISTANCE_REWARDS as ENV_DISTANCE_REWARDS
+
+    assert DISTANCE_REWARDS == ENV_DISTANCE_REWARDS
+
+
+def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
+    """One image size (egosearch.sim.agent.IMAGE_SIZE): the env's frames, the sensor's default, and every
+    profile's image_size; a config that differs is refused in one line when its training makes the env."""
+    from egosearch.rl.train import train
+    from egosearch.sim.agent import IMAGE_SIZE
+    from egosearch.sim.env import SearchEnv
+    from egosearch.sim.sensor import DEFAULT_HEIGHT, DEFAULT_WIDTH
+
+    env = SearchEnv(layout="kitchen_living")
+    try:
+        assert env.observation_space["depth"].shape[1:] == (IMAGE_SIZE, IMAGE_SIZE)
+    finally:
+        env.close()
+    assert (DEFAULT_WIDTH, DEFAULT_HEIGHT) == (IMAGE_SIZE, IMAGE_SIZE)
+    assert {load_config(name, {}).image_size for name in PROFILES} == {LearnerConfig().image_size} == {IMAGE_SIZE}
+    smaller = load_config("smoke", {"image_size": 90, "device": "cpu", "num_envs": 1})
+    with pytest.raises(ValueError, match=r"config expects \(5, 90, 90\) uint8") as err:
+        train("EgoSearch-v0", smaller, tmp_path, env_kwargs={"layout": "kitchen_living"}, progress=False)
+    assert "\n" not in str(err.value)
+
+
 # the paper's Table 2 (Appendix A), verbatim
 PAPER_TABLE2 = [
     ("Image Size", "100x100"), ("Augmentation", "Random Crop (84x84)"),

@@ -37,7 +37,8 @@ CURRICULUM_START_RADIUS = 1.0
 CURRICULUM_END_RADIUS = 12.0
 """Radius (m) the curriculum reaches at its end: more than any home's extent."""
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
-"""Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; a test keeps them equal)."""
+"""Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; ``tests/test_rl_sac.py``'s
+``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
 ENCODER_AUX_LOSSES = ("none", "reconstruction")
 """Auxiliary losses on the "sac_drq" encoder (see ``LearnerConfig.encoder_aux_loss``)."""
 
@@ -58,7 +59,8 @@ class LearnerConfig:
     # ---- Table 2: observation and data -------------------------------------------------
     image_size: int = 100
     """Table 2 "Image Size" 100x100: side (px) of the depth frames the env renders and the
-    replay buffer stores."""
+    replay buffer stores. It must be the env's, ``egosearch.sim.agent.IMAGE_SIZE`` (every profile's is:
+    ``tests/test_rl_sac.py``); a training whose config differs stops in one line when it makes its env."""
     crop_size: int = 84
     """Table 2 "Augmentation: Random Crop (84x84)": side of the random crop fed to the encoder
     during updates (a centre crop when acting)."""

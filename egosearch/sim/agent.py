@@ -15,6 +15,12 @@ import numpy as np
 
 STEP_SECONDS = 0.15
 """Duration of one env step (s): 100 steps ~ 15 s, paper 6.1."""
+IMAGE_SIZE = 100
+"""Side (px) of the square depth frames the camera renders (paper Table 2 "Image Size" 100x100): the
+one source of the env's frames (:mod:`egosearch.sim.env`) and the sensor's default size
+(:mod:`egosearch.sim.sensor`). A learner config's ``image_size`` and an actor file's
+``arch["image_size"]`` must equal it (:class:`egosearch.rl.actor.ActorPolicy` checks the actor's on
+loading it)."""
 
 #: Camera heights the paper evaluates (m): the humanoid, the Fetch robot and a short agent.
 EVAL_HEIGHTS = (0.45, 1.05, 1.65)

@@ -52,7 +52,7 @@ from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
 from egosearch.scene.placement import sample_target
-from egosearch.sim.agent import AgentSpec, AgentState, check_height
+from egosearch.sim.agent import IMAGE_SIZE, AgentSpec, AgentState, check_height
 from egosearch.sim.floormap import FloorMap
 from egosearch.sim.scenarios import (
     MAX_STEPS,
@@ -67,8 +67,6 @@ from egosearch.sim.world import World
 
 FRAME_HISTORY = 5
 """K of paper 4.1."""
-IMAGE_SIZE = 100
-"""Rendered side (px); the learner crops 84x84 from it (paper Table 2)."""
 MASK_FEATURE_DIM = 30
 REWARD_WEIGHTS = (1.0, 1.0, 1.0, 0.1)
 """[w_s, w_d, w_l, w_c] of paper eq. 2."""

@@ -75,9 +75,10 @@ import numpy as np
 from egosearch.scene.meshes import part_mesh, scene_meshes
 from egosearch.scene.parts import Part, Scene
 from egosearch.sim import rasterbuild
+from egosearch.sim.agent import IMAGE_SIZE
 
-DEFAULT_WIDTH = 100
-DEFAULT_HEIGHT = 100
+DEFAULT_WIDTH = IMAGE_SIZE
+DEFAULT_HEIGHT = IMAGE_SIZE
 DEFAULT_FOV_DEG = 90.0
 DEFAULT_MAX_DEPTH = 5.0
 #: Near clipping plane of the rasteriser (m): geometry nearer than this is not seen.
