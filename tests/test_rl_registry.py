@@ -1,9 +1,11 @@
 """The learner registry and the Agent protocol: every registered learner is an Agent, and a learner
-registered from outside egosearch (a toy defined here) trains through the real training loop."""
+registered from outside egosearch (a toy defined here) trains through the real training loop and its
+actor file acts through ActorPolicy, as every written contract (egosearch.rl.agent) says it will."""
 
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -11,8 +13,8 @@ import numpy as np
 import pytest
 import torch
 
-from egosearch.rl.actor import AgentPolicy, load_any_actor_net
-from egosearch.rl.agent import Agent, AgentBase
+from egosearch.rl.actor import ActorPolicy, AgentPolicy, load_any_actor_net
+from egosearch.rl.agent import ActorFileNet, Agent, AgentBase
 from egosearch.rl.common import METRIC_KEYS, AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
@@ -28,18 +30,19 @@ TOY_AGENT_FORMAT, TOY_ACTOR_FORMAT = "toy-agent-v1", "toy-actor-v1"
 
 
 class ToyActorNet(torch.nn.Module):
-    """A linear policy on [mask, proprio] (it ignores depth)."""
+    """A linear policy on [mask, proprio] (it ignores depth), called as an actor file's network is
+    (``egosearch.rl.agent.ActorFileNet``): ``(depth, extra) -> (mean before the tanh, None)``."""
 
-    def __init__(self, in_dim: int, action_dim: int):
+    def __init__(self, extra_dim: int, action_dim: int):
         super().__init__()
-        self.fc = torch.nn.Linear(in_dim, action_dim)
+        self.fc = torch.nn.Linear(extra_dim, action_dim)
 
-    def forward(self, extra: torch.Tensor) -> torch.Tensor:
-        return torch.tanh(self.fc(extra))
+    def forward(self, depth: torch.Tensor | None, extra: torch.Tensor) -> tuple[torch.Tensor, None]:
+        return self.fc(extra), None
 
 
 def load_toy_actor_net(state: dict, device) -> ToyActorNet:
-    net = ToyActorNet(state["arch"]["in_dim"], state["arch"]["action_dim"])
+    net = ToyActorNet(state["arch"]["extra_dim"], state["arch"]["action_dim"])
     net.load_state_dict(state["state_dict"])
     return net.to(device).eval()
 
@@ -49,7 +52,8 @@ class ToyAgent(AgentBase):
 
     def __init__(self, cfg, action_dim: int, mask_dim: int, proprio_dim: int, device=None, state_dim: int = 0):
         self.cfg = cfg.validate()
-        self.arch = {"in_dim": mask_dim + proprio_dim, "action_dim": action_dim}
+        # an ActorArch's sizes and nothing else: no crop_size, so a policy hands it whole frames
+        self.arch = {"action_dim": action_dim, "extra_dim": mask_dim + proprio_dim}
         self.net = ToyActorNet(mask_dim + proprio_dim, action_dim)
         self.opt = torch.optim.SGD(self.net.parameters(), lr=0.01)
         self.num_updates = 0
@@ -62,7 +66,7 @@ class ToyAgent(AgentBase):
     def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         extra = torch.as_tensor(np.concatenate([obs["mask"], obs["proprio"]]), dtype=torch.float32)
         with torch.no_grad():
-            a = self.net(extra)
+            a = torch.tanh(self.net(None, extra)[0])
             if not deterministic:
                 a = (a + 0.3 * torch.randn_like(a)).clamp(-1.0, 1.0)
         return a.numpy()
@@ -70,7 +74,8 @@ class ToyAgent(AgentBase):
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         self.num_updates += 1
         self.batch_sizes.append(int(batch["action"].shape[0]))
-        loss = (self.net(torch.cat([batch["mask"], batch["proprio"]], -1)) - batch["action"]).pow(2).mean()
+        mean, _ = self.net(None, torch.cat([batch["mask"], batch["proprio"]], -1))
+        loss = (torch.tanh(mean) - batch["action"]).pow(2).mean()
         self.opt.zero_grad()
         loss.backward()
         self.opt.step()
@@ -133,9 +138,39 @@ def test_a_registered_learner_trains_through_the_real_loop(toy_learner, tmp_path
     state = torch.load(tmp_path / "actor.pt", weights_only=True)
     assert state["format"] == TOY_ACTOR_FORMAT and state["metadata"]["env_id"] == FAKE_ENV_ID
     net = load_any_actor_net(state, "cpu")
-    assert isinstance(net, ToyActorNet)
-    extra = torch.randn(3, state["arch"]["in_dim"])
-    assert torch.equal(net(extra), agent.net(extra).detach())
+    assert isinstance(net, ToyActorNet) and isinstance(net, ActorFileNet)
+    extra = torch.randn(3, state["arch"]["extra_dim"])
+    assert torch.equal(net(None, extra)[0], agent.net(None, extra)[0].detach())
+
+    # and the file acts through ActorPolicy as the trained agent does
+    policy = ActorPolicy(tmp_path / "actor.pt", device="cpu")
+    assert policy.action_dim == 5 and not policy.recurrent and policy.crop_size == 100
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        obs = {"depth": rng.integers(0, 256, (5, 100, 100), dtype=np.uint8),
+               "mask": rng.normal(size=30).astype(np.float32), "proprio": rng.normal(size=4).astype(np.float32)}
+        policy.reset(seed=0)
+        np.testing.assert_allclose(policy.act(obs), agent.act(obs, deterministic=True), rtol=0, atol=1e-6)
+
+
+def test_an_actor_file_that_breaks_the_written_contract_is_one_line(toy_learner, tmp_path):
+    cfg = load_config("smoke", {"algorithm": "toy", "device": "cpu"})
+    good = make_agent(cfg, 5, 30, 4, torch.device("cpu")).actor_state({"env_id": "EgoSearch-v0"})
+    bad_files = {
+        "no_extra_dim": ({**good, "arch": {"action_dim": 5}}, "arch has extra_dim=None; it needs an integer >= 1"),
+        "a_float_crop": ({**good, "arch": {**good["arch"], "crop_size": 84.0}}, "arch has crop_size=84.0"),
+        "other_frames": ({**good, "arch": {**good["arch"], "image_size": 64}},
+                         "trained on 64x64 depth frames \\(its arch's image_size\\); the envs render 100x100"),
+        "other_config": ({**good, "metadata": {"config": {"image_size": 50}}},
+                         "trained on 50x50 depth frames \\(its recorded config's image_size\\)"),
+    }
+    for name, (state, message) in bad_files.items():
+        torch.save(state, tmp_path / f"{name}.pt")
+        with pytest.raises(AgentStateError, match=message) as err:
+            ActorPolicy(tmp_path / f"{name}.pt")
+        assert str(err.value).startswith(str(tmp_path / name)) and "\n" not in str(err.value)
+    torch.save(good, tmp_path / "good.pt")
+    assert ActorPolicy(tmp_path / "good.pt").fits("EgoSearch-v0")
 
 
 def test_register_refuses_a_taken_name_and_a_format_loaded_differently(toy_learner):
@@ -168,7 +203,9 @@ def test_every_registered_learner_is_an_agent_and_writes_a_registered_actor_form
     agent = make_agent(cfg, 5, 30, 4, torch.device("cpu"))
     assert isinstance(agent, Agent) and isinstance(agent, AgentBase)
     assert isinstance(agent, LEARNERS[name].agent_factory())
-    assert agent.num_updates == 0 and agent.alpha > 0
+    # alpha, the entropy term's weight, is only logged: SAC's initial temperature, PPO's coefficient
+    assert agent.num_updates == 0 and math.isfinite(agent.alpha)
+    assert agent.alpha == pytest.approx(cfg.entropy_coef if name == "ppo" else cfg.init_temperature)
     assert agent.recurrent == (name == "sac_drq_recurrent")
 
     actor = agent.actor_state({"variant": "x"})
@@ -187,3 +224,37 @@ def test_every_registered_learner_is_an_agent_and_writes_a_registered_actor_form
     agent.reset_state(0)
     AgentPolicy(agent).reset(seed=0)
     assert set(agent.state_dict()) >= {"format", "num_updates"}
+    # behaviour cloning: SAC-DrQ's own hooks; every other learner refuses it in one line (AgentBase's)
+    assert agent.bc_weight_now == 0.0
+    if name == "sac_drq":
+        assert len(agent.clone_parameters()) > 0
+    else:
+        with pytest.raises(NotImplementedError, match="does not learn from demonstrations"):
+            agent.clone_parameters()
+        with pytest.raises(NotImplementedError, match="does not learn from demonstrations"):
+            agent.clone_update({}, torch.optim.SGD([torch.zeros(1, requires_grad=True)], lr=0.1))
+
+
+def test_every_hook_the_loop_calls_is_in_the_protocol():
+    """Each ``agent.NAME`` the training loop and imitation use is a member of ``Agent`` (and so has a
+    default in ``AgentBase`` or is one every learner defines)."""
+    import ast
+    import inspect
+
+    import egosearch.rl.actor
+    import egosearch.rl.imitation
+    import egosearch.rl.train
+
+    used = set()
+    for module in (egosearch.rl.train, egosearch.rl.imitation, egosearch.rl.actor):
+        for node in ast.walk(ast.parse(inspect.getsource(module))):
+            if isinstance(node, ast.Attribute):
+                owner = node.value
+                if isinstance(owner, ast.Name) and owner.id == "agent" or (
+                        isinstance(owner, ast.Attribute) and owner.attr == "agent"):
+                    used.add(node.attr)
+    members = {name for name in dir(Agent) if not name.startswith("_")} | set(Agent.__annotations__)
+    assert {"bc_weight_now", "clone_parameters", "clone_update", "update"} <= used
+    assert used <= members, sorted(used - members)
+    # AgentBase names every member (a default or an abstract method), but the counter a learner sets itself
+    assert {name for name in members if not hasattr(AgentBase, name)} == {"num_updates"}

@@ -1,6 +1,10 @@
 """A trained actor as a policy: :class:`ActorPolicy` loads ``actor.pt`` (any learner's, by its
 ``format``) behind the project's policy interface, ``reset(seed)`` and ``act(obs)``;
 :class:`AgentPolicy` puts a live agent behind the same interface (the training loop's evaluations).
+
+What an actor file holds and how its network is called is written down in :mod:`egosearch.rl.agent`
+(:class:`~egosearch.rl.agent.ActorFile`, :class:`~egosearch.rl.agent.ActorArch`,
+:class:`~egosearch.rl.agent.ActorFileNet`); :func:`check_actor_file` holds a file to it on loading.
 """
 
 from __future__ import annotations
@@ -11,9 +15,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from egosearch.rl.agent import Agent
+from egosearch.rl.agent import ActorFileNet, Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.registry import actor_loader
+from egosearch.sim.agent import IMAGE_SIZE
 from egosearch.sim.envs import ALL_ENV_IDS, env_space_dims
 
 
@@ -30,13 +35,35 @@ class AgentPolicy:
         return self.agent.act(obs, deterministic=True)
 
 
-def load_any_actor_net(state: dict, device) -> torch.nn.Module:
+def check_actor_file(state: dict) -> None:
+    """Raise :class:`AgentStateError` (one line) unless the actor file ``state``'s ``arch`` holds what
+    :class:`ActorPolicy` reads (:class:`egosearch.rl.agent.ActorArch`) and the actor was trained on
+    frames of the env's size (its ``arch["image_size"]``, else its recorded config's, where either is
+    written): an actor on other frames would otherwise crop or pool them to the wrong size in silence."""
+    arch = state.get("arch")
+    if not isinstance(arch, dict):
+        raise AgentStateError("the actor file has no arch (a dict of its sizes: egosearch.rl.agent.ActorArch)")
+    for key in ("action_dim", "extra_dim") + tuple(k for k in ("crop_size", "mask_dim", "proprio_dim") if k in arch):
+        if not isinstance(arch.get(key), int) or isinstance(arch[key], bool) or arch[key] < 1:
+            raise AgentStateError(f"the actor file's arch has {key}={arch.get(key)!r}; it needs an integer >= 1 "
+                                  "(egosearch.rl.agent.ActorArch)")
+    config = (state.get("metadata") or {}).get("config") or {}
+    side = arch.get("image_size", config.get("image_size"))
+    if side is not None and side != IMAGE_SIZE:
+        where = "arch" if "image_size" in arch else "recorded config"
+        raise AgentStateError(f"this actor was trained on {side}x{side} depth frames (its {where}'s image_size); "
+                              f"the envs render {IMAGE_SIZE}x{IMAGE_SIZE} (egosearch.sim.agent.IMAGE_SIZE)")
+
+
+def load_any_actor_net(state: dict, device) -> ActorFileNet:
     """An actor file's network, any registered learner's: the loader its ``format`` is registered
-    with (:func:`egosearch.rl.registry.actor_loader`)."""
+    with (:func:`egosearch.rl.registry.actor_loader`), once the file holds what a policy reads
+    (:func:`check_actor_file`)."""
     fmt = state.get("format") if isinstance(state, dict) else None
     loader = actor_loader(fmt) if isinstance(fmt, str) else None
     if loader is None:
         raise AgentStateError(f"not an actor file (format={fmt!r})")
+    check_actor_file(state)
     return loader(state, device)
 
 
@@ -71,6 +98,8 @@ class ActorPolicy:
         self.env_id = self.metadata.get("env_id")
         self.config = self.metadata.get("config")
         self.action_dim = int(self.arch["action_dim"])
+        # without a crop_size the network reads the whole frame (a centre crop of the frame's own size)
+        self.crop_size = int(self.arch.get("crop_size", IMAGE_SIZE))
         self.recurrent = bool(getattr(self.net, "recurrent", False))
         self._h = None
 
@@ -109,7 +138,7 @@ class ActorPolicy:
 
     def act(self, obs: dict) -> np.ndarray:
         with torch.inference_mode():
-            depth, extra = obs_to_tensors(obs, self.device, self.arch["crop_size"])
+            depth, extra = obs_to_tensors(obs, self.device, self.crop_size)
             if self.recurrent:
                 mu, _, self._h = self.net(depth.float(), extra, self._h)
             else:

@@ -1,31 +1,50 @@
-"""What a learner is to the training loop: the :class:`Agent` protocol and :class:`AgentBase`, its
-optional hooks' default behaviour.
+"""What a learner is to the training loop and what its actor file is to a policy: the :class:`Agent`
+protocol, :class:`AgentBase` (its optional hooks' default behaviour), and the actor file's contract
+(:class:`ActorFile`, :class:`ActorArch`, :class:`ActorFileNet`).
 
-:mod:`egosearch.rl.train` (``_Run``) and :class:`egosearch.rl.actor.AgentPolicy` call an agent
-through :class:`Agent` only, and call every hook directly: a learner that subclasses
-:class:`AgentBase` inherits the hooks it does not need. A learner is registered by name in
-:mod:`egosearch.rl.registry` (one ``register`` line), which ``cfg.algorithm`` then picks.
+:mod:`egosearch.rl.train` (``_Run``), :mod:`egosearch.rl.imitation` and
+:class:`egosearch.rl.actor.AgentPolicy` call an agent through :class:`Agent` only, and call every
+hook directly: a learner that subclasses :class:`AgentBase` inherits the hooks it does not need. A
+learner is registered by name in :mod:`egosearch.rl.registry` (one ``register`` line), which
+``cfg.algorithm`` then picks; :class:`egosearch.rl.actor.ActorPolicy` loads its actor files through
+the loader registered with their ``format``.
 
-This module imports neither torch nor a learner.
+This module imports neither torch nor a learner, nor the learner config: it is the contract its
+implementers import, so it imports nothing of theirs (the config imports the registry, which imports
+this module). What it reads of a config is :class:`LearnerSettings`.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, TypedDict, runtime_checkable
 
 import numpy as np
 
 if TYPE_CHECKING:
     import torch
 
-    from egosearch.rl.config import LearnerConfig
     from egosearch.rl.replay import MultiReplay
+
+
+class LearnerSettings(Protocol):
+    """What the registry and :class:`AgentBase`'s defaults read of a learner config
+    (:class:`egosearch.rl.config.LearnerConfig` is one; a learner reads its own fields from it)."""
+
+    @property
+    def algorithm(self) -> str: ...
+
+    @property
+    def image_size(self) -> int: ...
+
+    @property
+    def batch_size(self) -> int: ...
 
 
 @runtime_checkable
 class Agent(Protocol):
-    """What the training loop (``egosearch.rl.train._Run``) and ``AgentPolicy`` may call on a learner.
+    """What the training loop (``egosearch.rl.train._Run``), imitation (:mod:`egosearch.rl.imitation`)
+    and ``AgentPolicy`` may call on a learner: every attribute and method below, and nothing else.
 
     Acting: ``act(obs, deterministic)`` -> one action (A,) in [-1, 1] for ONE env observation (the
     evaluation episode's, for a recurrent agent); ``act_batch(obs, deterministic)`` -> (B, A) for a
@@ -39,18 +58,26 @@ class Agent(Protocol):
     Memory: ``reset_state(env_index)`` when training env ``env_index``'s episode ends or is cut;
     ``reset_policy_state()`` when an evaluation episode starts.
 
+    Demonstrations (configs with ``bc_updates`` or ``bc_weight``): before RL, behaviour cloning
+    builds one optimiser over ``clone_parameters()`` and calls ``clone_update(batch, optimiser)``
+    (a batch of ``obs_depth``, ``mask``, ``proprio`` and the teacher's ``action``) for each step;
+    during RL, with ``bc_weight``, the loop sets ``bc_weight_now`` (the decayed weight of the
+    update's behaviour-cloning term) before each env step's updates.
+
     Persistence: ``state_dict()`` / ``load_state_dict(state)`` (the checkpoint's agent, which
     raises :class:`egosearch.rl.common.AgentStateError` on a mismatch); ``actor_state(metadata)``
-    -> the actor file (``format``, ``arch``, ``state_dict``, ``metadata``), whose ``format`` the
-    registry maps to the function that loads its network.
+    -> the actor file (:class:`ActorFile`), whose ``format`` the registry maps to the function that
+    loads its network (:class:`ActorFileNet`).
 
-    Logs: ``num_updates`` (gradient updates so far) and ``alpha`` (SAC's temperature, PPO's
-    entropy weight)."""
+    Logs: ``num_updates`` (gradient updates so far) and ``alpha``, the weight of the entropy term
+    (SAC's temperature, PPO's entropy coefficient): a finite number >= 0, 0 for a learner without
+    one. The loop only logs it."""
 
     recurrent: bool
     """True when ``act_batch`` carries a memory per training env (then ``act`` is the evaluation
     episode's and training envs always act through ``act_batch``)."""
     num_updates: int
+    bc_weight_now: float
 
     @property
     def alpha(self) -> float: ...
@@ -68,6 +95,10 @@ class Agent(Protocol):
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]: ...
 
+    def clone_parameters(self) -> list[torch.nn.Parameter]: ...
+
+    def clone_update(self, batch: dict[str, torch.Tensor], optimiser: torch.optim.Optimizer) -> dict[str, float]: ...
+
     def reset_state(self, env_index: int | None = None) -> None: ...
 
     def reset_policy_state(self) -> None: ...
@@ -76,17 +107,21 @@ class Agent(Protocol):
 
     def load_state_dict(self, state: dict[str, Any]) -> None: ...
 
-    def actor_state(self, metadata: dict[str, Any] | None = None) -> dict[str, Any]: ...
+    def actor_state(self, metadata: dict[str, Any] | None = None) -> ActorFile: ...
 
 
 class AgentBase(ABC):
     """A learner's optional hooks, with the behaviour of a memoryless agent whose replay holds the
-    env's observations as they are. A subclass sets ``cfg`` and ``num_updates`` and defines
-    ``alpha``, ``act``, ``update``, ``state_dict``, ``load_state_dict`` and ``actor_state``."""
+    env's observations as they are and that cannot learn from demonstrations. A subclass sets
+    ``cfg`` and ``num_updates`` and defines ``alpha``, ``act``, ``update``, ``state_dict``,
+    ``load_state_dict`` and ``actor_state``."""
 
     recurrent: ClassVar[bool] = False
-    cfg: LearnerConfig
+    cfg: LearnerSettings
     num_updates: int
+    bc_weight_now: float = 0.0
+    """The behaviour-cloning term's weight at this update, set by the loop; without such a term in
+    ``update``, it is never read."""
 
     @property
     @abstractmethod
@@ -105,7 +140,7 @@ class AgentBase(ABC):
     def load_state_dict(self, state: dict[str, Any]) -> None: ...
 
     @abstractmethod
-    def actor_state(self, metadata: dict[str, Any] | None = None) -> dict[str, Any]: ...
+    def actor_state(self, metadata: dict[str, Any] | None = None) -> ActorFile: ...
 
     def act_batch(self, obs: dict, deterministic: bool = False) -> np.ndarray:
         """Actions (B, A) for a stacked batch: ``act`` on each observation in turn."""
@@ -125,6 +160,18 @@ class AgentBase(ABC):
         """An update's batch: ``batch_size`` transitions drawn uniformly."""
         return replay.sample(self.cfg.batch_size)
 
+    def clone_parameters(self) -> list[torch.nn.Parameter]:
+        """What behaviour cloning trains: nothing here, so it is refused."""
+        raise NotImplementedError(self._no_cloning())
+
+    def clone_update(self, batch: dict[str, torch.Tensor], optimiser: torch.optim.Optimizer) -> dict[str, float]:
+        """A behaviour-cloning step: refused without ``clone_parameters``."""
+        raise NotImplementedError(self._no_cloning())
+
+    def _no_cloning(self) -> str:
+        return (f"{type(self).__name__} does not learn from demonstrations (bc_updates): it defines no "
+                "clone_parameters and clone_update")
+
     def reset_state(self, env_index: int | None = None) -> None:
         """A training env's episode ended: nothing to forget without a memory."""
         return None
@@ -132,3 +179,44 @@ class AgentBase(ABC):
     def reset_policy_state(self) -> None:
         """An evaluation episode starts: nothing to forget without a memory."""
         return None
+
+
+# ---- the actor file ------------------------------------------------------------------------------
+
+class ActorArch(TypedDict):
+    """An actor file's ``arch``: the sizes :class:`egosearch.rl.actor.ActorPolicy` reads, beside
+    whatever else fixes the network's shapes for its loader (any further keys).
+
+    ``action_dim``: the action's size; ``extra_dim``: the size of the vector the network reads
+    beside depth, ``[mask, proprio]``. Read when present: ``mask_dim`` and ``proprio_dim`` (both, to
+    tell apart envs whose sums agree); ``crop_size``, the side of the centre crop of the depth
+    frames the network reads (without it, the whole frame); ``image_size``, the side of the frames
+    it was trained on, which must be the env's (:data:`egosearch.sim.agent.IMAGE_SIZE`)."""
+
+    action_dim: int
+    extra_dim: int
+
+
+class ActorFile(TypedDict):
+    """What ``Agent.actor_state`` returns and ``actor.pt`` holds: tensors and plain python types
+    only, so that ``torch.load(weights_only=True)`` reads it. ``format`` names the loader registered
+    for it (:func:`egosearch.rl.registry.actor_loader`); ``state_dict`` holds the weights;
+    ``metadata`` what the training recorded (variant, env id, config, ...)."""
+
+    format: str
+    arch: ActorArch
+    state_dict: dict[str, Any]
+    metadata: dict[str, Any]
+
+
+@runtime_checkable
+class ActorFileNet(Protocol):
+    """The network an actor file's loader returns (``(state, device) -> ActorFileNet``), as
+    :class:`egosearch.rl.actor.ActorPolicy` drives it: ``net(depth, extra) -> (mu, anything)`` with
+    ``depth`` the K newest frames (1, K, S, S) as floats in [0, 255] (centre-cropped to
+    ``crop_size``) and ``extra`` (1, ``extra_dim``) = ``[mask, proprio]``; ``mu`` (1, ``action_dim``)
+    is the Gaussian mean BEFORE the tanh, which the policy applies. A net with ``recurrent = True``
+    is called ``net(depth, extra, h) -> (mu, anything, new h)`` instead, ``h`` None at an episode's
+    start."""
+
+    def __call__(self, depth: torch.Tensor, extra: torch.Tensor, *state: Any) -> tuple[Any, ...]: ...

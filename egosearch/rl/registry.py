@@ -5,7 +5,8 @@
 is what ``LearnerConfig.validate`` accepts. Adding a learner is one module with its agent class (an
 :class:`egosearch.rl.agent.Agent`, most simply a subclass of :class:`egosearch.rl.agent.AgentBase`)
 and one :func:`register` line below. Agents and loaders may be named ``"module:attribute"``, imported
-on first use: this module imports neither torch nor a learner (:mod:`egosearch.rl.config` imports it).
+on first use: this module imports neither torch nor a learner, nor the config (:mod:`egosearch.rl.config`
+imports it); it types configs as :class:`egosearch.rl.agent.LearnerSettings`.
 """
 
 from __future__ import annotations
@@ -13,11 +14,10 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from egosearch.rl.agent import Agent
-    from egosearch.rl.config import LearnerConfig
+    from egosearch.rl.agent import ActorFileNet, Agent, LearnerSettings
 
 
 def _resolve(ref: str | Callable) -> Callable:
@@ -36,19 +36,20 @@ class Learner:
     ``agent``: its agent class or factory (or ``"module:Class"``), called as
     ``agent(cfg, action_dim, mask_dim, proprio_dim, device=device[, state_dim=state_dim])``;
     ``actor_formats``: the ``format`` of each actor file it writes -> the function
-    ``(state, device) -> nn.Module`` (or ``"module:function"``) that loads that file's network;
+    ``(state, device) -> net`` (or ``"module:function"``) that loads that file's network, an
+    :class:`egosearch.rl.agent.ActorFileNet`;
     ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size)."""
 
     name: str
     display_name: str
     agent: str | Callable[..., Agent]
-    actor_formats: Mapping[str, str | Callable[..., Any]] = field(default_factory=dict)
+    actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] = field(default_factory=dict)
     takes_state_dim: bool = True
 
     def agent_factory(self) -> Callable[..., Agent]:
         return _resolve(self.agent)
 
-    def make(self, cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
+    def make(self, cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
              state_dim: int = 0) -> Agent:
         factory = self.agent_factory()
         if self.takes_state_dim:
@@ -63,7 +64,7 @@ ALGORITHMS = LEARNERS.keys()
 
 
 def register(name: str, display_name: str, agent: str | Callable[..., Agent],
-             actor_formats: Mapping[str, str | Callable[..., Any]] | None = None, *,
+             actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] | None = None, *,
              takes_state_dim: bool = True, replace: bool = False) -> Learner:
     """Register a learner under algorithm ``name`` (see :class:`Learner` for the arguments); a name
     already taken needs ``replace``, and an actor format another learner loads differently is refused."""
@@ -86,20 +87,20 @@ def learner(algorithm: str) -> Learner:
         raise ValueError(f"unknown algorithm {algorithm!r}; registered: {', '.join(LEARNERS)}") from None
 
 
-def make_agent(cfg: LearnerConfig, action_dim: int, mask_dim: int, proprio_dim: int, device,
+def make_agent(cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
                state_dim: int = 0) -> Agent:
     """The agent of the learner ``cfg.algorithm`` names; ``state_dim``: size of the env's privileged
     state (``critic_privileged_state``), for the learners that take it."""
     return learner(cfg.algorithm).make(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
 
 
-def actor_formats() -> dict[str, str | Callable[..., Any]]:
+def actor_formats() -> dict[str, str | Callable[..., ActorFileNet]]:
     """Every registered actor file ``format`` -> the function that loads its network."""
     return {fmt: loader for entry in LEARNERS.values() for fmt, loader in entry.actor_formats.items()}
 
 
-def actor_loader(fmt: str) -> Callable[..., Any] | None:
-    """The function ``(state, device) -> nn.Module`` that loads an actor file of format ``fmt``
+def actor_loader(fmt: str) -> Callable[..., ActorFileNet] | None:
+    """The function ``(state, device) -> ActorFileNet`` that loads an actor file of format ``fmt``
     (None for a format no registered learner writes)."""
     loader = actor_formats().get(fmt)
     return None if loader is None else _resolve(loader)
