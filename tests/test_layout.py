@@ -30,22 +30,15 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _runtime_imports(path: Path) -> list[tuple[str, str, bool]]:
-    """(imported egosearch module, imported name or '', inside a function) of every import that runs:
-    ``if TYPE_CHECKING:`` blocks are left out."""
-    tree = ast.parse(path.read_text())
-    skipped = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If)
-               and getattr(node.test, "id", "") == "TYPE_CHECKING" for n in ast.walk(node)}
-    local = {id(n) for node in ast.walk(tree) if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
-             for n in ast.walk(node)}
+def _imports(source: str) -> list[tuple[str, str]]:
+    """(imported egosearch module, imported name or '') of every import in ``source``, those under
+    ``if TYPE_CHECKING:`` and inside functions included: an annotation's import is an arrow too."""
     out = []
-    for node in ast.walk(tree):
-        if id(node) in skipped:
-            continue
+    for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("egosearch"):
-            out += [(node.module, a.name, id(node) in local) for a in node.names]
+            out += [(node.module, a.name) for a in node.names]
         elif isinstance(node, ast.Import):
-            out += [(a.name, "", id(node) in local) for a in node.names if a.name.startswith("egosearch")]
+            out += [(a.name, "") for a in node.names if a.name.startswith("egosearch")]
     return out
 
 
@@ -72,12 +65,19 @@ def test_the_top_of_the_package_holds_few_modules_and_every_subpackage_says_what
     assert set(LAYERS) >= {p.parent.name for p in PACKAGE.glob("*/__init__.py")} | {"variants"}
 
 
+def test_imports_under_type_checking_and_in_functions_count():
+    source = ("from typing import TYPE_CHECKING\n"
+              "if TYPE_CHECKING:\n    from egosearch.variants import ResolvedVariant\n"
+              "def f():\n    import egosearch.sim.envs\n")
+    assert _imports(source) == [("egosearch.variants", "ResolvedVariant"), ("egosearch.sim.envs", "")]
+
+
 def test_each_stage_imports_only_the_stages_below_it():
     modules = _modules()
     wrong = []
     for name, path in modules.items():
         stage = _stage(name)
-        for imported, item, _ in _runtime_imports(path):
+        for imported, item in _imports(path.read_text()):
             other = _stage(_target(imported, item, modules))
             if other not in (stage, "(root)") and other not in LAYERS[stage]:
                 wrong.append(f"{name} -> {imported}")
@@ -107,7 +107,7 @@ def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 def test_no_import_circles():
     assert find_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
     modules = _modules()
-    graph = {name: {_target(i, n, modules) for i, n, _ in _runtime_imports(path)} & set(modules) - {name}
+    graph = {name: {_target(i, n, modules) for i, n in _imports(path.read_text())} & set(modules) - {name}
              for name, path in modules.items()}
     assert not find_cycles(graph)
 
@@ -115,6 +115,7 @@ def test_no_import_circles():
 def test_no_module_imports_another_modules_private_names():
     modules = _modules()
     private = [f"{name} imports {imported}.{item}" for name, path in modules.items()
-               for imported, item, _ in _runtime_imports(path)
+               for imported, item in _imports(path.read_text())
                if item.startswith("_") and not item.startswith("__") and imported != name]
     assert not private, private
+

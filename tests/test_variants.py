@@ -53,3 +53,13 @@ def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
     got["modular_searcher"] = got["modular_searcher"] or "Modular" in stored["env_id"]
     differ = {k: (got[k], v) for k, v in want.items() if k not in NOT_LEARNING and got[k] != v}
     assert not differ, f"{run}: stored, variant file: {differ}"
+
+
+def test_a_resolved_variant_is_the_training_run_the_gpu_check_reads():
+    """rl/bench.py names what it reads of a resolved variant (TrainingRun) instead of importing the layer above."""
+    from egosearch.rl.bench import TrainingRun
+    from egosearch.variants import resolve_variant
+
+    run = resolve_variant("head_on", "smoke")
+    assert isinstance(run, TrainingRun)
+    assert (run.name, run.env_id, run.train_env["layout"]) == ("head_on", "EgoSearch-v0", "paper_homes")

@@ -36,7 +36,7 @@ import sys
 import tempfile
 import time
 import warnings
-from typing import TYPE_CHECKING
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import torch
@@ -44,7 +44,7 @@ import torch
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit, own_cpu_seconds
 from egosearch.rl.common import resolve_device
-from egosearch.rl.config import DECISIONS, load_config
+from egosearch.rl.config import DECISIONS, LearnerConfig, load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.sac_curl import SacCurlAgent
@@ -53,8 +53,24 @@ from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
 from egosearch.sim.home_pool import curve_homes
 
-if TYPE_CHECKING:  # the CLI resolves the variant: rl/ never imports the variants layer above it
-    from egosearch.variants import ResolvedVariant
+
+@runtime_checkable
+class TrainingRun(Protocol):
+    """What :func:`gpu_check` reads of the training it times: a variant resolved at a learner profile
+    (:class:`egosearch.variants.ResolvedVariant` is one). The CLI resolves it, and rl/ names only what
+    it reads, so that it never imports the variants layer above it."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def config(self) -> LearnerConfig: ...
+
+    @property
+    def env_id(self) -> str: ...
+
+    @property
+    def train_env(self) -> dict: ...
 
 
 def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: int = 0, size: int = 100,
@@ -90,8 +106,7 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
             agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
         else:
             agent = make_agent(cfg, action_dim, 30, 4, device, state_dim)
-        replay = _filled_replay(action_dim, device, size=getattr(agent, "replay_image_size", cfg.image_size),
-                                state_dim=state_dim)
+        replay = _filled_replay(action_dim, device, size=agent.replay_image_size, state_dim=state_dim)
         sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
         for _ in range(warmup):
             agent.update(replay.sample(cfg.batch_size))
@@ -231,8 +246,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
     state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
     agent = (SacCurlAgent(cfg, 5, device="cuda") if cfg.algorithm == "sac_curl"
              else make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim))
-    replay = _filled_replay(5, torch.device("cuda"), size=getattr(agent, "replay_image_size", cfg.image_size),
-                            state_dim=state_dim)
+    replay = _filled_replay(5, torch.device("cuda"), size=agent.replay_image_size, state_dim=state_dim)
     batches = [replay.sample(cfg.batch_size) for _ in range(updates + 6)]
     for batch in batches[:6]:
         agent.update(batch)
@@ -249,7 +263,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
     return round(len(syncs) / updates, 2)
 
 
-def gpu_check(seconds: float, out_dir: str, run: ResolvedVariant, overrides: dict | None = None,
+def gpu_check(seconds: float, out_dir: str, run: TrainingRun, overrides: dict | None = None,
               baseline_seconds: float = 0.0) -> dict:
     """The paper profile on this machine's accelerator: the learner benchmarks, then a real training
     of ``run`` (a variant resolved at the paper profile, :func:`egosearch.variants.resolve_variant`;
@@ -265,17 +279,18 @@ def gpu_check(seconds: float, out_dir: str, run: ResolvedVariant, overrides: dic
     if torch.cuda.is_available():
         result["host_syncs_per_update_table2_graph"] = host_syncs_per_update("paper", overrides={"cuda_graph": True})
     overrides = dict(overrides or {})
-    result["training"] = _timed_training(seconds, out_dir, run, overrides)
+    result["training"] = _timed_training(seconds, out_dir, run, run.config, overrides)
     if baseline_seconds > 0:
-        eager = dataclasses.replace(run, config=dataclasses.replace(run.config, cuda_graph=False).validate())
-        result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"), eager,
+        eager = dataclasses.replace(run.config, cuda_graph=False).validate()
+        result["training_baseline"] = _timed_training(baseline_seconds, os.path.join(out_dir, "baseline"), run, eager,
                                                       {**overrides, "cuda_graph": False})
     return result
 
 
-def _timed_training(seconds: float, out_dir: str, run: ResolvedVariant, overrides: dict) -> dict:
-    """A training of ``run`` for ``seconds``, and its rates read back from its CSVs."""
-    cfg, env_id = run.config, run.env_id
+def _timed_training(seconds: float, out_dir: str, run: TrainingRun, cfg: LearnerConfig, overrides: dict) -> dict:
+    """A training of ``run`` with ``cfg`` (its config, or that config launched eagerly) for ``seconds``, and
+    its rates read back from its CSVs."""
+    env_id = run.env_id
     evaluator = scenario_evaluator(env_id, curve_homes(run.train_env), run.train_env["placement"],
                                    n=cfg.eval_episodes)
     eval_s: list[float] = []
