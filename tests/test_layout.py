@@ -2,11 +2,13 @@
 imports that run one way (no circles, no arrow back up a stage), shared pieces public."""
 
 import ast
+import re
 from pathlib import Path
 
 import egosearch
 
 PACKAGE = Path(egosearch.__file__).resolve().parent
+LAYOUT_MD = PACKAGE.parent / "docs" / "layout.md"
 
 LAYERS = {
     "core": set(),
@@ -119,3 +121,44 @@ def test_no_module_imports_another_modules_private_names():
                if item.startswith("_") and not item.startswith("__") and imported != name]
     assert not private, private
 
+
+def _drawn_tree() -> dict[str, list[str]]:
+    """docs/layout.md's drawing of the package: each top-level row's name ('' for the package's own
+    files) -> the lines drawn under it, itself included."""
+    drawing = LAYOUT_MD.read_text().split("```")[1]
+    sections: dict[str, list[str]] = {}
+    current = ""
+    for line in drawing.splitlines():
+        top = re.match(r"[├└]── (\S+)", line)
+        if top:
+            current = top.group(1).rstrip("/") if top.group(1).endswith("/") else ""
+        sections.setdefault(current, []).append(line)
+    return sections
+
+
+def test_layout_md_draws_every_stage_and_every_module_of_the_stages_it_draws_module_by_module():
+    sections = _drawn_tree()
+    assert set(sections) - {""} == {p.parent.name for p in PACKAGE.glob("*/__init__.py")}
+    for stage, lines in sections.items():
+        folder = PACKAGE / stage
+        named = {name for line in lines for name in re.findall(r"\b(\w+\.(?:py|c))\b", line)}
+        assert all((folder / name).is_file() for name in named), (stage, sorted(n for n in named
+                                                                                 if not (folder / n).is_file()))
+        # a stage drawn module by module (rows of their own under it) names all its modules
+        if stage == "" or any(re.match(r"│   [├└]── ", line) for line in lines):
+            modules = {p.name for p in folder.glob("*.py")} - ({"__init__.py"} if stage else set())
+            assert modules <= named, (stage or "egosearch/", sorted(modules - named))
+
+
+def test_a_packages_docstring_that_lists_its_modules_lists_all_of_them():
+    checked = 0
+    for init in PACKAGE.glob("*/__init__.py"):
+        doc = ast.get_docstring(ast.parse(init.read_text())) or ""
+        if not re.search(r"^- :mod:", doc, re.MULTILINE):
+            continue
+        package = init.parent.name
+        listed = set(re.findall(rf":mod:`~?egosearch\.{package}\.(\w+)`", doc))
+        modules = {p.stem for p in init.parent.glob("*.py")} - {"__init__"}
+        assert listed == modules, (package, "missing:", sorted(modules - listed), "gone:", sorted(listed - modules))
+        checked += 1
+    assert checked >= 2  # rl and motion list theirs

@@ -3,10 +3,13 @@ Imports core/, scene/, sim/ and runs/ (the policy comes in as a callable); impor
 
 - :mod:`~egosearch.motion.mocap`: DeepMimic clips from pybullet_data;
 - :mod:`~egosearch.motion.humanoid` (1.65 m DeepMimic humanoid), :mod:`~egosearch.motion.fetch`;
+  :mod:`~egosearch.motion.skeleton` (the humanoid's URDF in numpy), :mod:`~egosearch.motion.quat`
+  (quaternions in pybullet's order);
 - :mod:`~egosearch.motion.base`: ``FullBodyPose`` and the ``MotionGenerator`` interface;
   :mod:`~egosearch.motion.phase` (``PhaseMG``), :mod:`~egosearch.motion.matching` (``MatchingMG``),
   ``FetchMG``;
 - :mod:`~egosearch.motion.replan`: Algorithm 1, baselines, ``evaluate_fullbody``;
+- :mod:`~egosearch.motion.collision`: ``PenetrationCounter``, the full body's penetration of the home;
 - :mod:`~egosearch.motion.video`: first-person + third-person search videos.
 """
 

@@ -1,5 +1,6 @@
 """The search policy's learners (paper 4.2, Table 2), their training loop and their actor files.
-Imports core/, scene/, sim/ and runs/ (its curve evaluations); imported by variants and the CLI.
+Imports core/, scene/, sim/, searchers/ (the teacher) and runs/ (its curve evaluations); imported by variants
+and the CLI.
 
 - :mod:`egosearch.rl.config`: ``LearnerConfig`` (every Table 2 value and every learner's knobs),
   ``PROFILES`` (smoke / cpu / paper), ``load_config(profile, overrides)``, ``table2_rows(cfg)``;
@@ -7,7 +8,8 @@ Imports core/, scene/, sim/ and runs/ (its curve evaluations); imported by varia
   and the actor file formats they write (``actor_loader``); adding a learner is one module and
   one ``register`` line there;
 - :mod:`egosearch.rl.agent`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,
-  and ``AgentBase``, its optional hooks' defaults;
+  and ``AgentBase``, its optional hooks' defaults; the actor file's contract (``ActorFile``,
+  ``ActorArch``, ``ActorFileNet``);
 - :mod:`egosearch.rl.common`: what every learner builds from (actor head, layers, crops,
   observation tensors, update metrics, actor weights);
 - :mod:`egosearch.rl.base`: what the pooled-depth learners share (``PooledConvEncoder``,
@@ -23,11 +25,17 @@ Imports core/, scene/, sim/ and runs/ (its curve evaluations); imported by varia
   (one ring per env, n-step returns), ``replay_gb``;
 - :mod:`egosearch.rl.train`: ``train(env_id, cfg, out_dir, env_kwargs, evaluate_fn)``
   (resumable; its loop's steps are the methods of ``_Run``);
+- :mod:`egosearch.rl.train_env`: the training envs (``make_train_env``, ``train_env_kwargs``: the
+  variant's env with the config's training aids);
+- :mod:`egosearch.rl.demos`: the frontier searcher's transitions stored as a replay, the demonstrations
+  (``collect_demonstrations``, ``load_demonstrations``);
+- :mod:`egosearch.rl.imitation`: behaviour cloning on them (``clone``) and DAgger rounds
+  (``dagger_round``), before RL;
 - :mod:`egosearch.rl.run_files`: the run's files (atomic writes, CSV logs, checkpoints);
 - :mod:`egosearch.rl.actor`: ``ActorPolicy`` (loads any learner's ``actor.pt``) and ``AgentPolicy``
   (a live agent behind the policy interface);
 - :mod:`egosearch.rl.cuda_graph`: ``GraphedUpdate`` (an update recorded as CUDA graphs);
-- :mod:`egosearch.rl.bench`: ``bench_learner()``.
+- :mod:`egosearch.rl.bench`: ``bench_learner()`` and ``gpu_check()``.
 
 Nothing is imported here, so ``import egosearch.rl`` does not load torch.
 """
