@@ -1,8 +1,10 @@
 """Every variant file in ablations/ loads, and a bad one is one clear line."""
 
+import re
+
 import pytest
 
-from egosearch.variants import VariantError, load_variant, variant_names
+from egosearch.variants import ABLATIONS_DIR, VariantError, load_variant, variant_names
 
 
 @pytest.mark.parametrize("name", variant_names())
@@ -13,6 +15,19 @@ def test_every_ablation_file_loads_and_its_config_validates(name):
     assert variant.name == name
     for profile in ("smoke", "cpu", "paper"):  # `egosearch variant check` checks all three
         load_config(profile, variant.config)
+
+
+@pytest.mark.parametrize("name", variant_names())
+def test_a_pin_holds_a_value_the_cpu_profile_no_longer_has(name):
+    """``# pinned`` marks a config line kept for the variant's stored runs after the cpu profile moved; a pin
+    on the profile's own value changes nothing, and a file of such pins no longer says what it changes."""
+    from egosearch.rl.config import load_config
+
+    cpu = load_config("cpu", {})
+    config = load_variant(name).config
+    pinned = re.findall(r"^  (\w+):[^#\n]*#\s*pinned", (ABLATIONS_DIR / f"{name}.yaml").read_text(), re.MULTILINE)
+    assert all(key in config for key in pinned), pinned
+    assert not [key for key in pinned if getattr(cpu, key) == config[key]], "the cpu profile's own value again"
 
 
 def test_bad_variant_files(tmp_path):
