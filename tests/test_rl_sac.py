@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import io
 
 import numpy as np
@@ -300,7 +301,7 @@ def test_the_configs_forms_of_r_d_are_the_envs():
 
 def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
     """One image size (egosearch.sim.agent.IMAGE_SIZE): the env's frames, the sensor's default, and every
-    profile's image_size; a config that differs is refused in one line when its training makes the env."""
+    profile's image_size; a config that differs is refused in one line when it is loaded or trained."""
     from egosearch.rl.train import train
     from egosearch.sim.agent import IMAGE_SIZE
     from egosearch.sim.env import SearchEnv
@@ -313,10 +314,14 @@ def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
         env.close()
     assert (DEFAULT_WIDTH, DEFAULT_HEIGHT) == (IMAGE_SIZE, IMAGE_SIZE)
     assert {load_config(name, {}).image_size for name in PROFILES} == {LearnerConfig().image_size} == {IMAGE_SIZE}
-    smaller = load_config("smoke", {"image_size": 90, "device": "cpu", "num_envs": 1})
-    with pytest.raises(ValueError, match=r"config expects \(5, 90, 90\) uint8") as err:
-        train("EgoSearch-v0", smaller, tmp_path, env_kwargs={"layout": "kitchen_living"}, progress=False)
+    with pytest.raises(ValueError, match=r"image_size=90 is out of range; allowed: 100 \(the env renders") as err:
+        load_config("smoke", {"image_size": 90})
     assert "\n" not in str(err.value)
+    # a config made around the check (dataclasses.replace skips it) is refused by the training before any work
+    smaller = dataclasses.replace(load_config("smoke", {"device": "cpu", "num_envs": 1}), image_size=90)
+    with pytest.raises(ValueError, match=r"image_size=90 is out of range"):
+        train("EgoSearch-v0", smaller, tmp_path, env_kwargs={"layout": "kitchen_living"}, progress=False)
+    assert not any(tmp_path.iterdir())
 
 
 # the paper's Table 2 (Appendix A), verbatim

@@ -28,6 +28,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from egosearch.rl.registry import ALGORITHMS  # the registered learners' names
+from egosearch.sim.agent import IMAGE_SIZE  # the env's frames: one source
 
 ACTIVATIONS = ("relu", "elu", "leaky_relu", "gelu", "tanh")
 """Activation names the networks understand (Table 2 uses ReLU everywhere)."""
@@ -57,10 +58,10 @@ class LearnerConfig:
     never as a pickled class, so renaming it does not touch stored runs."""
 
     # ---- Table 2: observation and data -------------------------------------------------
-    image_size: int = 100
+    image_size: int = IMAGE_SIZE
     """Table 2 "Image Size" 100x100: side (px) of the depth frames the env renders and the
-    replay buffer stores. It must be the env's, ``egosearch.sim.agent.IMAGE_SIZE`` (every profile's is:
-    ``tests/test_rl_sac.py``); a training whose config differs stops in one line when it makes its env."""
+    replay buffer stores. It must be the env's, ``egosearch.sim.agent.IMAGE_SIZE``: a config that
+    differs is one line when it is loaded (``tests/test_rl_sac.py``)."""
     crop_size: int = 84
     """Table 2 "Augmentation: Random Crop (84x84)": side of the random crop fed to the encoder
     during updates (a centre crop when acting)."""
@@ -467,6 +468,9 @@ class LearnerConfig:
         for name in ("head_history", "init_steps", "seed", "num_threads", "curriculum_steps"):
             if getattr(self, name) < 0:
                 bad(name, "an integer >= 0")
+        if self.image_size != IMAGE_SIZE:
+            bad("image_size", f"{IMAGE_SIZE} (the env renders {IMAGE_SIZE} x {IMAGE_SIZE} frames: "
+                "egosearch.sim.agent.IMAGE_SIZE)")
         for name in ("actor_num_layers", "critic_num_layers"):
             if getattr(self, name) < 2:
                 bad(name, "an integer >= 2 (Linear layers incl. the output layer)")
