@@ -59,6 +59,11 @@ def _resolve(name_or_path: str | Path, directory: Path) -> Path:
     path = Path(name_or_path)
     if path.suffix in (".yaml", ".yml") and path.exists():
         return _shown(path)
+    if path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
+        # a path, not a name: ablations/<path>.yaml is never what was meant
+        problem = ": not a .yaml file" if path.is_file() else " is a folder" if path.is_dir() else ": no such file"
+        raise VariantError(f"{path}{problem}; a variant is a name (a file in {_shown(Path(directory))}) or the path "
+                           "of an existing .yaml file")
     candidate = Path(directory) / f"{name_or_path}.yaml"
     if not candidate.exists():
         raise VariantError(f"variant={str(name_or_path)!r} is unknown; allowed: "
@@ -156,6 +161,10 @@ def _learner_overrides(config: dict, path: Path) -> dict:
     kinds = {f.name: f.type for f in fields(LearnerConfig)}
     out = {}
     for key, value in config.items():
+        if key == "seed":
+            # every run sets it (egosearch train --seed, the DAG's seeds), so a variant's would never be read
+            raise VariantError(f"{path}: config: seed is set per run (`egosearch train --seed`, the profile's seeds in "
+                               "the workflow config), not by a variant: leave it out")
         if key not in kinds:
             close = difflib.get_close_matches(str(key), kinds, n=1)
             hint = f" (did you mean {close[0]}?)" if close else ""
@@ -204,6 +213,9 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
     """Write ``<directory>/<name>.yaml``: a copy of ``template`` with ``name:`` set, ready to edit."""
     if not re.fullmatch(r"[A-Za-z0-9_\-]+", name):
         raise VariantError(f"variant name {name!r}: use letters, digits, '_' and '-' only (it names output folders)")
+    if name in REFERENCE_SEARCHERS:
+        raise VariantError(f"variant name {name!r} is a reference searcher's, whose evaluations sit in the same "
+                           f"folders: name the variant otherwise (taken: {', '.join(REFERENCE_SEARCHERS)})")
     path = _shown(Path(directory) / f"{name}.yaml")
     if path.exists():
         raise VariantError(f"{path} exists already; edit it, or choose another name")
@@ -215,5 +227,10 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
         "# train_env: the training home and placement scheme; config: LearnerConfig fields\n"
         "# (egosearch/rl/config.py) overridden on top of the profile.\n"
         + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
-    load_variant(path)
+    try:
+        load_variant(path)
+    except VariantError:
+        # a refused variant leaves no file: later `allowed:` lists would name it
+        path.unlink()
+        raise
     return path

@@ -82,9 +82,11 @@ BAD_VARIANT_FILES = [
 
 # (--config entries, the one line) of `snakemake -n all`.
 BAD_CONFIGS = [
-    (["variants=[head_on,hed_off]"], "variant='hed_off' is unknown; allowed: {allowed} (files in ablations)"),
-    (["reference_variant=hed_on"], "variant='hed_on' is unknown; allowed: {allowed} (files in ablations)"),
-    (["variant=nope"], "variant='nope' is unknown; allowed: {allowed} (files in ablations)"),
+    (["variants=[head_on,hed_off]"], "config variants: variant='hed_off' is unknown; allowed: {allowed} (files in "
+                                     "ablations)"),
+    (["reference_variant=hed_on"], "config reference_variant: variant='hed_on' is unknown; allowed: {allowed} (files "
+                                   "in ablations)"),
+    (["variant=nope"], "config variant: variant='nope' is unknown; allowed: {allowed} (files in ablations)"),
     (["heights=[7.0]"], "config heights/0: 7.0 is greater than the maximum of 2.0"),
     (["heights=[tall]"], "config heights/0: 'tall' is not of type 'number'"),
     (["profile=fast"], "config profile: 'fast' is not one of ['smoke', 'cpu', 'paper']"),
@@ -153,7 +155,7 @@ def test_a_bad_config_is_one_line_naming_the_key(suite, monkeypatch, capsys, ent
 @pytest.mark.parametrize("pairs, message", [
     ([["head_on", "head_on"]], "config claims_pairs: ['head_on', 'head_on'] is one searcher twice; a pair is [head "
                                "moving, head fixed]"),
-    ([["head_on", "head_of"]], re.compile(r"variant='head_of' is unknown; allowed: .*")),
+    ([["head_on", "head_of"]], re.compile(r"config claims_pairs: variant='head_of' is unknown; allowed: .*")),
     ([["head_on"]], re.compile(r"config claims_pairs/0: \['head_on'\] is too short")),
 ], ids=["one_searcher_twice", "variant_typo", "one_searcher"])
 def test_a_bad_claims_pair_is_one_line(suite, monkeypatch, capsys, pairs, message):
@@ -304,7 +306,7 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["report", "regenerate", "--profile", "fast"],
          "egosearch report: error: --profile='fast'; allowed: smoke, cpu, paper"),
         (["report", "fig6", str(tmp_path / "curve.csv"), "--out-prefix", str(tmp_path / "f6")],
-         f"egosearch report: error: training curve CSV not found: {tmp_path / 'curve.csv'}"),
+         f"egosearch report: error: the input files: {tmp_path / 'curve.csv'} not found"),
     ]
     for argv, message in cases:
         assert cli_error(capsys, *argv) == message, argv
@@ -443,6 +445,9 @@ def test_nonsense_scenarios_are_one_line_before_any_episode(tmp_path, capsys, no
 
 def test_a_variant_compared_with_itself_is_one_line(tmp_path, capsys, suite, monkeypatch):
     files = [str(tmp_path / "eval/head_on/seed0/kitchen_living/everywhere" / f"h{h}.csv") for h in ("0.45", "1.05")]
+    Path(files[0]).parent.mkdir(parents=True)
+    for file in files:
+        shutil.copy2(REPO / "results/cpu" / Path(file).relative_to(tmp_path), file)
     assert cli_error(capsys, "report", "compare", "--reference", *files, "--candidate", *files, "--out",
                      str(tmp_path / "c.csv")) == (
         f"egosearch report: error: {files[0]} is both a reference and a candidate file (1 more file(s) too): "
@@ -758,6 +763,217 @@ NEW_CASES = [
      f"egosearch report: error: the input files: {EMPTY_EVAL} is empty; a CSV file has a header line and rows"),
 ]
 
+# --------------------------------------------------------------------------- issue 48: a newcomer's round
+# The same form as issue 35's table, with one more kind before the fix: damage (a stored or input file
+# changed or left behind). The rows of the issue first (item 1), then the 30 new bad inputs of item 4,
+# tried in the estimate, the searchers' env options, the variant files' new fields and the commands above.
+BEFORE_KINDS_48 = ("clear", "cryptic", "traceback", "silent", "damage")
+RECORD = ("a provenance record is the JSON file `egosearch report provenance` writes "
+          "(results/<profile>/provenance.json)")
+BENCH = "a learner benchmark record is the JSON file `egosearch bench learner --out` writes"
+SNAKEMAKE_LOG = "a Snakemake log is .snakemake/log/<date>.snakemake.log"
+NOT_A_VARIANT = "a variant is a name (a file in ablations) or the path of an existing .yaml file"
+
+ISSUE48_CASES = [
+    ("estimate_check_record_not_json", "cryptic",
+     ["estimate", "check", "--log", "{t}/cpu.log", "--record", "{t}/notjson.json"],
+     "egosearch estimate: error: --record: {t}/notjson.json is not JSON (Expecting property name enclosed in double "
+     f"quotes at line 1); {RECORD}"),
+    ("estimate_all_bench_not_json", "cryptic", ["estimate", "all", "--from-bench", "--bench", "{t}/notjson.json"],
+     "egosearch estimate: error: --bench: {t}/notjson.json is not JSON (Expecting property name enclosed in double "
+     f"quotes at line 1); {BENCH}"),
+    ("estimate_check_a_csv_as_log_and_record", "cryptic",
+     ["estimate", "check", "--log", S3, "--record", S3],
+     "egosearch estimate: error: --log: {t}/s3.csv: no finished job in it (a Snakemake run's log, "
+     ".snakemake/log/*.snakemake.log, of a run that ran jobs)"),
+    ("estimate_check_record_a_list", "traceback", ["estimate", "check", "--log", "{t}/cpu.log", "--record",
+                                                   "{t}/list.json"],
+     f"egosearch estimate: error: --record: {{t}}/list.json holds a JSON list, not an object; {RECORD}"),
+    ("estimate_all_bench_a_list", "traceback", ["estimate", "all", "--bench", "{t}/list.json", "--rate", "19"],
+     f"egosearch estimate: error: --bench: {{t}}/list.json holds a JSON list, not an object; {BENCH}"),
+    ("estimate_check_no_such_target", "traceback",
+     ["estimate", "check", "--log", "{t}/cpu.log", "--target", "no_such_rule"],
+     "egosearch estimate: error: --target='no_such_rule' is not a rule of the workflow; the run's target, e.g. all, "
+     "table1 or screen (`snakemake --list-target-rules` lists them)"),
+    ("estimate_check_smoke_log_against_the_cpu_record", "silent", ["estimate", "check", "--log", "{t}/smoke.log"],
+     "egosearch estimate: error: results/smoke/provenance.json not found: the jobs of {t}/smoke.log ran at the smoke "
+     "profile, and the check judges them against that profile's recorded job times: give --record, a record of the "
+     "smoke profile"),
+    ("estimate_check_profile_ignored", "silent", ["estimate", "check", "--log", "{t}/cpu.log", "--profile", "paper"],
+     "egosearch estimate: error: --profile=paper: the jobs of {t}/cpu.log ran at the cpu profile (their paths say "
+     "so): leave --profile out, or give the log of a paper run"),
+    ("evaluate_head_off_floor_in_a_head_on_env", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "modular_random_head_off", "--env-id", "EgoSearch-v0", "--out",
+      "{t}/o.csv"],
+     "egosearch evaluate: error: --env-id=EgoSearch-v0 moves the head, and --policy modular_random_head_off is the "
+     "searcher with the head fixed: its rows would be read under that name; leave --env-id out, or use --policy "
+     "modular_random"),
+    ("variant_new_named_as_a_reference_searcher", "silent", ["variant", "new", "frontier"],
+     "egosearch variant: error: variant name 'frontier' is a reference searcher's, whose evaluations sit in the same "
+     "folders: name the variant otherwise (taken: random, oracle, frontier, frontier_head_off, modular_random, "
+     "modular_random_head_off)"),
+    ("variant_check_a_missing_path", "cryptic", ["variant", "check", "{t}/missing.yaml"],
+     f"egosearch variant: error: {{t}}/missing.yaml: no such file; {NOT_A_VARIANT}"),
+    ("train_seed_beyond_32_bits", "cryptic",
+     ["train", "--variant", "head_on", "--seed", "99999999999999999999", "--out-dir", "{t}/run2"],
+     "egosearch train: error: --seed=99999999999999999999: a seed must be at most 2**32 - 1 = 4294967295 (numpy's "
+     "global seed is 32-bit)"),
+    ("compare_a_file_with_its_copy", "silent",
+     ["report", "compare", "--reference", ev("head_on"), "--candidate",
+      "{t}/copy/cand/seed0/kitchen_living/everywhere/h1.05.csv"],
+     "egosearch report: error: --candidate: {t}/copy/cand/seed0/kitchen_living/everywhere/h1.05.csv has the same "
+     f"content as the reference's {ev('head_on')} (a copy?): every difference would be 0; compare two different "
+     "variants, or pass --force when they did give the same episodes"),
+    ("compare_missing_reference", "cryptic", ["report", "compare", "--reference", "{t}/missing.csv", "--candidate",
+                                              ev("head_off")],
+     "egosearch report: error: --reference: {t}/missing.csv not found"),
+    ("fresh_missing_stored", "cryptic", ["report", "fresh", "--stored", "{t}/missing.csv", "--fresh",
+                                         "{t}/fresh/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+                                         "--out-prefix", "{t}/f"],
+     "egosearch report: error: --stored: {t}/missing.csv not found"),
+    ("bench_env_seconds_zero", "silent", ["bench", "env", "--seconds", "0"],
+     "egosearch bench: error: --seconds is read by `bench gpu` only, not by `bench env`"),
+    ("estimate_all_cores_100000", "silent", ["estimate", "all", "--cores", "100000"],
+     re.compile(r"egosearch estimate: error: --cores=100000: at most 1024, the cores of one machine snakemake "
+                r"schedules on \(this one has \d+\)")),
+]
+
+NEW48_CASES = [
+    ("estimate_check_log_a_folder", "traceback", ["estimate", "check", "--log", "{t}/eval"],
+     f"egosearch estimate: error: --log: {{t}}/eval is a folder; {SNAKEMAKE_LOG}"),
+    ("estimate_check_log_missing", "cryptic", ["estimate", "check", "--log", "{t}/missing.log"],
+     f"egosearch estimate: error: --log: {{t}}/missing.log not found; {SNAKEMAKE_LOG}"),
+    ("estimate_check_record_of_another_profile", "silent",
+     ["estimate", "check", "--log", "{t}/cpu.log", "--record", "{t}/smoke_record.json"],
+     "egosearch estimate: error: --record: {t}/smoke_record.json holds the smoke profile's job times, but the jobs of "
+     "{t}/cpu.log ran at the cpu profile: give a record of the cpu profile"),
+    ("estimate_check_record_jobs_not_a_list", "traceback",
+     ["estimate", "check", "--log", "{t}/cpu.log", "--record", "{t}/nojobs.json"],
+     "egosearch estimate: error: --record: {t}/nojobs.json holds no list of jobs with their rule and job ('jobs'); "
+     + RECORD),
+    ("estimate_all_bench_result_not_an_object", "traceback",
+     ["estimate", "all", "--bench", "{t}/badbench.json", "--rate", "5"],
+     "egosearch estimate: error: --bench: {t}/badbench.json holds no benchmark result ('result' and 'machine' must "
+     f"be objects); {BENCH}"),
+    ("estimate_all_rate_infinite", "silent", ["estimate", "all", "--rate", "inf"],
+     "egosearch estimate: error: --rate=inf: env steps per CPU-second must be a positive, finite number"),
+    ("estimate_all_profile_without_a_run", "silent", ["estimate", "all", "--profile", "paper", "--rate", "50"],
+     "egosearch estimate: error: results/paper/provenance.json records no job's time: the paper profile has no "
+     "stored run to scale (--profile cpu has one)"),
+    ("estimate_check_rate_zero", "silent", ["estimate", "check", "--log", "{t}/cpu.log", "--rate", "0"],
+     "egosearch estimate: error: --rate is read by `estimate all` only, not by `estimate check`"),
+    ("bench_learner_baseline_seconds_zero", "silent", ["bench", "learner", "--baseline-seconds", "0"],
+     "egosearch bench: error: --baseline-seconds is read by `bench gpu` only, not by `bench learner`"),
+    ("evaluate_frontier_in_a_head_off_env", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "frontier", "--env-id", "EgoSearchNoHead-v0", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: --env-id=EgoSearchNoHead-v0 fixes the head, and --policy frontier is the searcher "
+     "with the head moving: its rows would be read under that name; leave --env-id out, or use --policy "
+     "frontier_head_off"),
+    ("evaluate_frontier_head_off_in_a_head_on_memory_env", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "frontier_head_off", "--env-id", "EgoSearchMemory-v0", "--out",
+      "{t}/o.csv"],
+     "egosearch evaluate: error: --env-id=EgoSearchMemory-v0 moves the head, and --policy frontier_head_off is the "
+     "searcher with the head fixed: its rows would be read under that name; leave --env-id out, or use --policy "
+     "frontier"),
+    ("evaluate_oracle_in_a_decision_env", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "oracle", "--env-id", "EgoSearchModular-v0", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: --env-id=EgoSearchModular-v0 takes a modular searcher's decisions, and --policy "
+     "oracle acts at every body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out"),
+    ("evaluate_modular_floor_in_a_head_off_map_env", "silent",
+     ["evaluate", "--scenarios", S3, "--policy", "modular_random", "--env-id", "EgoSearchNoHeadMap-v0", "--out",
+      "{t}/o.csv"],
+     "egosearch evaluate: error: --env-id=EgoSearchNoHeadMap-v0 fixes the head, and --policy modular_random is the "
+     "searcher with the head moving: its rows would be read under that name; leave --env-id out, or use --policy "
+     "modular_random_head_off"),
+    ("evaluate_a_modular_actor_in_a_head_off_env", "clear",
+     ["evaluate", "--scenarios", "{t}/missing.csv", "--weights", "results/cpu/train/head_on/seed0/actor.pt",
+      "--env-id", "EgoSearchNoHead-v0", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: results/cpu/train/head_on/seed0/actor.pt: this actor was trained in "
+     "EgoSearchModular-v0 (4 action values, 466 observation values besides depth), not in EgoSearchNoHead-v0 (3 and "
+     "34): run it in EgoSearchModular-v0"),
+    ("demos_of_a_modular_variant", "cryptic",
+     ["demos", "--variant", "head_on", "--episodes", "1", "--out", "{t}/d.replay.npz"],
+     "egosearch demos: error: --variant=head_on at the cpu profile is a modular searcher (its env step is a decision, "
+     "not a body step): demonstrations are the frontier searcher's body steps, which it cannot learn from; give a "
+     "variant that acts at every body step (e.g. head_on_from_scratch)"),
+    ("scenarios_layout_and_homes", "silent",
+     ["scenarios", "--layout", "studio", "--homes", "0:2", "--n", "1", "--out", "{t}/s.csv"],
+     "egosearch scenarios: error: --layout=studio and --homes=0:2 both name the homes: give one"),
+    ("variant_config_sets_the_seed", "silent", ["variant", "check", "{t}/seed_in.yaml"],
+     "egosearch variant: error: {t}/seed_in.yaml: config: seed is set per run (`egosearch train --seed`, the "
+     "profile's seeds in the workflow config), not by a variant: leave it out"),
+    ("variant_objects_empty", "silent", ["variant", "check", "{t}/objects_empty.yaml"],
+     "egosearch variant: error: {t}/objects_empty.yaml: train_env/objects: [] should be non-empty"),
+    ("variant_check_a_folder", "cryptic", ["variant", "check", "{t}/eval"],
+     f"egosearch variant: error: {{t}}/eval is a folder; {NOT_A_VARIANT}"),
+    ("variant_new_from_a_missing_file", "cryptic", ["variant", "new", "tmp_bad_input_x", "--from", "{t}/missing.yaml"],
+     f"egosearch variant: error: --from: {{t}}/missing.yaml: no such file; {NOT_A_VARIANT}"),
+    ("report_readme_missing_page", "cryptic", ["report", "readme", "--readme", "{t}/missing.md", "--check"],
+     "egosearch report: error: --readme: {t}/missing.md not found; a page of marked blocks (README.md, docs/*.md)"),
+    ("report_regenerate_unknown_variant", "cryptic", ["report", "regenerate", "--variant", "nope"],
+     f"egosearch report: error: --variant: variant='nope' is unknown; allowed: {ALLOWED} (files in ablations)"),
+    ("pathlength_missing_scenarios", "cryptic",
+     ["report", "pathlength", ev("head_on"), "--scenarios", "{t}/missing.csv", "--out-prefix", "{t}/p"],
+     "egosearch report: error: --scenarios: {t}/missing.csv not found"),
+    ("behaviour_missing_traces", "cryptic",
+     ["report", "behaviour", "{t}/missing.npz", TRACES[1], "--out-prefix", "{t}/b"],
+     "egosearch report: error: the input files: {t}/missing.npz not found"),
+    ("fresh_a_copy_as_the_fresh_set", "silent",
+     ["report", "fresh", "--stored", ev("head_on"), "--fresh",
+      "{t}/copy/cand/seed0/kitchen_living/everywhere/h1.05.csv", "--out-prefix", "{t}/f"],
+     "egosearch report: error: --fresh: {t}/copy/cand/seed0/kitchen_living/everywhere/h1.05.csv has the same content "
+     f"as the --stored {ev('head_on')} (a copy?): the check reads evaluations on two different scenario sets; pass "
+     "--force when they did give the same episodes"),
+    ("a_report_typed_as_a_command", "cryptic", ["behaviour"],
+     "egosearch: error: 'behaviour' is not a command; it is `egosearch report behaviour`, or the workflow's target "
+     "`snakemake --cores 2 behaviour`"),
+    ("a_command_typed_as_a_report", "cryptic", ["report", "estimate"],
+     "egosearch: error: 'estimate' is not a report; it is `egosearch estimate`"),
+    ("a_report_misspelt", "clear", ["report", "tabel1"],
+     "egosearch: error: 'tabel1' is not a report; did you mean `egosearch report table1`?"),
+]
+
+# The workflow's config (the Snakefile's first check): (id, before, --config changes, target, the one line).
+ISSUE48_CONFIGS = [
+    ("screen_reference_variant_a_searcher", "cryptic", {"variant": "head_off", "reference_variant": "frontier"},
+     "screen", "config reference_variant: 'frontier' is a reference searcher, not a variant (a file in ablations/, "
+               "e.g. head_on)"),
+    ("screen_reference_variant_unknown", "cryptic", {"variant": "head_off", "reference_variant": "nosuch"}, "screen",
+     "config reference_variant: variant='nosuch' is unknown; allowed: {allowed} (files in ablations)"),
+]
+NEW48_CONFIGS = [
+    ("compare_variant_a_searcher", "cryptic", {"variant": "oracle"}, "compare",
+     "config variant: 'oracle' is a reference searcher, not a variant (a file in ablations/, e.g. head_on)"),
+    ("claims_pair_with_the_random_searcher", "cryptic", {"claims_pairs": [["head_on", "random"]]}, "behaviour",
+     "config claims_pairs: 'random' is a reference searcher, not a variant (a file in ablations/, e.g. head_on)"),
+]
+COUNTS_BEFORE_48 = {"issue": {"clear": 0, "cryptic": 9, "traceback": 3, "silent": 7, "damage": 0},
+                    "new": {"clear": 2, "cryptic": 12, "traceback": 3, "silent": 13, "damage": 0}}
+"""What each table's inputs did before the fix (the issue's 19 rows; the 30 new ones). After it, every one
+is one clear line before any work (the tests below)."""
+
+
+def test_issue_48s_counts_before_and_after():
+    for table, cases in (("issue", ISSUE48_CASES + ISSUE48_CONFIGS), ("new", NEW48_CASES + NEW48_CONFIGS)):
+        before = dict.fromkeys(BEFORE_KINDS_48, 0)
+        for case in cases:
+            before[case[1]] += 1
+        assert before == COUNTS_BEFORE_48[table], table
+    assert len(ISSUE48_CASES + ISSUE48_CONFIGS) == 19 and len(NEW48_CASES + NEW48_CONFIGS) == 30
+    names = [c[0] for c in ISSUE_CASES + NEW_CASES + ISSUE48_CASES + NEW48_CASES + ISSUE48_CONFIGS + NEW48_CONFIGS]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("case", ISSUE48_CONFIGS + NEW48_CONFIGS, ids=[c[0] for c in ISSUE48_CONFIGS + NEW48_CONFIGS])
+def test_a_config_naming_no_variant_names_its_key(case, suite, monkeypatch, capsys):
+    _, _, changes, target, message = case
+    monkeypatch.chdir(suite)
+    with pytest.raises(SystemExit) as stop:
+        checked_variants(config(**changes), argv=[target], directory=suite / "ablations")
+    allowed = ", ".join(variant_names(suite / "ablations"))
+    assert stop.value.code == 1 and capsys.readouterr().err == f"egosearch: error: {message.format(allowed=allowed)}\n"
+
+
 # Every case of the bad-input tables, the README's: the ones above and the older tables (all one
 # clear line before this issue: their tests passed).
 OLDER_CASES = 17 + 11 + 18 + 13 + 3  # BAD_VARIANT_FILES, BAD_CONFIGS, the CLI, output paths, nonsense scenarios
@@ -844,6 +1060,24 @@ def bad(tmp_path_factory):
             "env_id": resolved.env_id, "env_kwargs": env_kwargs_key(resolved.train_env),
             "config": resolved.config.to_dict()}
     write("run/done.json", json.dumps(done).encode())
+    # issue 48: JSON records that are not what they claim, Snakemake logs of a cpu and a smoke run, a copy
+    write("notjson.json", b"{bad")
+    write("list.json", b"[1, 2]")
+    write("nojobs.json", b'{"jobs": 5}')
+    write("badbench.json", b'{"result": [1]}')
+    write("smoke_record.json", json.dumps({"profile": "smoke", "jobs": [{"rule": "train", "job": "my_lr/seed0",
+                                                                           "wall_s": 60.0}]}).encode())
+    for profile, variant in (("cpu", "head_on"), ("smoke", "my_lr")):
+        write(f"{profile}.log", "\n".join([
+            "Provided cores: 2", "[Fri Nov 27 08:00:00 2026]", "localrule train:", "    jobid: 3",
+            f"    benchmark: results/{profile}/benchmarks/train/{variant}/seed0.tsv",
+            f"    wildcards: profile={profile}, variant={variant}, seed=0", "[Fri Nov 27 08:01:00 2026]",
+            "Finished jobid: 3 (Rule: train)", ""]).encode())
+    copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
+         "copy/cand/seed0/kitchen_living/everywhere/h1.05.csv")
+    write("seed_in.yaml", (HEAD.replace("NAME", "seed_in") + "config: {seed: 5}\n").encode())
+    write("objects_empty.yaml", HEAD.replace("NAME", "objects_empty").replace("everywhere}", "everywhere, objects: []}")
+          .encode())
     # the same scenario ids with other ℓ: another scenario set of the same names
     ref = copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
                "cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv")
@@ -868,6 +1102,8 @@ def nothing_runs(monkeypatch):
     """Any episode, training step, scenario draw, benchmark or picture fails the test: each bad input
     must be refused before it."""
     import egosearch.cli.bench
+    import egosearch.cli.demos
+    import egosearch.cli.estimate
     import egosearch.cli.evaluate
     import egosearch.cli.fullbody
     import egosearch.cli.pictures
@@ -882,7 +1118,8 @@ def nothing_runs(monkeypatch):
                          (egosearch.cli.video, "write_search_video"), (egosearch.cli.scenarios, "generate_scenarios"),
                          (egosearch.cli.bench, "gpu_check"), (egosearch.cli.bench, "bench_learner"),
                          (egosearch.cli.bench.bench, "bench_env"), (egosearch.cli.pictures, "make_pictures"),
-                         (egosearch.rl.train, "_train")):
+                         (egosearch.rl.train, "_train"), (egosearch.cli.estimate, "dag_jobs"),
+                         (egosearch.cli.estimate, "calibrate"), (egosearch.cli.demos, "collect_demonstrations")):
         monkeypatch.setattr(module, name, work)
 
 
@@ -893,22 +1130,27 @@ def _filled(value, t: Path):
     return value.replace("{t}", str(t)).replace("{torch}", f"{torch.__version__} ({built})")
 
 
-@pytest.mark.parametrize("case", ISSUE_CASES + NEW_CASES, ids=[c[0] for c in ISSUE_CASES + NEW_CASES])
+CLI_CASES = ISSUE_CASES + NEW_CASES + ISSUE48_CASES + NEW48_CASES
+
+
+@pytest.mark.parametrize("case", CLI_CASES, ids=[c[0] for c in CLI_CASES])
 def test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs):
     name, _, argv, expected = case
     if "cuda" in name and torch.cuda.is_available():
         pytest.skip("this machine has CUDA: bench gpu runs")
     monkeypatch.chdir(REPO)  # the stored results are the checkout's
     before = sorted(p.relative_to(bad) for p in bad.rglob("*"))
+    variants_before = variant_names(REPO / "ablations")
     line = cli_error(capsys, *[_filled(arg, bad) for arg in argv])
     expected = _filled(expected, bad)
     if isinstance(expected, re.Pattern):
         assert expected.fullmatch(line), line
     else:
         assert line == expected
-    # nothing written, not even a temporary file or an empty folder
+    # nothing written, not even a temporary file or an empty folder, nor a variant file left behind
     assert sorted(p.relative_to(bad) for p in bad.rglob("*")) == before
     assert not (REPO / "ablations" / "tmp_bad_input_x.yaml").exists()
+    assert variant_names(REPO / "ablations") == variants_before
 
 
 def test_the_overwrite_guard_without_git_reads_the_provenance(tmp_path, monkeypatch):

@@ -14,7 +14,15 @@ from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
-from egosearch.sim.envs import BODY_ENV_IDS, MODULAR_FLOORS, REFERENCE_SEARCHERS, modular_decision_dim
+from egosearch.sim.envs import (
+    ALL_ENV_IDS,
+    BODY_ENV_IDS,
+    ENV_IDS,
+    MODULAR_ENV_IDS,
+    MODULAR_FLOORS,
+    REFERENCE_SEARCHERS,
+    modular_decision_dim,
+)
 
 
 def set_acting_threads(threads: int) -> None:
@@ -43,6 +51,7 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         # the oracle, random and frontier searchers would run and the weights be ignored without a word
         raise ValueError(f"--weights={weights} is only read with --policy actor, not --policy {kind}: drop one of "
                          "them")
+    check_searcher_env(kind, env_id)
     if kind == "oracle":
         return OraclePolicy, env_id or "EgoSearch-v0"
     if kind == "random":
@@ -74,6 +83,28 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         return (lambda env: actor), env_id
     raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, "
                      f"{', '.join(MODULAR_RANDOM)}, actor")
+
+
+HEAD_OF_SEARCHER = {"frontier": True, "frontier_head_off": False, "modular_random": True,
+                    "modular_random_head_off": False}
+"""Whether each reference searcher that is named by its head moves the head (the env decides it)."""
+
+
+def check_searcher_env(kind: str, env_id: str | None) -> None:
+    """A reference searcher named by its head runs in an env of that head, and every reference searcher
+    acts at the body's steps: in another env it would search otherwise than its name says, and its rows
+    would be read under that name (a head-off searcher's with a moving head)."""
+    if env_id is None or kind not in REFERENCE_SEARCHERS or env_id not in ALL_ENV_IDS:
+        return
+    if env_id in MODULAR_ENV_IDS:
+        raise ValueError(f"--env-id={env_id} takes a modular searcher's decisions, and --policy {kind} acts at every "
+                         "body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out")
+    wanted, head = HEAD_OF_SEARCHER.get(kind), ENV_IDS[env_id]["head"]
+    if wanted is not None and wanted != head:
+        other = kind.removesuffix("_head_off") if not wanted else f"{kind}_head_off"
+        raise ValueError(f"--env-id={env_id} {'moves' if head else 'fixes'} the head, and --policy {kind} is the "
+                         f"searcher with the head {'moving' if wanted else 'fixed'}: its rows would be read under "
+                         f"that name; leave --env-id out, or use --policy {other}")
 
 
 STORED_PROFILE = "cpu"

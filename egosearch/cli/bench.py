@@ -32,7 +32,9 @@ def run(args) -> None:
     check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
     check_overwrites(files={"--out": args.out}, dirs={"--out-dir": args.out_dir}, force=args.force)
     for name, what in READ_BY.items():
-        if getattr(args, name) not in (None, False) and args.what != what:
+        # `is not`: 0 equals False, so `--seconds 0` would pass for an option not given
+        given = getattr(args, name) is not None and getattr(args, name) is not False
+        if given and args.what != what:
             # an option the benchmark never reads would leave a record that seems to say it was used
             raise ValueError(f"--{name.replace('_', '-')} is read by `bench {what}` only, not by `bench {args.what}`")
     for name, value in DEFAULTS.items():

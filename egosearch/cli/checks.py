@@ -5,6 +5,7 @@ that the report commands, which never load torch, can use them too."""
 from __future__ import annotations
 
 import codecs
+import json
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -26,9 +27,18 @@ def at_least(option: str, value: int | float | None, low: int | float, meaning: 
         raise ValueError(f"{option}={_num(value)}: {meaning} must be >= {_num(low)}")
 
 
-def check_seed(option: str, seed: int | None) -> None:
-    # gymnasium and numpy refuse a negative seed only once an episode or a draw starts
+MAX_SEED = 2**32 - 1
+"""The largest seed numpy's legacy seeding (``np.random.seed``, which a training calls) takes."""
+
+
+def check_seed(option: str, seed: int | None, numpy_legacy: bool = False) -> None:
+    """``seed >= 0``, and with ``numpy_legacy`` (a command whose run seeds numpy's global generator, as a
+    training does) at most :data:`MAX_SEED`: either is refused only once the run starts, with a message
+    that names no option."""
     at_least(option, seed, 0, "a seed")
+    if numpy_legacy and seed is not None and seed > MAX_SEED:
+        raise ValueError(f"{option}={seed}: a seed must be at most 2**32 - 1 = {MAX_SEED} (numpy's global seed is "
+                         "32-bit)")
 
 
 def check_suffix(option: str, path: PathLike | None, allowed: tuple[str, ...], what: str) -> None:
@@ -61,6 +71,29 @@ def check_text_files(option: str, paths: Iterable[PathLike | None], what: str = 
                     raise ValueError(f"{option}: {path} is not a text {what} file (byte {offset + err.start} is "
                                      "not UTF-8)") from None
                 offset += len(block)
+
+
+def read_json_object(option: str, path: PathLike, what: str) -> dict:
+    """The JSON object in ``path``, the file ``option`` names; ``what`` says what such a file is and
+    what writes it. The json module's own message names neither the file nor the option ("Expecting
+    property name enclosed in double quotes"), and a list or a number read as a record fails later with
+    an AttributeError."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{option}: {path} is a folder; {what}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{option}: {path} not found; {what}") from None
+    except UnicodeDecodeError as err:
+        raise ValueError(f"{option}: {path} is not a text file (byte {err.start} is not UTF-8); {what}") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{option}: {path} is not JSON ({err.msg} at line {err.lineno}); {what}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{option}: {path} holds a JSON {type(data).__name__}, not an object; {what}")
+    return data
 
 
 def check_npz_files(option: str, paths: Iterable[PathLike]) -> None:

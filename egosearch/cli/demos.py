@@ -17,6 +17,13 @@ def run(args) -> None:
     at_least("--episodes", args.episodes, 1, "a number of episodes")
     check_seed("--seed", args.seed)
     resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed})
+    if resolved.config.modular_searcher:
+        # its training could not read them (demo_episodes must be 0 there), and collecting them fails
+        # half-way with numpy's reshape error: a decision is not a body step
+        raise ValueError(f"--variant={args.variant} at the {args.profile} profile is a modular searcher (its env step "
+                         "is a decision, not a body step): demonstrations are the frontier searcher's body steps, "
+                         "which it cannot learn from; give a variant that acts at every body step (e.g. "
+                         "head_on_from_scratch)")
     summary = collect_demonstrations(resolved.env_id, resolved.config, resolved.train_env, args.episodes, args.out,
                                      seed=args.seed)
     print(json.dumps(summary))

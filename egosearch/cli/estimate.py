@@ -13,18 +13,30 @@ at the record's times and at their own, beside the run's elapsed time (:func:`sc
 
 from __future__ import annotations
 
+import contextlib
+import difflib
+import io
 import json
 import math
 import os
 import statistics
 import sys
+import time
 from dataclasses import replace
 from pathlib import Path
 
-from egosearch.core.machine import cpu_model, cpu_vector_unit, measured_on, with_machine
+from egosearch.cli.checks import read_json_object
+from egosearch.core.machine import (
+    cpu_model,
+    cpu_seconds_all,
+    cpu_vector_unit,
+    measured_on,
+    own_cpu_seconds,
+    with_machine,
+)
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.report.data import counts_decisions
-from egosearch.report.run_log import dag_id, read_run_log
+from egosearch.report.run_log import RunLog, dag_id, read_run_log
 from egosearch.report.schedule import (
     TRAIN,
     durations_from_provenance,
@@ -35,7 +47,7 @@ from egosearch.report.schedule import (
 )
 from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
 from egosearch.rl.config import BODY_STEPS, DECISIONS, load_config
-from egosearch.workflow.dag import dag_jobs
+from egosearch.workflow.dag import dag_jobs, rule_names
 
 CALIBRATION_CACHE = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "egosearch" / "learner_rate.json"
 """This machine's last calibration, so that ``snakemake all`` can print the estimate without a minute's wait."""
@@ -45,34 +57,67 @@ CHECK_ONLY = {"log": "--log", "record": "--record", "target": "--target"}
 """Options that ``estimate check`` reads and ``estimate all`` does not (and the reverse below)."""
 ALL_ONLY = {"rate": "--rate", "from_bench": "--from-bench", "bench": "--bench"}
 
+MAX_CORES = 1024
+"""Most cores an estimate is made for: snakemake's ``--cores`` on one machine (the DAG has a few hundred
+jobs; a larger figure is a typo, and the estimate would be the DAG's longest chain without a word)."""
+RECORD_FILE = ("a provenance record is the JSON file `egosearch report provenance` writes "
+               "(results/<profile>/provenance.json)")
+BENCH_FILE = "a learner benchmark record is the JSON file `egosearch bench learner --out` writes"
+BUSY_CORES = 0.25
+"""Other processes' CPU use during a calibration (cores) above which the estimate says it was measured on
+a busy machine: the calibration counts this process's CPU time, but shared caches and memory slow it."""
+
 
 def run(args) -> None:
     args.out = with_machine(args.out)
     if args.cores < 1:
         raise ValueError(f"--cores={args.cores}: the estimate needs at least 1 core")
+    if args.cores > MAX_CORES:
+        raise ValueError(f"--cores={args.cores}: at most {MAX_CORES}, the cores of one machine snakemake schedules "
+                         f"on (this one has {os.cpu_count()})")
     unread = ALL_ONLY if args.what == "check" else CHECK_ONLY
     for name, flag in unread.items():
-        if getattr(args, name) not in (None, False):
+        # `is not`: 0 equals False, so `--rate 0` would pass for an option not given
+        if getattr(args, name) is not None and getattr(args, name) is not False:
             # an option the command never reads would leave a record that seems to say it was used
             raise ValueError(f"{flag} is read by `estimate {'all' if args.what == 'check' else 'check'}` only, not "
                              f"by `estimate {args.what}`")
     if args.what == "check" and not args.log:
         raise ValueError("estimate check needs --log: a finished run's .snakemake/log/<date>.snakemake.log")
-    if args.rate is not None and not args.rate > 0:
-        raise ValueError(f"--rate={args.rate}: env steps per CPU-second must be a positive number")
+    if args.rate is not None and not (args.rate > 0 and math.isfinite(args.rate)):
+        raise ValueError(f"--rate={args.rate}: env steps per CPU-second must be a positive, finite number")
     if args.rate is not None and args.from_bench:
         raise ValueError("--rate and --from-bench both name the rate: give one")
     check_outputs(files={"--out": args.out})
     check_overwrites(files={"--out": args.out}, inputs={"--bench": args.bench, "--log": args.log,
                                                         "--record": args.record}, force=args.force)
-    results = Path("results") / args.profile
+    if args.what == "check":
+        check_target(args.target)
+        run_log = read_log(args.log)
+        profile = checked_run_profile(args.log, run_log, args.profile)
+    else:
+        run_log, profile = None, args.profile or "cpu"
+    results = Path("results") / profile
     record_path = Path(args.record) if args.record else results / "provenance.json"
-    if not record_path.is_file():
+    if not args.record and not record_path.is_file() and args.what == "check":
+        raise FileNotFoundError(f"{record_path} not found: the jobs of {args.log} ran at the {profile} profile, and "
+                                "the check judges them against that profile's recorded job times: give --record, a "
+                                f"record of the {profile} profile")
+    if not args.record and not record_path.is_file():
         raise FileNotFoundError(f"{record_path} not found: the estimate scales the stored run's job times "
                                 "(run it in the project's root, at a profile with a stored run)")
-    record = json.loads(record_path.read_text(encoding="utf-8"))
+    record = read_record("--record" if args.record else "the stored record", record_path)
+    if not record.get("jobs"):
+        # every job would be taken at 0 s: "about 0.0 h" (results/paper/ holds its GPU check, not a run)
+        raise ValueError(f"{record_path} records no job's time: the {profile} profile has no stored run to "
+                         "scale" + ("" if args.record else " (--profile cpu has one)"))
     if args.what == "check":
-        figures = schedule_check(args.log, record, args.profile, args.target or "all", args.cores, record_path)
+        if record.get("profile") not in (None, profile):
+            raise ValueError(f"--record: {record_path} holds the {record['profile']} profile's job times, but the "
+                             f"jobs of {args.log} ran at the {profile} profile: give a record of the {profile} "
+                             "profile")
+        figures = schedule_check(args.log, record, profile, args.target or "all", args.cores, record_path,
+                                 run_log=run_log)
     else:
         figures = _estimate_all_here(args, record, results)
     for line in figures["lines"]:
@@ -87,42 +132,117 @@ def run(args) -> None:
         print(json.dumps({k: v for k, v in figures.items() if k != "lines"}))
 
 
+def read_record(option: str, path: Path) -> dict:
+    """The provenance record at ``path``: a JSON object whose ``jobs`` is a list of rows, each naming its
+    ``rule`` and ``job`` (what the schedule reads)."""
+    record = read_json_object(option, path, RECORD_FILE)
+    jobs = record.get("jobs", [])
+    if not isinstance(jobs, list) or not all(isinstance(row, dict) and "rule" in row and "job" in row
+                                             for row in jobs):
+        raise ValueError(f"{option}: {path} holds no list of jobs with their rule and job ('jobs'); {RECORD_FILE}")
+    return record
+
+
+def read_bench(option: str, path: Path) -> dict:
+    """The learner benchmark record at ``path``: a JSON object whose ``result`` is an object."""
+    bench = read_json_object(option, path, BENCH_FILE)
+    if not isinstance(bench.get("result", {}), dict) or not isinstance(bench.get("machine", {}), dict):
+        raise ValueError(f"{option}: {path} holds no benchmark result ('result' and 'machine' must be objects); "
+                         f"{BENCH_FILE}")
+    return bench
+
+
+def read_log(path: str) -> RunLog:
+    """``--log``: the finished run's Snakemake log."""
+    if Path(path).is_dir():
+        raise ValueError(f"--log: {path} is a folder; a Snakemake log is .snakemake/log/<date>.snakemake.log")
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"--log: {path} not found; a Snakemake log is .snakemake/log/<date>.snakemake.log")
+    try:
+        return read_run_log(path)
+    except ValueError as err:
+        raise ValueError(f"--log: {err}") from None
+
+
+def check_target(target: str | None) -> None:
+    """``--target`` is a rule of the workflow: Snakemake otherwise fails with a traceback
+    (``MissingRuleException``) once the DAG is built."""
+    if target is None:
+        return
+    rules = rule_names()
+    if target not in rules:
+        close = difflib.get_close_matches(target, rules, n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise ValueError(f"--target={target!r} is not a rule of the workflow{hint}; the run's target, e.g. all, "
+                         "table1 or screen (`snakemake --list-target-rules` lists them)")
+
+
+def run_profile(run_log: RunLog) -> str | None:
+    """The profile the logged jobs ran at, read off their wildcards (every rule's paths hold it)."""
+    named = [job.wildcards["profile"] for job in run_log.finished() if "profile" in job.wildcards]
+    return statistics.mode(named) if named else None
+
+
+def checked_run_profile(log_path: str, run_log: RunLog, asked: str | None) -> str:
+    """The profile ``estimate check`` judges the run at: the one its jobs ran at, which ``--profile``, when
+    given, must be (a run at another profile judged against this one's job times reads as a slow or fast
+    run without a word), else ``--profile``, else cpu."""
+    ran = run_profile(run_log)
+    if asked and ran and asked != ran:
+        raise ValueError(f"--profile={asked}: the jobs of {log_path} ran at the {ran} profile (their paths say so): "
+                         f"leave --profile out, or give the log of a {asked} run")
+    return ran or asked or "cpu"
+
+
 def _estimate_all_here(args, record: dict, results: Path) -> dict:
     bench_path = Path(args.bench) if args.bench else results / "bench" / "learner.json"
+    if args.bench or bench_path.is_file():
+        bench = read_bench("--bench" if args.bench else "the stored learner benchmark", bench_path)
+    else:
+        bench = {}
     rate, how, where = args.rate, "given", "on this machine"
     if rate is None and args.from_bench:
-        bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
         rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
         if not rate:
             raise FileNotFoundError(f"--from-bench: {bench_path} holds no learner benchmark "
                                     "(egosearch bench learner --out writes one)")
-        if steps_of_bench(bench) != steps_of_profile(args.profile):
+        profile = args.profile or "cpu"
+        if steps_of_bench(bench) != steps_of_profile(profile):
             raise ValueError(f"--from-bench: {bench_path} timed the cpu profile's {steps_of_bench(bench)}, but the "
-                             f"{args.profile} profile's env steps are {steps_of_profile(args.profile)} "
+                             f"{profile} profile's env steps are {steps_of_profile(profile)} "
                              "(egosearch bench learner --out times today's profile)")
         how = f"recorded in {bench_path}"
         where = f"on {machine_key(bench.get('machine'))}"
+    busy = None
     if rate is None:
         print("calibrating: a short cpu-profile training (about a minute, as `egosearch bench learner` times) ...",
-              flush=True)
-        rate, how = calibrate(), "measured now"
-    return estimate_all(record, results, args.cores, args.profile, rate=rate, rate_source=how, bench=bench_path,
-                        where=where)
+              file=sys.stderr, flush=True)
+        rate, busy = calibrate()
+        how = "measured now"
+        where = f"on this machine ({machine_key(this_machine())})"
+    figures = estimate_all(record, results, args.cores, args.profile or "cpu", rate=rate, rate_source=how,
+                           bench=bench_path, where=where)
+    if busy is not None:
+        figures["other_load_cores_while_calibrating"] = busy
+        if busy > BUSY_CORES:
+            figures["lines"].insert(2, f"  the machine was busy while it calibrated: other processes used {busy:.1f} "
+                                       "cores meanwhile, so the rate here may be low and the estimate long (calibrate "
+                                       "again when it is idle)")
+    return figures
 
 
 def schedule_check(log_path: str | Path, record: dict, profile: str, target: str, cores: int,
-                   record_path: str | Path = "the record") -> dict:
+                   record_path: str | Path = "the record", run_log: RunLog | None = None) -> dict:
     """A finished run against the simulation of its own jobs (:mod:`egosearch.report.run_log`): the jobs
     the log says it ran, with their dependencies among them in ``target``'s DAG, laid out on the run's
     cores (``cores`` where the log does not say; its profile where its jobs name one, else ``profile``)
     at the wall times ``record`` held for them (what the
     estimate would have predicted), and at the wall times the run itself logged (the schedule's model
     alone); beside the elapsed time the log shows."""
-    run = read_run_log(log_path)
+    run = run_log or read_run_log(log_path)
     cores = run.cores or cores
     # the run's own profile where its jobs name it (every rule's paths hold the profile wildcard)
-    named = [job.wildcards["profile"] for job in run.finished() if "profile" in job.wildcards]
-    profile = statistics.mode(named) if named else profile
+    profile = run_profile(run) or profile
     ran = {dag_id(job, profile): job for job in run.finished()}
     dag = dag_jobs(target, cores, config={"profile": profile})
     keep = {job.id for job in dag if job.id in ran}
@@ -159,7 +279,9 @@ def _minutes(seconds: float) -> str:
 
 def _command(args) -> str:
     """The estimate's command as a user would type it again (what it was calibrated or given)."""
-    words = ["egosearch estimate", args.what, f"--cores {args.cores}", f"--profile {args.profile}"]
+    # check without --profile judges the run at its own profile: the command says what was typed
+    profile = args.profile or ("cpu" if args.what == "all" else None)
+    words = ["egosearch estimate", args.what, f"--cores {args.cores}"] + ([f"--profile {profile}"] if profile else [])
     words += [f"--rate {args.rate:g}"] if args.rate is not None else []
     words += ["--from-bench"] if args.from_bench else []
     for flag, value in (("--bench", args.bench), ("--log", args.log), ("--record", args.record),
@@ -258,21 +380,32 @@ def benchmark_ratio(record: dict, rates: dict[str, float], bench: dict,
     return statistics.median(same) / float(bench_rate), machine_key(machine)
 
 
-def calibrate() -> float:
+def this_machine() -> dict:
+    """This machine as records name one: its CPU, vector unit and cores."""
+    return {"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()}
+
+
+def calibrate() -> tuple[float, float | None]:
     """This machine's env steps per CPU-second in a short real cpu-profile training (~a minute),
-    remembered in :data:`CALIBRATION_CACHE` for this machine."""
+    remembered in :data:`CALIBRATION_CACHE` for this machine, and the cores other processes kept busy
+    meanwhile (as ``egosearch bench learner`` records it; None where the system does not say). The
+    training's own lines (its evaluations, its config) are held back: the estimate is the answer."""
     # local: loads torch and the simulator, which an estimate from a given --rate never needs
     from egosearch.rl.bench import cpu_profile_run_steps, training_throughput
 
-    rate = float(training_throughput("cpu", env_steps=cpu_profile_run_steps())["env_steps_per_core_s"])
+    busy0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
+    with contextlib.redirect_stdout(io.StringIO()):
+        rate = float(training_throughput("cpu", env_steps=cpu_profile_run_steps())["env_steps_per_core_s"])
+    wall, busy1, own = time.perf_counter() - wall0, cpu_seconds_all(), own_cpu_seconds() - own0
+    other = (round(max(0.0, busy1 - busy0 - own) / wall, 2)
+             if busy0 is not None and busy1 is not None and wall > 0 else None)
     try:
         CALIBRATION_CACHE.parent.mkdir(parents=True, exist_ok=True)
-        CALIBRATION_CACHE.write_text(json.dumps({"machine": machine_key({"cpu": cpu_model(), "vector_unit":
-                                                 cpu_vector_unit(), "cores": os.cpu_count()}), "rate": rate,
-                                                 "steps": steps_of_profile("cpu")}))
+        CALIBRATION_CACHE.write_text(json.dumps({"machine": machine_key(this_machine()), "rate": rate,
+                                                 "steps": steps_of_profile("cpu"), "other_load_cores": other}))
     except OSError:
         pass  # a read-only home: the next estimate calibrates again
-    return rate
+    return rate, other
 
 
 def cached_rate() -> float | None:
@@ -282,7 +415,7 @@ def cached_rate() -> float | None:
         cached = json.loads(CALIBRATION_CACHE.read_text())
     except (OSError, ValueError):
         return None
-    here = machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
+    here = machine_key(this_machine())
     same = cached.get("machine") == here and cached.get("steps", BODY_STEPS) == steps_of_profile("cpu")
     return float(cached["rate"]) if same and cached.get("rate") else None
 
@@ -292,17 +425,37 @@ def print_before_a_run(profile: str, cores: int) -> None:
     estimate of the whole DAG from scratch, on this machine when it has been calibrated, else as the
     stored run recorded it, with the command that calibrates. Never stops the run."""
     record_path = Path("results") / profile / "provenance.json"
+    if no_record(profile, record_path):
+        print(f"(no estimate of the run's time: {no_record(profile, record_path)})", file=sys.stderr)
+        return
     try:
         record = json.loads(record_path.read_text(encoding="utf-8"))
         rate = cached_rate()
         lines = estimate_all(record, record_path.parent, cores, profile, rate=rate,
-                             rate_source="this machine's last calibration")["lines"][:-2]
+                             rate_source="this machine's last calibration",
+                             where=f"on this machine ({machine_key(this_machine())})")["lines"][:-2]
         if rate is None:
             lines.append(f"  for this machine: egosearch estimate all --cores {cores} --profile {profile} (a minute)")
     except (OSError, ValueError, RuntimeError, KeyError) as err:
         lines = [f"(no estimate of the run's time: {err})"]
     for line in lines:
         print(line, file=sys.stderr)
+
+
+def no_record(profile: str, record_path: Path) -> str | None:
+    """Why no estimate can be made at ``profile``, in words (it has no stored run to scale: no record, or
+    one of no job, as the paper profile's GPU check); None when one can."""
+    try:
+        jobs = json.loads(record_path.read_text(encoding="utf-8")).get("jobs")
+    except (OSError, ValueError, AttributeError):
+        jobs = None
+    if jobs:
+        return None
+    there = "records no job" if record_path.is_file() else "is not there"
+    why = f"the {profile} profile has no stored run whose job times an estimate scales ({record_path} {there})"
+    if profile == "smoke":
+        why += "; a smoke run is plumbing only, minutes long"
+    return why
 
 
 def _hours(seconds: float) -> str:
@@ -369,6 +522,10 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
     from egosearch.variants import resolve_variant
 
     results = Path("results") / profile
+    if no_record(profile, results / "provenance.json"):
+        print(f"(no estimate of the {target}'s cost: {no_record(profile, results / 'provenance.json')})",
+              file=sys.stderr)
+        return
     try:
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         bench_path = results / "bench" / "learner.json"

@@ -23,13 +23,13 @@ FORCE = ("overwrite stored results (files git tracks under results/ or paper_fig
 LEARNERS = "the profile's learner (SAC-DrQ at cpu, SAC+CURL at smoke and paper)"
 
 
-def add_force(p) -> None:
-    p.add_argument("--force", action="store_true", help=FORCE)
+def add_force(p, also: str = "") -> None:
+    p.add_argument("--force", action="store_true", help=FORCE + also)
 
 
 def add_scenarios(sub) -> None:
     p = sub.add_parser("scenarios", help="generate a fixed scenario set as CSV")
-    p.add_argument("--layout", default="kitchen_living", help=f"home: {LAYOUTS}")
+    p.add_argument("--layout", help=f"home: {LAYOUTS} (default kitchen_living; not with --homes)")
     p.add_argument("--placement", default="everywhere", choices=PLACEMENT_SCHEMES,
                    help="where targets may be: every support surface, or none inside low cabinets")
     p.add_argument("--height", type=float, default=1.65,
@@ -164,9 +164,10 @@ def add_estimate(sub) -> None:
     p.add_argument("what", choices=("all", "check"),
                    help="all: the target `snakemake all` builds; check: a finished run (--log) against the "
                         "simulation of its own jobs")
-    p.add_argument("--cores", type=int, default=2, help="the cores snakemake gets (--cores N; default 2)")
-    p.add_argument("--profile", default="cpu", choices=("cpu", "paper"),
-                   help="the profile whose stored run gives the job times (default cpu)")
+    p.add_argument("--cores", type=int, default=2, help="the cores snakemake gets (--cores N, 1 to 1024; default 2)")
+    p.add_argument("--profile", choices=("cpu", "paper"),
+                   help="the profile whose stored run gives the job times (default cpu; check: the profile the "
+                        "log's jobs ran at, which --profile must then be)")
     p.add_argument("--rate", type=float, help="this machine's learner benchmark in env steps per CPU-second (what "
                                               "`egosearch bench learner` prints as env_steps_per_core_s_cpu_profile): "
                                               "skips the calibration")
@@ -265,7 +266,8 @@ def add_report(sub) -> None:
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
     r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
                                  "pooled, to <out stem>_by_length.csv) as well as printing them")
-    add_force(r)
+    add_force(r, "; also compares a candidate file with the same content as a reference file (refused without it: "
+                 "a copy)")
 
     r = reports.add_parser("pathlength", help="success by shortest path ℓ and by detour, with two-level intervals")
     r.add_argument("files", nargs="+", help="evaluation CSVs of one variant: .../{variant}/seed{seed}/{home}/"
@@ -300,7 +302,7 @@ def add_report(sub) -> None:
     r.add_argument("--variant", default="head_on", help="the variant, for the caption (default: head_on)")
     r.add_argument("--fresh-seed", type=int, help="the fresh sets' scenario seed (>= 0), for the caption")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".csv and .md") + "; no dot in its name")
-    add_force(r)
+    add_force(r, "; also reads a --fresh file with the same content as a --stored one (refused without it: a copy)")
 
     traces = "trace files of `egosearch evaluate --traces`: .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
 

@@ -7,6 +7,7 @@ One report per function; :data:`REPORTS` maps each ``REPORT`` name to it.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import os
 import re
@@ -98,6 +99,12 @@ def check_report_outputs(args) -> None:
 def check_report_inputs(args) -> None:
     """The input files are files of their kind, and every option names something they hold: a report
     otherwise fails half-way with pandas' or numpy's words, or draws an empty row without a word."""
+    for option, paths in report_inputs(args).items():
+        missing = [path for path in paths if not os.path.exists(path)]
+        if missing:
+            # before the path is parsed: a missing file would be told the pattern of the paths it has
+            more = f" ({len(missing) - 1} more missing too)" if len(missing) > 1 else ""
+            raise FileNotFoundError(f"{option}: {missing[0]} not found{more}")
     if args.what in ("behaviour", "searches"):
         check_npz_files("the input files", args.files)
     else:
@@ -151,6 +158,14 @@ def _check_fresh(args) -> None:
     if both:
         raise ValueError(f"{both[0]} is both a --stored and a --fresh file: the check reads evaluations on two "
                          "different scenario sets")
+    if not args.force:
+        stored_content = {_sha256(path): path for path in args.stored}
+        for path in args.fresh:
+            same = stored_content.get(_sha256(path))
+            if same is not None:
+                raise ValueError(f"--fresh: {path} has the same content as the --stored {same} (a copy?): the check "
+                                 "reads evaluations on two different scenario sets; pass --force when they did give "
+                                 "the same episodes")
     written = prefix_files("fresh", args.out_prefix)
     wanted = Path(args.out_prefix)
     if written[0].parent == wanted.parent and written[0].stem != wanted.name:
@@ -178,7 +193,9 @@ def _check_budget(args) -> None:
 def _check_compare(args) -> None:
     """A candidate whose actors trained at another learner profile than the reference's (a smoke run
     in a cpu results folder) is refused: its rows would read as a worse variant. The profile is read
-    from each actor's ``config.json``, found beside the evaluation as the DAG lays them out."""
+    from each actor's ``config.json``, found beside the evaluation as the DAG lays them out. A candidate
+    file with the same content as a reference file (a copy) is refused without ``--force``: a table of
+    +0.000 would read as a result."""
     sides = {option: actor_profiles(files) for option, files in (("--reference", args.reference),
                                                                  ("--candidate", args.candidate))}
     for file, (profile, config) in sides["--candidate"].items():
@@ -187,6 +204,19 @@ def _check_compare(args) -> None:
             raise ValueError(f"--candidate: {file} was evaluated from an actor trained at the {profile} learner "
                              f"profile ({config}), the reference's at {', '.join(sorted(reference))}: compare "
                              "variants trained at one profile")
+    if not args.force:
+        reference_by_content = {_sha256(path): path for path in args.reference}
+        for path in args.candidate:
+            same = reference_by_content.get(_sha256(path))
+            if same is not None and Path(same).resolve() != Path(path).resolve():  # one path: refused below
+                raise ValueError(f"--candidate: {path} has the same content as the reference's {same} (a copy?): "
+                                 "every difference would be 0; compare two different variants, or pass --force "
+                                 "when they did give the same episodes")
+
+
+def _sha256(path: str) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
 
 
 def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
@@ -332,6 +362,14 @@ def _provenance(args) -> None:
 
 
 def _regenerate(args) -> None:
+    if args.variant:
+        # local: the variants layer loads gymnasium's registry
+        from egosearch.variants import load_variant
+
+        try:
+            load_variant(args.variant)
+        except ValueError as err:
+            raise ValueError(f"--variant: {err}") from None
     regenerate(args.profile, args.variant)
 
 
@@ -347,6 +385,8 @@ def _verify(args) -> None:
 
 
 def _readme(args) -> None:
+    if args.readme and not Path(args.readme).is_file():
+        raise FileNotFoundError(f"--readme: {args.readme} not found; a page of marked blocks (README.md, docs/*.md)")
     if args.readme:
         checked = [args.readme]
         stale = [] if update_readme(args.readme, args.profile, check=args.check) else checked

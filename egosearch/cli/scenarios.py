@@ -24,6 +24,10 @@ def run(args) -> None:
     check_seed("--seed", args.seed)
     check_height(args.height)
     homes = None
+    if args.homes and args.layout:
+        # the set would be the generated homes', and its rows read as the layout's
+        raise ValueError(f"--layout={args.layout} and --homes={args.homes} both name the homes: give one")
+    args.layout = args.layout or "kitchen_living"
     if args.homes:
         first, sep, stop = args.homes.partition(":")
         if not (sep and first.isdigit() and stop.isdigit() and int(first) < int(stop)):

@@ -21,7 +21,7 @@ def run(args) -> None:
     check_overwrites(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir}, force=args.force)
     if args.max_wall_s is not None and not args.max_wall_s > 0:
         raise ValueError(f"--max-wall-s must be a positive number of seconds, got {args.max_wall_s}")
-    check_seed("--seed", args.seed)
+    check_seed("--seed", args.seed, numpy_legacy=True)
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     overrides = {"seed": args.seed, **({"num_threads": args.threads} if args.threads else {})}
     resolved = resolve_variant(args.variant, args.profile, overrides)

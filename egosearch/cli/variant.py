@@ -11,11 +11,14 @@ def run(args) -> None:
     if args.what == "new":
         check_outputs(dirs={"the variants folder": ABLATIONS_DIR})
         try:
-            load_variant(args.template)
+            load_variant(args.template, ABLATIONS_DIR)
         except VariantError as err:
             raise ValueError(f"--from: {err}") from None
-        path = new_variant(args.name, template=args.template)
-        print(f"wrote {path}: edit it, then `snakemake --cores 2 compare --config variant={args.name}`")
+        path = new_variant(args.name, template=args.template, directory=ABLATIONS_DIR)
+        # the order docs/ablations.md gives: one seed first, every seed for a variant that passes
+        print(f"wrote {path}: edit it, check it (`egosearch variant check {args.name}`), then screen it on one seed: "
+              f"`snakemake --cores 2 screen --config variant={args.name}`; a variant that passes its screen gets "
+              f"`snakemake --cores 2 compare --config variant={args.name}` (every seed; docs/ablations.md)")
         return
     for profile in args.profile:
         # else the profile's error reads as a fault of the first variant file

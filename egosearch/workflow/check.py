@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
+from egosearch.sim.envs import REFERENCE_SEARCHERS
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
@@ -101,21 +102,26 @@ def workflow_variants(config: dict, compare: bool | str = False,
     budget_config = config["profiles"][config["profile"]].get("budget", {})
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
-    claims = [name for _, pairs in every_claims_pairs(config) for pair in pairs for name in pair
+    claims = [(where, name) for where, pairs in every_claims_pairs(config) for pair in pairs for name in pair
               if name not in CLASSICAL_SEARCHERS]
-    names = list(dict.fromkeys(config["variants"] + [config["reference_variant"]] + budget
-                               + generalise["variants"] + claims))
+    # the config key that names each variant first: an unknown name's line says which key to fix
+    named_by: dict[str, str] = {}
+    for key, name in ([("variants", n) for n in config["variants"]]
+                      + [("reference_variant", config["reference_variant"])]
+                      + [(f"profiles/{config['profile']}/budget", n) for n in budget]
+                      + [("generalise/variants", n) for n in generalise["variants"]] + claims
+                      + ([("variant", config["variant"])] if config.get("variant") else [])):
+        named_by.setdefault(name, key)
+    names = list(named_by)
     if compare and not config.get("variant"):
         raise VariantError(f"{target} needs a variant: snakemake --cores 2 {target} --config variant=NAME")
     if compare and config["variant"] == config["reference_variant"]:
         raise VariantError(f"variant={config['variant']!r} is the reference variant itself: {target} needs another "
                            "variant (or another reference_variant)")
-    if config.get("variant"):
-        names = list(dict.fromkeys(names + [config["variant"]]))
     learner = config["profiles"][config["profile"]]["learner"]
     variants = {}
     for name in names:
-        variants[name] = load_variant(name, directory)
+        variants[name] = _named_variant(name, named_by[name], directory)
         check_learner_config(variants[name], learner)
     generated = generalise.get("generated_variant")
     if generated is not None and (generated not in generalise["variants"]
@@ -126,6 +132,20 @@ def workflow_variants(config: dict, compare: bool | str = False,
     if reference is not None and reference not in generalise["variants"]:
         raise ConfigError(f"config generalise/reference: {reference!r} must be one of generalise/variants")
     return variants
+
+
+def _named_variant(name: str, key: str, directory: Path) -> Variant:
+    """The variant file ``name`` that the config's ``key`` names; a name with no file is refused naming
+    the key (a reference searcher's name too: its evaluations are no variant's)."""
+    if not (Path(directory) / f"{name}.yaml").is_file():
+        if name in REFERENCE_SEARCHERS:
+            raise VariantError(f"config {key}: {name!r} is a reference searcher, not a variant (a file in "
+                               f"{Path(directory).name}/, e.g. head_on)")
+        try:
+            load_variant(name, directory)
+        except VariantError as err:
+            raise VariantError(f"config {key}: {err}") from None
+    return load_variant(name, directory)
 
 
 def checked_variants(config: dict, argv: list[str] | None = None,

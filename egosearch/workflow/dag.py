@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -51,6 +52,18 @@ class DagJob:
     def as_dict(self) -> dict:
         """The job as a JSON-ready dict (what :mod:`egosearch.report.schedule` reads)."""
         return asdict(self) | {"deps": list(self.deps)}
+
+
+_DECLARED_RULE = re.compile(r"^(?:rule|checkpoint) (\w+):", re.MULTILINE)
+
+
+def rule_names(root: str | os.PathLike | None = None) -> list[str]:
+    """Every rule the workflow declares (the Snakefile and ``egosearch/workflow/rules/*.smk``), sorted:
+    the names a target may take. Read from the files' text, in a moment, without building a DAG."""
+    root = Path(root or ROOT)
+    files = [root / "Snakefile", *sorted((root / "egosearch" / "workflow" / "rules").glob("*.smk"))]
+    return sorted({name for path in files if path.is_file()
+                   for name in _DECLARED_RULE.findall(path.read_text(encoding="utf-8"))})
 
 
 def _config_items(config: Mapping[str, object] | Sequence[str] | None) -> list[str]:
