@@ -5,6 +5,7 @@
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
 import sys
 
+from snakemake.settings.types import Quietness
 from snakemake.utils import min_version, validate
 
 from egosearch.workflow.check import checked_variants
@@ -46,18 +47,23 @@ rule all:
 
 
 onstart:
-    # The cost of `all` before its first job: the whole DAG from scratch, simulated on these cores
-    # (egosearch estimate all; on this machine once it has been calibrated).
-    if "all" in workflow.dag_settings.targets and PROFILE != "smoke":
-        from egosearch.cli.estimate import print_before_a_run
+    # The cost of the run before its first job (egosearch.cli.estimate.print_costs); no target given:
+    # Snakemake builds the first rule, `all`.
+    from egosearch.cli.estimate import print_costs
 
-        print_before_a_run(PROFILE, workflow.cores)
-    for target in ("compare", "screen"):
-        if target in workflow.dag_settings.targets and config.get("variant"):
-            from egosearch.cli.estimate import print_variant_cost
+    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, workflow.cores)
 
-            seeds = SEEDS if target == "compare" else [config["screen_seed"]]
-            print_variant_cost(PROFILE, target, config["variant"], seeds, REF, workflow.cores)
+
+# A dry run is where a user plans (`snakemake -n screen --config variant=NAME`): it prints the same cost
+# line, here, since Snakemake calls onstart only before a real run's first job. Its targets are read from
+# the command line, as checked_variants reads them (the DAG's settings are not set yet). The DAG's own
+# quiet child (egosearch.workflow.dag, which `estimate all` runs) prints nothing.
+if (workflow.is_main_process and workflow.output_settings.dryrun
+        and Quietness.ALL not in (workflow.output_settings.quiet or ())):
+    from egosearch.cli.estimate import print_costs
+
+    named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}]
+    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, workflow.cores)
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

@@ -123,3 +123,40 @@ def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_pa
     (run / "done.json").write_text(json.dumps({"demonstrations": {"episodes": 1500, "cpu_s": 375.0}}))
     # 100 + 20 episodes x 0.25 s = 30 s, 1000 cloning steps / 50 per s = 20 s; x 100 / 50 = 100 s
     assert estimate.teacher_cost_s(cfg, results, bench, 50.0) == pytest.approx(100.0)
+
+
+@pytest.mark.skipif(not RECORD.exists(), reason="no stored cpu run")
+def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_path, monkeypatch, capsys):
+    """The calibration's own lines (its evaluations, its config) are held back: stdout is the answer, whose
+    first figure names the CPU it was calibrated on; other processes' 1.5 cores meanwhile get a line."""
+    import types
+
+    import egosearch.cli.estimate as estimate
+    import egosearch.rl.bench
+    from egosearch.workflow.dag import DagJob
+
+    def short_training(profile, env_steps):
+        print("eval @ 0: success nan  return nan  spl nan")  # what a real calibration prints
+        return {"env_steps_per_core_s": 40.0}
+
+    monkeypatch.chdir(REPO)
+    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(egosearch.rl.bench, "training_throughput", short_training)
+    monkeypatch.setattr(egosearch.rl.bench, "cpu_profile_run_steps", lambda: 10)
+    monkeypatch.setattr(estimate, "dag_jobs", lambda target, cores, config: [
+        DagJob(id="train/head_on/seed0", rule="train", job="head_on/seed0", record_rule="train", threads=1, deps=(),
+               order=1)])
+    # 60 s of calibration in which the machine's CPU time grew by 100 s, 10 of them its own: 1.5 other cores
+    monkeypatch.setattr(estimate, "time", types.SimpleNamespace(perf_counter=iter([0.0, 60.0]).__next__))
+    monkeypatch.setattr(estimate, "cpu_seconds_all", iter([1000.0, 1100.0]).__next__)
+    monkeypatch.setattr(estimate, "own_cpu_seconds", iter([5.0, 15.0]).__next__)
+    assert main(["estimate", "all"]) == 0
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert "nan" not in out and lines[0].startswith("snakemake --cores 2 all from a fresh clone, cpu profile")
+    here = estimate.machine_key(estimate.this_machine())
+    assert lines[1].startswith(f"  on this machine ({here}): about ") and "40 decisions per CPU-second" in lines[1]
+    assert ("  the machine was busy while it calibrated: other processes used 1.5 cores meanwhile, so the rate here "
+            "may be low and the estimate long (calibrate again when it is idle)") in lines
+    assert err.startswith("calibrating: ")
+    assert json.loads((tmp_path / "rate.json").read_text())["other_load_cores"] == 1.5

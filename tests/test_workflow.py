@@ -221,6 +221,30 @@ def test_a_screen_compares_one_seed_against_the_references_same_seed():
     assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr
 
 
+def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
+    """`snakemake -n screen` is where a user plans: the line onstart prints before a real run's first job,
+    once (a dry run has 1 core unless --cores says otherwise)."""
+    from egosearch.cli.estimate import print_variant_cost
+
+    out = run(["-n", "screen", "--config", "variant=head_off"])
+    assert out.returncode == 0, out.stderr
+    monkeypatch.chdir(REPO)
+    print_variant_cost("cpu", "screen", "head_off", [0], "head_on", 1)
+    line = capsys.readouterr().err.strip()
+    assert line.startswith("screen of head_off against head_on: ") and "about" in line
+    assert out.stderr.splitlines().count(line) == 1
+
+
+def test_a_dry_run_without_a_stored_run_says_why_there_is_no_estimate(checkout):
+    for target, what in (("screen", "the screen's cost"), ("all", "the run's time")):
+        out = run(["-n", target, "--config", "profile=smoke", "variant=head_off"], cwd=checkout)
+        assert out.returncode == 0, out.stderr
+        assert (f"(no estimate of {what}: the smoke profile has no stored run whose job times an estimate scales "
+                "(results/smoke/provenance.json is not there); a smoke run is plumbing only, minutes long)"
+                in out.stderr.splitlines()), out.stderr
+        assert "Errno" not in out.stderr
+
+
 def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
     """Its pair is a modular searcher: the claims are read both ways (the pair that learned every body step is
     stored); the other profiles read the top level's pairs."""

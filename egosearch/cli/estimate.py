@@ -420,6 +420,19 @@ def cached_rate() -> float | None:
     return float(cached["rate"]) if same and cached.get("rate") else None
 
 
+def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int) -> None:
+    """What ``snakemake`` prints before the first job of ``targets`` (the Snakefile's ``onstart``, and a
+    dry run's start): `all`'s whole DAG from scratch, simulated on ``cores`` (:func:`print_before_a_run`),
+    and a comparison's trainings and evaluations still to run (:func:`print_variant_cost`: every one of
+    ``seeds`` for compare, ``screen_seed`` for screen). Where no estimate can be made, a line says why."""
+    if "all" in targets:
+        print_before_a_run(profile, cores)
+    for target in ("compare", "screen"):
+        if target in targets and config.get("variant"):
+            chosen = seeds if target == "compare" else [config["screen_seed"]]
+            print_variant_cost(profile, target, config["variant"], chosen, reference, cores)
+
+
 def print_before_a_run(profile: str, cores: int) -> None:
     """What ``snakemake ... all`` prints before its first job (the Snakefile's ``onstart``): the
     estimate of the whole DAG from scratch, on this machine when it has been calibrated, else as the
