@@ -271,3 +271,21 @@ def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_ran
     assert f"eval/{floor}/seed1/" not in text
     smoke = run(["-n", "-p", "decisions_floor", "--config", "profile=smoke"])
     assert smoke.returncode == 0 and "report compare" not in smoke.stdout + smoke.stderr
+
+
+def test_learning_adds_compares_the_pair_with_its_own_start_on_the_same_sets(checkout):
+    """`learning_adds`: every seed's start (actor_start.pt, beside the actor.pt the train rule makes) on every
+    Table 1 cell under eval_start/, and each variant of the pair against it, seed by seed."""
+    out = run(["-n", "-p", "learning_adds", "--config", "profile=smoke"], cwd=checkout)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout + out.stderr
+    for variant in ("head_on", "head_off"):
+        assert (f"--weights results/smoke/train/{variant}/seed0/actor_start.pt --scenarios "
+                f"results/smoke/scenarios/kitchen_living/everywhere/h1.05.csv --seed 0 --out "
+                f"results/smoke/eval_start/{variant}/seed0/kitchen_living/everywhere/h1.05.csv") in text
+        compare = next(line for line in text.splitlines()
+                       if f"--out results/smoke/compare/{variant}_vs_its_start.csv" in line)
+        reference, candidate = compare.split("--reference ")[1].split(" --candidate ")
+        assert f"results/smoke/eval_start/{variant}/seed0/bedroom_bath/no_low_cabinets/h0.45.csv" in reference
+        assert "/eval/" not in reference and "/eval_start/" not in candidate.split(" --out ")[0]
+        assert f"results/smoke/eval/{variant}/seed0/bedroom_bath/no_low_cabinets/h0.45.csv" in candidate

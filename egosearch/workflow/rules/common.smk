@@ -61,6 +61,18 @@ def eval_files(variant, homes=None):
                   seed=SEEDS, home=homes or HOMES, placement=PLACEMENTS, height=HEIGHTS)
 
 
+def start_actor(actor_path):
+    """The start actor file beside a run's actor.pt (imported here, not at the top: it loads torch)."""
+    from egosearch.rl.run_files import START_ACTOR_NAME
+
+    return str(Path(actor_path).with_name(START_ACTOR_NAME))
+
+
+def start_eval_files(variant):
+    """``eval_files`` of the variant's start (its actor_start.pt): the policy before it learned."""
+    return [f.replace(f"{RESULTS}/eval/", f"{RESULTS}/eval_start/", 1) for f in eval_files(variant)]
+
+
 def curve_files(variant):
     return expand(f"{RESULTS}/train/{variant}/seed{{seed}}/curve.csv", seed=SEEDS)
 

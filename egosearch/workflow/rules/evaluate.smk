@@ -20,6 +20,32 @@ rule evaluate:
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
+rule evaluate_start:
+    """A trained policy's start (actor_start.pt beside its actor.pt: the clone after imitation, else the
+    untrained net) on one Table 1 cell: what its learning starts from, on the stored sets. Runs stored
+    before trainings wrote the start have none: the job stops with one line saying so."""
+    input:
+        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+    output:
+        "results/{profile}/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+    log:
+        "results/{profile}/logs/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+    benchmark:
+        "results/{profile}/benchmarks/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+    params:
+        start=lambda wc, input: start_actor(input.actor),
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=30,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --force --policy actor --weights {params.start} --scenarios {input.scenarios} "
+        "--seed {wildcards.seed} --out {output} > {log} 2>&1"
+
+
 # eval/random/... and eval/oracle/... are the bounds' (BOUNDS in egosearch.report.tables), not variants; so are
 # eval/modular_random/... (REFERENCE_SEARCHERS: the modular searcher's floor, read by the decisions_floor rule).
 ruleorder: bound > evaluate

@@ -224,6 +224,31 @@ rule provenance:
         "> {log} 2>&1"
 
 
+rule learning_adds:
+    """What learning adds: the profile's pair (head on, head off) against its own start (each seed's
+    policy at step 0: the clone after imitation, else the untrained net) on the same stored sets, per
+    cell and per shortest-path bin. Needs trainings that wrote actor_start.pt."""
+    input:
+        [f"{RESULTS}/compare/{variant}_vs_its_start.csv" for variant in VARIANTS],
+
+
+rule learning_adds_compare:
+    """One variant (all its seeds) against its start (the same seeds at step 0)."""
+    input:
+        reference=ancient(lambda wc: start_eval_files(wc.variant)),
+        candidate=ancient(lambda wc: eval_files(wc.variant)),
+    output:
+        cells=f"{RESULTS}/compare/{{variant}}_vs_its_start.csv",
+        by_length=f"{RESULTS}/compare/{{variant}}_vs_its_start_by_length.csv",
+    log:
+        f"{RESULTS}/logs/report/learning_adds_{{variant}}.log",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
+        "--out {output.cells} > {log} 2>&1"
+
+
 rule decisions_floor:
     """What a modular searcher's learned decisions add: the profile's pair (head on, head off) against the
     same walk with random decisions, per cell and per shortest-path bin. Nothing to do at a profile whose
