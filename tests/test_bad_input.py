@@ -240,6 +240,35 @@ def test_variant_new_copies_the_template_with_its_name(tmp_path, monkeypatch):
         new_variant("my variant", directory=tmp_path)
 
 
+def test_variant_new_says_to_screen_first_as_the_ablations_page_does(tmp_path, monkeypatch, capsys):
+    import egosearch.cli.variant
+
+    shutil.copy2(REPO / "ablations" / "head_on.yaml", tmp_path)
+    monkeypatch.setattr(egosearch.cli.variant, "ABLATIONS_DIR", tmp_path)
+    assert main(["variant", "new", "my_lever"]) == 0
+    said = capsys.readouterr().out
+    screen, compare = ("snakemake --cores 2 screen --config variant=my_lever",
+                       "snakemake --cores 2 compare --config variant=my_lever")
+    assert (tmp_path / "my_lever.yaml").is_file() and said.index(screen) < said.index(compare)
+    page = (REPO / "docs" / "ablations.md").read_text()
+    assert page.index(screen.replace("my_lever", "my_variant")) < page.index(compare.replace("my_lever", "my_variant"))
+
+
+@pytest.mark.parametrize("argv, hint", [
+    (["generalise"], "'generalise' is not a command; it is `egosearch report generalise`, or the workflow's target "
+                     "`snakemake --cores 2 generalise`"),
+    (["fresh"], "'fresh' is not a command; it is `egosearch report fresh`, or the workflow's target "
+                "`snakemake --cores 2 fresh`"),
+    (["traces"], "'traces' is not a command: `egosearch evaluate --traces FILE.npz` writes a search's every step; "
+                 "`egosearch report behaviour` and `egosearch report searches` read them (the workflow's targets: "
+                 "`snakemake --cores 2 behaviour searches`)"),
+    (["evalute", "--policy", "oracle"], "'evalute' is not a command; did you mean `egosearch evaluate`?"),
+], ids=["generalise", "fresh", "traces", "evalute"])
+def test_a_misplaced_command_gets_a_hint(argv, hint, capsys):
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"egosearch: error: {hint}\n"
+
+
 def cli_error(capsys, *argv):
     assert main(list(argv)) == 2
     err = capsys.readouterr().err

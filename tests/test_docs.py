@@ -74,6 +74,38 @@ def test_the_readme_keeps_the_commands_ci_runs():
     assert "```bash\nsnakemake --cores 2 all\n```" in readme
 
 
+def test_the_readme_is_a_two_minute_read_and_the_test_time_lives_there_only():
+    """The README stays short (details in docs/), and the default test command's time is given in one place:
+    the README's Run and test; a docs page naming the command points there instead of repeating a figure."""
+    import re
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    assert len(readme.splitlines()) <= 230
+    command = 'python -m pytest -q -n auto -m "not slow"'
+    timed = re.compile(r"\d+ min \d+ s")
+    after = readme.split(f"```bash\n{command}\n```", 1)[1]
+    assert timed.search(after.split("\n\n", 2)[1]), "the README's test time follows its test command"
+    for page in sorted((REPO / "docs").glob("*.md")):
+        for line in page.read_text(encoding="utf-8").splitlines():
+            if command in line:
+                assert not timed.search(line) and "README" in line, f"{page.name}: {line}"
+
+
+def test_the_readme_shows_making_the_env_in_one_line():
+    import gymnasium
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    block = readme.split("```python\n", 1)[1].split("\n```", 1)[0]
+    assert "\n" not in block and 'gymnasium.make("EgoSearch-v0")' in block
+    scope: dict = {}
+    exec(block, scope)  # the line as a reader pastes it
+    try:
+        assert set(scope["obs"]) == {"depth", "mask", "proprio"} and isinstance(scope["env"].unwrapped,
+                                                                                  gymnasium.Env)
+    finally:
+        scope["env"].close()
+
+
 def _record(result: dict, command: str, other: float = 0.02) -> dict:
     return {"command": command, "date_utc": "2026-01-02T03:04:05+00:00", "commit": "0123456789abcdef",
             "commit_dirty": False, "machine": {"cpu": "X CPU", "cores": 2}, "load_average_before": [0.1, 0.2, 0.3],
