@@ -160,3 +160,33 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
             "may be low and the estimate long (calibrate again when it is idle)") in lines
     assert err.startswith("calibrating: ")
     assert json.loads((tmp_path / "rate.json").read_text())["other_load_cores"] == 1.5
+
+
+def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_from_them(tmp_path, monkeypatch,
+                                                                                          capsys):
+    """A variant with demo_episodes runs the classical searcher's episodes and clones them before its RL phase,
+    whose rate alone the stored trainings give: the cost line adds them, or says it cannot price them."""
+    import egosearch.cli.estimate as estimate
+    from egosearch.variants import resolve_variant
+
+    variant = "head_on_imitation_finetune"
+    config = resolve_variant(variant, "cpu").config
+    assert config.demo_episodes and config.env_step_unit == "body steps"
+    results = tmp_path / "results" / "cpu"
+    (results / "bench").mkdir(parents=True)
+    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+        {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0}]}))
+    (results / "bench" / "learner.json").write_text(json.dumps({"result": {
+        "env_steps_per_core_s_cpu_profile": 10.0, "cpu_profile_steps": "decisions"}}))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(estimate, "stored_cpu_s_per_step", lambda record, results, kind: 0.01)
+    rl_phase = config.total_env_steps * 0.01
+    unpriced = "plus the teacher's {} episodes and the cloning (no stored measurement prices them)"
+    for teacher_s, said in ((1800.0, "of which about 0.5 h the teacher's"), (None, unpriced)):
+        monkeypatch.setattr(estimate, "teacher_cost_s", lambda config, results, bench, rate, s=teacher_s: s)
+        estimate.print_variant_cost("cpu", "screen", variant, [0], "head_on", 1)
+        line = capsys.readouterr().err
+        each = (rl_phase + (teacher_s or 0.0)) / 3600
+        assert f"1 training(s) of {config.total_env_steps} env steps, about {each:.1f} h each" in line, line
+        assert said.format(config.demo_episodes) in line

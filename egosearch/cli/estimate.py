@@ -568,9 +568,21 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
             per_step = stored_cpu_s_per_step(record, results, variant_kind)
             per_training = steps * per_step if per_step else float("nan")
             where = f"the stored trainings' machines (their CPU time per env step, {variant_kind})"
+        teacher = ""
+        if config_of_variant.demo_episodes:
+            # the rates above are the RL phase's: a training that learns from the classical searcher first
+            # runs its episodes and clones them (training_time_line adds them the same way)
+            extra = teacher_cost_s(config_of_variant, results, bench, rate) if rate else None
+            if extra is not None:
+                per_training += extra
+                teacher = (f", of which about {extra / 3600:.1f} h the teacher's {config_of_variant.demo_episodes} "
+                           "episodes and the cloning")
+            else:
+                teacher = (f", plus the teacher's {config_of_variant.demo_episodes} episodes and the cloning (no "
+                           "stored measurement prices them)")
         hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
         print(f"{target} of {variant} against {reference}: {len(trainings)} training(s) of {steps} env steps, about "
-              f"{per_training / 3600:.1f} h each on {where}, and {n_evals} evaluations of about "
+              f"{per_training / 3600:.1f} h each on {where}{teacher}, and {n_evals} evaluations of about "
               f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
     except (OSError, ValueError, KeyError, TypeError) as err:
         print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)
