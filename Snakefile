@@ -47,9 +47,9 @@ rule all:
 
 
 onstart:
-    # The cost of the run before its first job (egosearch.cli.estimate.print_costs); no target given:
+    # The cost of the run before its first job (egosearch.cost.estimate.print_costs); no target given:
     # Snakemake builds the first rule, `all`.
-    from egosearch.cli.estimate import print_costs
+    from egosearch.cost.estimate import print_costs
 
     print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, workflow.cores)
 
@@ -60,7 +60,7 @@ onstart:
 # quiet child (egosearch.workflow.dag, which `estimate all` runs) prints nothing.
 if (workflow.is_main_process and workflow.output_settings.dryrun
         and Quietness.ALL not in (workflow.output_settings.quiet or ())):
-    from egosearch.cli.estimate import print_costs
+    from egosearch.cost.estimate import print_costs
 
     named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}]
     print_costs(named or ["all"], config, PROFILE, SEEDS, REF, workflow.cores)

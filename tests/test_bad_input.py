@@ -1138,6 +1138,8 @@ def nothing_runs(monkeypatch):
     import egosearch.cli.pictures
     import egosearch.cli.scenarios
     import egosearch.cli.video
+    import egosearch.cost.estimate
+    import egosearch.cost.schedule_check
     import egosearch.rl.train
 
     def work(*args, **kwargs):
@@ -1147,8 +1149,9 @@ def nothing_runs(monkeypatch):
                          (egosearch.cli.video, "write_search_video"), (egosearch.cli.scenarios, "generate_scenarios"),
                          (egosearch.cli.bench, "gpu_check"), (egosearch.cli.bench, "bench_learner"),
                          (egosearch.cli.bench.bench, "bench_env"), (egosearch.cli.pictures, "make_pictures"),
-                         (egosearch.rl.train, "_train"), (egosearch.cli.estimate, "dag_jobs"),
-                         (egosearch.cli.estimate, "calibrate"), (egosearch.cli.demos, "collect_demonstrations")):
+                         (egosearch.rl.train, "_train"), (egosearch.cost.estimate, "dag_jobs"),
+                         (egosearch.cost.schedule_check, "dag_jobs"), (egosearch.cli.estimate, "calibrate"),
+                         (egosearch.cli.demos, "collect_demonstrations")):
         monkeypatch.setattr(module, name, work)
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from egosearch.cli import main
-from egosearch.cli.estimate import estimate_all
+from egosearch.cost.estimate import estimate_all
 
 REPO = Path(__file__).resolve().parent.parent
 RECORD = REPO / "results" / "cpu" / "provenance.json"
@@ -16,7 +16,7 @@ RECORD = REPO / "results" / "cpu" / "provenance.json"
 @pytest.mark.skipif(not RECORD.exists(), reason="no stored cpu run")
 def test_the_estimate_simulates_the_schedule_and_scales_trainings_to_the_machine(monkeypatch):
     monkeypatch.chdir(REPO)
-    from egosearch.cli.estimate import steps_of_profile, stored_training_rates
+    from egosearch.cost.rates import steps_of_profile, stored_training_rates
 
     record = json.loads(RECORD.read_text())
     # rates in the profile's own unit (decisions for a modular searcher), about the recorded ones
@@ -43,11 +43,12 @@ def test_bad_estimate_inputs_are_one_line(capsys):
 
 def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypatch):
     """From this machine's cached calibration; without one it names the command that makes one."""
-    import egosearch.cli.estimate as estimate
+    import egosearch.cost.estimate as estimate
     from egosearch.core.machine import cpu_model, cpu_vector_unit
+    from egosearch.cost import calibration
 
     monkeypatch.chdir(tmp_path)  # no stored record here: a training is taken at the calibrated rate
-    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     assert "egosearch estimate all" in estimate.training_time_line(200_000, "cpu")
     here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
     (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "decisions"}))
@@ -69,7 +70,7 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
     modular searcher's run is left out too: its env steps are decisions."""
     import json
 
-    from egosearch.cli.estimate import stored_training_rates
+    from egosearch.cost.rates import stored_training_rates
 
     results = tmp_path / "results" / "cpu"
     jobs = []
@@ -91,7 +92,8 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
     assert stored_training_rates({"jobs": jobs}, results) == {"scratch/seed0": 100.0, "finetuned/seed0": 100.0,
                                                               "replayed/seed0": 100.0}
     # a modular searcher's rate counts decisions, apart: 30,000 / 2,400 CPU-s = 12.5, i.e. 0.08 CPU-s each
-    from egosearch.cli.estimate import DECISIONS, stored_cpu_s_per_step
+    from egosearch.cost.rates import stored_cpu_s_per_step
+    from egosearch.rl.config import DECISIONS
 
     assert stored_training_rates({"jobs": jobs}, results, DECISIONS) == {"modular/seed0": 12.5}
     assert stored_cpu_s_per_step({"jobs": jobs}, results, DECISIONS) == pytest.approx(0.08)
@@ -101,12 +103,13 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
 def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_path, monkeypatch):
     """Hand-worked: 100 demonstration and 20 DAgger episodes at 0.25 CPU-s each and 2 x 500 cloning steps at 50
     updates per second on the benchmark's machine (30 + 20 s), on a machine calibrated at half its rate: 100 s."""
-    import egosearch.cli.estimate as estimate
+    import egosearch.cost.estimate as estimate
     from egosearch.core.machine import cpu_model, cpu_vector_unit
+    from egosearch.cost import calibration, rates
     from egosearch.rl.config import load_config
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
     (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 50.0}))
     results = tmp_path / "results" / "cpu"
@@ -122,7 +125,7 @@ def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_pa
     run.mkdir(parents=True)
     (run / "done.json").write_text(json.dumps({"demonstrations": {"episodes": 1500, "cpu_s": 375.0}}))
     # 100 + 20 episodes x 0.25 s = 30 s, 1000 cloning steps / 50 per s = 20 s; x 100 / 50 = 100 s
-    assert estimate.teacher_cost_s(cfg, results, bench, 50.0) == pytest.approx(100.0)
+    assert rates.teacher_cost_s(cfg, results, bench, 50.0) == pytest.approx(100.0)
 
 
 @pytest.mark.skipif(not RECORD.exists(), reason="no stored cpu run")
@@ -131,8 +134,9 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
     first figure names the CPU it was calibrated on; other processes' 1.5 cores meanwhile get a line."""
     import types
 
-    import egosearch.cli.estimate as estimate
+    import egosearch.cost.estimate as estimate
     import egosearch.rl.bench
+    from egosearch.cost import calibration
     from egosearch.workflow.dag import DagJob
 
     def short_training(profile, env_steps):
@@ -140,21 +144,21 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
         return {"env_steps_per_core_s": 40.0}
 
     monkeypatch.chdir(REPO)
-    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     monkeypatch.setattr(egosearch.rl.bench, "training_throughput", short_training)
     monkeypatch.setattr(egosearch.rl.bench, "cpu_profile_run_steps", lambda: 10)
     monkeypatch.setattr(estimate, "dag_jobs", lambda target, cores, config: [
         DagJob(id="train/head_on/seed0", rule="train", job="head_on/seed0", record_rule="train", threads=1, deps=(),
                order=1)])
     # 60 s of calibration in which the machine's CPU time grew by 100 s, 10 of them its own: 1.5 other cores
-    monkeypatch.setattr(estimate, "time", types.SimpleNamespace(perf_counter=iter([0.0, 60.0]).__next__))
-    monkeypatch.setattr(estimate, "cpu_seconds_all", iter([1000.0, 1100.0]).__next__)
-    monkeypatch.setattr(estimate, "own_cpu_seconds", iter([5.0, 15.0]).__next__)
+    monkeypatch.setattr(calibration, "time", types.SimpleNamespace(perf_counter=iter([0.0, 60.0]).__next__))
+    monkeypatch.setattr(calibration, "cpu_seconds_all", iter([1000.0, 1100.0]).__next__)
+    monkeypatch.setattr(calibration, "own_cpu_seconds", iter([5.0, 15.0]).__next__)
     assert main(["estimate", "all"]) == 0
     out, err = capsys.readouterr()
     lines = out.splitlines()
     assert "nan" not in out and lines[0].startswith("snakemake --cores 2 all from a fresh clone, cpu profile")
-    here = estimate.machine_key(estimate.this_machine())
+    here = estimate.machine_key(calibration.this_machine())
     assert lines[1].startswith(f"  on this machine ({here}): about ") and "40 decisions per CPU-second" in lines[1]
     assert ("  the machine was busy while it calibrated: other processes used 1.5 cores meanwhile, so the rate here "
             "may be low and the estimate long (calibrate again when it is idle)") in lines
@@ -166,7 +170,8 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
                                                                                           capsys):
     """A variant with demo_episodes runs the classical searcher's episodes and clones them before its RL phase,
     whose rate alone the stored trainings give: the cost line adds them, or says it cannot price them."""
-    import egosearch.cli.estimate as estimate
+    import egosearch.cost.estimate as estimate
+    from egosearch.cost import calibration
     from egosearch.variants import resolve_variant
 
     variant = "head_on_imitation_finetune"
@@ -179,7 +184,7 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
     (results / "bench" / "learner.json").write_text(json.dumps({"result": {
         "env_steps_per_core_s_cpu_profile": 10.0, "cpu_profile_steps": "decisions"}}))
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(estimate, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     monkeypatch.setattr(estimate, "stored_cpu_s_per_step", lambda record, results, kind: 0.01)
     rl_phase = config.total_env_steps * 0.01
     unpriced = "plus the teacher's {} episodes and the cloning (no stored measurement prices them)"

@@ -6,7 +6,7 @@ import json
 import pytest
 
 from egosearch.cli import main
-from egosearch.report.run_log import dag_id, read_run_log
+from egosearch.cost.run_log import dag_id, read_run_log
 
 
 def _start(stamp, rule, jobid, wildcards, benchmark=None):
@@ -64,12 +64,13 @@ def test_the_check_sets_a_run_beside_the_simulation_of_its_own_jobs(tmp_path, mo
     (tmp_path / "record.json").write_text(json.dumps(record))
     out = tmp_path / "check.json"
     asked = []
-    monkeypatch.setattr("egosearch.cli.estimate.dag_jobs", lambda target, cores, config: asked.append(config) or [])
+    monkeypatch.setattr("egosearch.cost.schedule_check.dag_jobs",
+                        lambda target, cores, config: asked.append(config) or [])
     assert main(["estimate", "check", "--log", str(tmp_path / "run.log"), "--record", str(tmp_path / "record.json"),
                  "--target", "all", "--out", str(out)]) == 2
     assert "none of the 3 jobs it ran is in the DAG of `all` at the smoke profile" in capsys.readouterr().err
     assert asked == [{"profile": "smoke"}]                      # the run's own profile, read off its jobs
-    monkeypatch.setattr("egosearch.cli.estimate.dag_jobs", lambda target, cores, config: jobs)
+    monkeypatch.setattr("egosearch.cost.schedule_check.dag_jobs", lambda target, cores, config: jobs)
     assert main(["estimate", "check", "--log", str(tmp_path / "run.log"), "--record", str(tmp_path / "record.json"),
                  "--target", "table1", "--out", str(out)]) == 0
     figures = json.loads(out.read_text())

@@ -3,7 +3,7 @@ record gives, the scaling of trainings to another machine, and the real DAG at t
 
 import pytest
 
-from egosearch.report.schedule import (
+from egosearch.cost.schedule import (
     durations_from_provenance,
     machine_key,
     machine_rates,

@@ -224,7 +224,7 @@ def test_a_screen_compares_one_seed_against_the_references_same_seed():
 def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
     """`snakemake -n screen` is where a user plans: the line onstart prints before a real run's first job,
     once (a dry run has 1 core unless --cores says otherwise)."""
-    from egosearch.cli.estimate import print_variant_cost
+    from egosearch.cost.estimate import print_variant_cost
 
     out = run(["-n", "screen", "--config", "variant=head_off"])
     assert out.returncode == 0, out.stderr

@@ -6,9 +6,9 @@ import json
 from pathlib import Path
 
 from egosearch.cli.checks import at_least, check_seed
-from egosearch.cli.estimate import training_time_line
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.core.staging import publish_run
+from egosearch.cost.estimate import training_time_line
 from egosearch.rl.run_files import CheckpointError, check_same_run
 from egosearch.rl.train import train
 from egosearch.runs.evaluate import scenario_evaluator

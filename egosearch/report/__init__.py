@@ -1,7 +1,8 @@
 """The report layer: stored CSVs and JSON in; tables, figures, studies and the docs' generated blocks out.
 Imports numpy, pandas, scipy, matplotlib, yaml and ``egosearch.core`` only (``searches`` also ``egosearch.scene``,
-when it draws); never torch, the simulator or gymnasium. Imported by the CLI (which passes Table 2's rows in)
-and the Snakefile's rules (``workflow_jobs``: the bound files in the DAG's order).
+when it draws); never torch, the simulator or gymnasium. Imported by the CLI (which passes Table 2's rows in),
+the Snakefile's rules (``workflow_jobs``: the bound files in the DAG's order) and the cost model (``egosearch.cost``:
+``workflow_jobs``' config readers and job costs, ``data``'s reading of a stored training).
 """
 
 from egosearch.report.data import (

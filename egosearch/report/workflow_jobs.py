@@ -1,8 +1,8 @@
 """The Snakemake workflow as the report reads it: its config, the variants ``all`` trains, and which
 study a recorded job belongs to and what it cost.
 
-Shared by :mod:`~egosearch.report.readme`, :mod:`~egosearch.report.gpu` and :mod:`~egosearch.report.speed`;
-it imports none of them (yaml and the stdlib only).
+Shared by :mod:`~egosearch.report.readme`, :mod:`~egosearch.report.gpu`, :mod:`~egosearch.report.speed` and the
+cost model (:mod:`egosearch.cost`, which prices a run's jobs with :func:`job_cost_s`); it imports none of them.
 """
 
 from __future__ import annotations

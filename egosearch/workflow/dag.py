@@ -1,5 +1,5 @@
 """The jobs ``snakemake <target>`` would run from a fresh state, as plain data: what the schedule
-simulation (:mod:`egosearch.report.schedule`) reads.
+simulation (:mod:`egosearch.cost.schedule`) reads.
 
 How: a child Python process builds the DAG with Snakemake's own API, the way ``snakemake --forceall
 --dry-run --d3dag --cores N <target>`` does (``Workflow._prepare_dag`` with ``forceall`` and no
@@ -50,7 +50,7 @@ class DagJob:
     wildcards: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
-        """The job as a JSON-ready dict (what :mod:`egosearch.report.schedule` reads)."""
+        """The job as a JSON-ready dict (what :mod:`egosearch.cost.schedule` reads)."""
         return asdict(self) | {"deps": list(self.deps)}
 
 

@@ -1,6 +1,6 @@
 """A finished ``snakemake`` run read back from its log (``.snakemake/log/<date>.snakemake.log``): which
 jobs it ran, when each started and finished, and how long the whole run took. What the schedule
-check of :mod:`egosearch.cli.estimate` compares the simulation with. Text in, data out.
+check of :mod:`egosearch.cost.schedule_check` compares the simulation with. Text in, data out.
 
 Snakemake prints a job's start as a ``[<date>]`` line followed by ``rule NAME:`` (``localrule`` when
 it runs on this machine) and indented fields (``jobid:``, ``benchmark:``, ``wildcards:``), and its end
