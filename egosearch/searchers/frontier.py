@@ -146,26 +146,19 @@ class FrontierPolicy:
         free = self._traversable(grid, offset, local, optimistic=self.target is not None)
         dist = self._distances(free, local, self.RESOLUTION)
         if self.target is not None:
-            # cells from which the target is well within reach, the nearest by path
             rr, cc = np.mgrid[rs, cs]
             ox, oy = self.map.origin
             xs = ox + (cc - self.n // 2 + 0.5) * self.RESOLUTION
             ys = oy + (rr - self.n // 2 + 0.5) * self.RESOLUTION
             near = np.hypot(xs - self.target[0], ys - self.target[1]) - self.env.spec_agent.body_radius
-            goal = np.isfinite(dist) & (near <= self.reach)
-            if not goal.any():  # nothing reachable within reach yet: get as near as the map allows
-                score = np.where(np.isfinite(dist), near + 0.1 * dist, np.inf)
-                goal = score == score.min() if np.isfinite(score).any() else goal
+            end = self.choose_approach(near, dist, offset)
         else:
             next_to_unknown = ndimage.binary_dilation(grid == UNKNOWN, structure=np.ones((3, 3), bool))
             goal = np.isfinite(dist) & next_to_unknown & (dist >= 0.5)
-        if not goal.any():
+            end = self.choose_frontier(goal, dist, offset) if goal.any() else None
+        if end is None:
             self.path = []
             return
-        if self.target is None:
-            end = self.choose_frontier(goal, dist, offset)
-        else:
-            end = np.unravel_index(int(np.argmin(np.where(goal, dist, np.inf))), dist.shape)
         # walk back down the distance field from the goal to the start
         path = [tuple(int(v) for v in end)]
         while path[-1] != local:
@@ -188,6 +181,25 @@ class FrontierPolicy:
         length (m) to each cell. This searcher takes the nearest by path; a searcher that learns where to
         go overrides only this choice and keeps the mapping, planning and walking."""
         return np.unravel_index(int(np.argmin(np.where(frontier, dist, np.inf))), dist.shape)
+
+    def choose_approach(self, near: np.ndarray, dist: np.ndarray, offset: tuple[int, int]) -> tuple[int, int] | None:
+        """Where to walk once the target is seen: a cell of the planning window whose top-left map cell is
+        ``offset``; ``near`` is each cell's distance (m) from the body's surface to the target's estimate,
+        ``dist`` the path length (m) to it (inf where unreachable); None: nowhere to go. This searcher takes
+        the nearest by path of the cells from which the target is well within reach (``near <= self.reach``),
+        and while none is reachable the cell that gets as near as the map allows."""
+        goal = np.isfinite(dist) & (near <= self.reach)
+        if not goal.any():
+            score = np.where(np.isfinite(dist), near + 0.1 * dist, np.inf)
+            if not np.isfinite(score).any():
+                return None
+            goal = score == score.min()
+        return np.unravel_index(int(np.argmin(np.where(goal, dist, np.inf))), dist.shape)
+
+    def target_not_in_view(self) -> None:
+        """Called when the body has stood at the place it walked to for the target for 3 steps without seeing
+        it: this searcher takes the estimate to be off and goes closer (down to 0.1 m)."""
+        self.reach = max(0.1, self.reach - 0.1)
 
     def scan_head(self) -> tuple[float, float]:
         """Where the head looks (pitch, yaw in rad) while no target is known: this searcher sweeps the yaw
@@ -231,8 +243,7 @@ class FrontierPolicy:
             heading = to_target if to_target is not None else s.theta + spec.max_turn
             self.idle += 1
             if self.target is not None and self.idle >= 3 and not seen:
-                # at the goal and the target is not in view: the estimate was off; go closer
-                self.reach = max(0.1, self.reach - 0.1)
+                self.target_not_in_view()
                 self.idle = 0
                 self.last_plan = -99
         elif to_target is not None and not self.head and math.hypot(wx - s.x, wy - s.y) < 0.2:
