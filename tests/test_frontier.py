@@ -77,3 +77,93 @@ def test_the_stored_bound_rows_are_the_nearest_frontier_choice_and_another_choic
 
     other = evaluate("EgoSearch-v0", Farthest, scenarios, seed=0)
     assert [r["path_length"] for r in other] != [r["path_length"] for r in rows]
+
+
+# -- the tuned searcher (egosearch.searchers.frontier_tuned): a teacher and a bound row of its own --------------
+
+def _searcher_on_a_drawn_map(cls):
+    """``cls`` on a map drawn by hand: a 2 m x 4 m block of free floor with one unknown cell inside it (a hole
+    that sparse depth rays leave), the body near the block's left edge, unknown all around."""
+    from egosearch.sim.floormap import FREE
+
+    scenario = generate_scenarios("kitchen_living", "no_low_cabinets", 1.05, n=1, seed=3)[0]
+    env = make_env("EgoSearch-v0", scenario)
+    env.reset(seed=0, options={"scenario": scenario})
+    policy = cls(env)
+    policy.reset()
+    policy.map.origin = (0.0, 0.0)
+    grid = policy.map.grid
+    grid[150:171, 150:191] = FREE
+    hole = (160, 166)  # 0.6 m from the body; the block's open edges are 1 m away or more
+    grid[hole] = 0
+    start = (160, 160)
+    env.close()
+    return policy, start, hole
+
+
+def _explore_goal(policy, start):
+    policy._plan(start)
+    return policy.path[-1]
+
+
+def test_the_tuned_searcher_takes_no_hole_for_a_frontier_and_drops_one_it_reached():
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    untuned, start, hole = _searcher_on_a_drawn_map(FrontierPolicy)
+    assert np.hypot(*np.subtract(_explore_goal(untuned, start), hole)) <= 1.5  # the nearest frontier: the hole
+
+    tuned, start, hole = _searcher_on_a_drawn_map(FrontierTunedPolicy)
+    goal = _explore_goal(tuned, start)
+    assert np.hypot(*np.subtract(goal, hole)) * tuned.RESOLUTION > 0.5
+    assert goal[0] in (150, 170) or goal[1] in (150, 190)  # on the block's open edge
+
+    # a goal the body reached and that stayed unknown is dropped, with the frontier cells around it (0.6 m)
+    tuned.reached_goals.append(goal)
+    again = _explore_goal(tuned, start)
+    assert np.hypot(*np.subtract(again, goal)) * tuned.RESOLUTION > 0.5
+
+
+def test_the_tuned_searcher_keeps_its_goal_unless_another_is_much_nearer():
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    tuned, _, _ = _searcher_on_a_drawn_map(FrontierTunedPolicy)
+    offset, a, b = (100, 100), (5, 5), (5, 25)  # two frontier cells in unknown land: the same gain
+    frontier = np.zeros((10, 30), bool)
+    frontier[a] = frontier[b] = True
+
+    def choose(dist_a, dist_b):
+        dist = np.full(frontier.shape, np.inf)
+        dist[a], dist[b] = dist_a, dist_b
+        return tuple(int(v) for v in tuned.choose_frontier(frontier, dist, offset))
+
+    assert choose(2.0, 2.5) == a
+    assert choose(2.6, 2.0) == a  # the body walked toward b: a is kept (the hysteresis is 1 m)
+    assert choose(3.6, 2.0) == b  # b is cheaper by more than the hysteresis
+
+
+def test_the_tuned_searcher_does_not_stand_again_where_the_target_stayed_out_of_view():
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    tuned, _, _ = _searcher_on_a_drawn_map(FrontierTunedPolicy)
+    rows, cols = np.mgrid[0:30, 0:30]
+    offset = (145, 145)
+    dist = np.hypot(rows - 5, cols - 5) * tuned.RESOLUTION  # the body at window cell (5, 5)
+    near = np.hypot(rows - 20, cols - 20) * tuned.RESOLUTION - 0.2  # the target at window cell (20, 20)
+    first = tuned.choose_approach(near, dist, offset)
+    assert near[first] <= tuned.APPROACH_REACH
+    tuned.tried.append(tuned._xy(first[0] + offset[0], first[1] + offset[1]))
+    second = tuned.choose_approach(near, dist, offset)
+    assert near[second] <= tuned.APPROACH_REACH
+    assert np.hypot(*np.subtract(second, first)) * tuned.RESOLUTION > 0.25  # not within 0.3 m of the first
+
+
+def test_the_tuned_searcher_reads_only_its_pose_and_is_named_by_its_head():
+    from egosearch.cli.acting import policy_factory
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    assert policy_factory("frontier_tuned", None, 0) == (FrontierTunedPolicy, "EgoSearch-v0")
+    assert policy_factory("frontier_tuned_head_off", None, 0) == (FrontierTunedPolicy, "EgoSearchNoHead-v0")
+    scenarios = generate_scenarios("kitchen_living", "everywhere", 1.65, n=6, seed=11)
+    for env_id in ("EgoSearch-v0", "EgoSearchNoHead-v0"):
+        rows = evaluate(env_id, lambda env: FrontierTunedPolicy(PoseOnly(env)), scenarios, seed=0)
+        assert sum(r["success"] for r in rows) >= 4, rows  # the untuned searcher's bar in the test above

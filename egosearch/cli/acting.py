@@ -13,6 +13,7 @@ from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
 from egosearch.sim.envs import (
     ALL_ENV_IDS,
@@ -42,6 +43,12 @@ MODULAR_RANDOM = {floor: BODY_ENV_IDS[env] for env, floor in MODULAR_FLOORS.item
 """The body env each modular floor walks in (:data:`egosearch.sim.envs.MODULAR_FLOORS`)."""
 
 
+FRONTIER_SEARCHERS = {"frontier": FrontierPolicy, "frontier_head_off": FrontierPolicy,
+                      "frontier_tuned": FrontierTunedPolicy, "frontier_tuned_head_off": FrontierTunedPolicy}
+"""The classical searchers by name: the untuned one (Table 1's classical rows) and the one tuned on
+training-side sets (a bound row of its own); each ``*_head_off`` holds the head fixed (its env has none)."""
+
+
 def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
     """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
     trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
@@ -56,8 +63,9 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         return OraclePolicy, env_id or "EgoSearch-v0"
     if kind == "random":
         return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), env_id or "EgoSearch-v0"
-    if kind in ("frontier", "frontier_head_off"):
-        return FrontierPolicy, env_id or ("EgoSearch-v0" if kind == "frontier" else "EgoSearchNoHead-v0")
+    if kind in FRONTIER_SEARCHERS:
+        head_env = "EgoSearchNoHead-v0" if kind.endswith("_head_off") else "EgoSearch-v0"
+        return FRONTIER_SEARCHERS[kind], env_id or head_env
     if kind in MODULAR_RANDOM:
         from egosearch.searchers.modular import ModularPolicy  # local: it loads the physics
 
@@ -81,12 +89,12 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         env_id = env_id or trained or "EgoSearch-v0"
         actor.check_env(env_id)
         return (lambda env: actor), env_id
-    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, frontier, frontier_head_off, "
+    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, {', '.join(FRONTIER_SEARCHERS)}, "
                      f"{', '.join(MODULAR_RANDOM)}, actor")
 
 
-HEAD_OF_SEARCHER = {"frontier": True, "frontier_head_off": False, "modular_random": True,
-                    "modular_random_head_off": False}
+HEAD_OF_SEARCHER = {"frontier": True, "frontier_head_off": False, "frontier_tuned": True,
+                    "frontier_tuned_head_off": False, "modular_random": True, "modular_random_head_off": False}
 """Whether each reference searcher that is named by its head moves the head (the env decides it)."""
 
 

@@ -51,12 +51,15 @@ def add_evaluate(sub) -> None:
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
     p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
                                                      "target), random, frontier / frontier_head_off (the "
-                                                     "classical searcher, head moving or fixed), or "
+                                                     "classical searcher, head moving or fixed), "
+                                                     "frontier_tuned / frontier_tuned_head_off (the same tuned on "
+                                                     "training-side sets: a teacher and a bound of its own), or "
                                                      "modular_random / modular_random_head_off (the modular "
                                                      "searcher's walk with random decisions)")
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
-    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier, "
-                                    "EgoSearchNoHead-v0 for frontier_head_off and modular_random_head_off")
+    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier/"
+                                    "frontier_tuned, EgoSearchNoHead-v0 for frontier_head_off, "
+                                    "frontier_tuned_head_off and modular_random_head_off")
     p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "

@@ -19,7 +19,7 @@ from egosearch.sim.envs import REFERENCE_SEARCHERS
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
-CLASSICAL_SEARCHERS = ("frontier", "frontier_head_off")
+CLASSICAL_SEARCHERS = ("frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off")
 """The names in ``claims_pairs`` that are the classical searchers (traced by the ``trace_bound`` rule), not
 variant files."""
 
