@@ -76,3 +76,40 @@ def test_the_head_off_body_learns_from_the_head_fixed_searcher(tmp_path):
     buf = load_demonstrations(path, cfg).buffers[0]
     assert buf.action.shape[1] == env.action_space.shape[0] < 5  # no head angles to act on
     env.close()
+
+
+def test_demonstrations_from_the_tuned_teacher_are_its_actions(tmp_path):
+    """demo_teacher: frontier_tuned stores the tuned searcher's actions (not the untuned one's) and says so."""
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    cfg = load_config("cpu", {**FROM_SCRATCH, "seed": 3, "demo_episodes": 2, "demo_teacher": "frontier_tuned"})
+    path = tmp_path / "tuned.replay.npz"
+    summary = collect_demonstrations("EgoSearch-v0", cfg, ENV, 2, path, seed=2, progress=False)
+    assert summary["teacher"] == "frontier_tuned" and summary["teacher_head"]
+    buf = load_demonstrations(path, cfg).buffers[0]
+    env = make_train_env(summary["env_id"], train_env_kwargs(cfg, ENV))
+    differs = 0
+    for episode in range(2):
+        obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * 2 + episode)
+        tuned, untuned = FrontierTunedPolicy(env), FrontierPolicy(env)
+        first = 0 if episode == 0 else int(np.flatnonzero(buf.terminated | buf.truncated)[0]) + 1
+        for t in range(first, buf.n_added):
+            action = tuned.act(obs)
+            np.testing.assert_allclose(buf.action[t], action, atol=1e-6)
+            differs += not np.allclose(untuned.act(obs), action, atol=1e-6)  # the untuned one, shown the same
+            obs, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                break
+    env.close()
+    assert differs > 0  # the untuned teacher would have acted otherwise somewhere: the test tells them apart
+
+
+def test_a_teacher_is_named_only_with_demonstrations():
+    from egosearch.rl.config import DEMO_TEACHERS
+    from egosearch.rl.demos import TEACHERS
+
+    assert tuple(TEACHERS) == DEMO_TEACHERS
+    with pytest.raises(ValueError, match="demo_teacher='frontier_tuned' .*unless demo_episodes >= 1"):
+        load_config("cpu", {**FROM_SCRATCH, "demo_teacher": "frontier_tuned"})
+    with pytest.raises(ValueError, match="demo_teacher='oracle' .*allowed: frontier, frontier_tuned"):
+        load_config("cpu", {**FROM_SCRATCH, "demo_episodes": 5, "demo_teacher": "oracle"})

@@ -42,6 +42,9 @@ DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 ``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
 ENCODER_AUX_LOSSES = ("none", "reconstruction")
 """Auxiliary losses on the "sac_drq" encoder (see ``LearnerConfig.encoder_aux_loss``)."""
+DEMO_TEACHERS = ("frontier", "frontier_tuned")
+"""The classical searchers demonstrations may come from (see ``LearnerConfig.demo_teacher``;
+``egosearch.rl.demos.TEACHERS`` maps each to its class)."""
 
 _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
                       "tanh": "Tanh"}
@@ -352,11 +355,17 @@ class LearnerConfig:
     # the paper's learner does not have). The actor, its file and every evaluation are as without them.
     demo_episodes: int = 0
     """Paper: 0 (no demonstrations). N > 0: a fresh training first runs the classical frontier searcher
-    (``egosearch.searchers.frontier``, untuned, head moving where the body has a head) for N episodes of
-    its own training envs and keeps their transitions (``egosearch.rl.demos``, seeded by ``seed``), for
-    ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from frontier-exploration
-    demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations kept in replay:
-    RLPD (Ball et al., ICML 2023). Their collection is part of the training's time."""
+    (``demo_teacher``: by default ``egosearch.searchers.frontier``, untuned; head moving where the body has a
+    head) for N episodes of its own training envs and keeps their transitions (``egosearch.rl.demos``,
+    seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
+    frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
+    kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time."""
+    demo_teacher: str = "frontier"
+    """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
+    of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
+    classical row (``egosearch.searchers.frontier``). "frontier_tuned": the same searcher tuned on
+    training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row). Either holds its head
+    fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
     bc_updates: int = 0
     """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
     before the first env step, this many behaviour-cloning steps of the encoder and the actor on
@@ -570,6 +579,10 @@ class LearnerConfig:
             bad("demo_batch_fraction", "[0, 1) (the rest of each batch is online)")
         if self.bc_weight < 0:
             bad("bc_weight", ">= 0")
+        if self.demo_teacher not in DEMO_TEACHERS:
+            bad("demo_teacher", ", ".join(DEMO_TEACHERS))
+        if self.demo_teacher != "frontier" and self.demo_episodes == 0:
+            bad("demo_teacher", "frontier (the default) unless demo_episodes >= 1 (no demonstrations, no teacher)")
         uses = {"bc_updates": self.bc_updates > 0, "demo_batch_fraction": self.demo_batch_fraction > 0,
                 "bc_weight": self.bc_weight > 0}
         for name, used in uses.items():

@@ -1,7 +1,9 @@
 """Demonstrations from the classical searcher: the frontier searcher's transitions, as a learner stores them.
 
-The teacher is :class:`egosearch.searchers.frontier.FrontierPolicy`, untuned (it is Table 1's reference
-bound): head moving in an env whose body has a head (``head_on``), head fixed where the body has none
+The teacher is the learner config's ``demo_teacher`` (:data:`TEACHERS`): by default
+:class:`egosearch.searchers.frontier.FrontierPolicy`, untuned (it is Table 1's reference bound), or
+:class:`egosearch.searchers.frontier_tuned.FrontierTunedPolicy` (tuned on training-side sets, its own bound
+row); head moving in an env whose body has a head (``head_on``), head fixed where the body has none
 (``head_off``). It searches the variant's training homes under the training distribution: the same env
 id (with the observation the learner sees, ``target_memory`` included), heights, reward form and
 privileged state as :func:`egosearch.rl.train_env.train_env_kwargs` gives a training, but no start-distance
@@ -11,8 +13,9 @@ curve's evaluation episodes (:data:`DEMO_SEED_BASE`).
 Each transition is stored as the learner's replay stores it (pooled depth frames once each, mask,
 proprioception, privileged state, action, reward, flags): a :class:`egosearch.rl.replay.ReplayBuffer`
 saved as an ``.npz`` (``*.replay.npz``, git-ignored: hundreds of MB), with a JSON summary beside it
-(episodes, steps, the teacher's success, CPU seconds). Imitation samples (obs, action) batches from it;
-RL can draw part of every batch from it (:func:`load_demonstrations` gives it n-step returns).
+(the teacher, episodes, steps, the teacher's success, CPU seconds). Imitation samples (obs, action)
+batches from it; RL can draw part of every batch from it (:func:`load_demonstrations` gives it n-step
+returns).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.run_files import atomic_json
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
 from egosearch.sim.envs import observed_env_id
 from egosearch.sim.scenarios import MAX_STEPS
 
@@ -38,6 +42,8 @@ DEMO_SEED_BASE = 7_000_000
 training curve's evaluation episodes (``rl.train.EVAL_SEED_BASE`` + i); Table 1's scenario sets fix their
 episodes by stored start poses and targets, not by seeds."""
 DEMO_FORMAT = "egosearch-demos-v1"
+TEACHERS = {"frontier": FrontierPolicy, "frontier_tuned": FrontierTunedPolicy}
+"""``LearnerConfig.demo_teacher`` -> the searcher class (``egosearch.rl.config.DEMO_TEACHERS`` names the same)."""
 
 
 def summary_path(replay_path: str | Path) -> Path:
@@ -48,8 +54,8 @@ def summary_path(replay_path: str | Path) -> Path:
 
 def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, episodes: int, out_path: str | Path,
                            seed: int = 0, progress: bool = True) -> dict[str, Any]:
-    """Run the frontier searcher for ``episodes`` training-side episodes of ``env_id`` under ``cfg``'s
-    training env settings and the variant's ``env_kwargs``; store its transitions at ``out_path``
+    """Run the teacher ``cfg.demo_teacher`` for ``episodes`` training-side episodes of ``env_id`` under
+    ``cfg``'s training env settings and the variant's ``env_kwargs``; store its transitions at ``out_path``
     (``*.replay.npz``) and return the summary written beside it (:func:`summary_path`)."""
     if episodes < 1:
         raise ValueError(f"episodes={episodes}; allowed: >= 1")
@@ -69,7 +75,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
         for episode in range(episodes):
             if episode:
                 obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * seed + episode)
-            teacher = new_teacher(env)
+            teacher = new_teacher(env, cfg.demo_teacher)
             stored = stored_observation(obs, cfg)
             total, steps, terminated, truncated = 0.0, 0, False, False
             while not (terminated or truncated):
@@ -91,7 +97,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
     out_path.parent.mkdir(parents=True, exist_ok=True)
     buffer.save(out_path)
     summary = {
-        "format": DEMO_FORMAT, "teacher": "frontier", "teacher_head": bool(teacher.head), "env_id": observed,
+        "format": DEMO_FORMAT, "teacher": cfg.demo_teacher, "teacher_head": bool(teacher.head), "env_id": observed,
         "env_kwargs": train_env_kwargs(cfg, env_kwargs), "seed": seed, "episodes": episodes,
         "transitions": int(sum(lengths)), "teacher_success": round(float(np.mean(successes)), 4),
         "mean_episode_steps": round(float(np.mean(lengths)), 2), "mean_return": round(float(np.mean(returns)), 3),
@@ -117,10 +123,11 @@ def load_demonstrations(path: str | Path, cfg: LearnerConfig, device: str = "cpu
     return replay
 
 
-def new_teacher(env) -> FrontierPolicy:
-    """The frontier searcher for an episode just reset in ``env``, reset itself (a pool of homes swaps its
-    env at each reset, so the teacher is made per episode, for the home the episode is in)."""
-    teacher = FrontierPolicy(getattr(env, "current", env))
+def new_teacher(env, name: str = "frontier") -> FrontierPolicy:
+    """The teacher ``name`` (:data:`TEACHERS`) for an episode just reset in ``env``, reset itself (a pool of
+    homes swaps its env at each reset, so the teacher is made per episode, for the home the episode is in).
+    Its head moves where the env's body has one, and is fixed where it has none."""
+    teacher = TEACHERS[name](getattr(env, "current", env))
     teacher.reset()
     return teacher
 

@@ -1,11 +1,12 @@
 """Imitation before RL: behaviour cloning on the teacher's demonstrations (PIRLNav's first phase), then
 DAgger rounds (Ross, Gordon & Bagnell 2011) in which the student drives and the teacher labels.
 
-The teacher is the classical frontier searcher (:class:`egosearch.searchers.frontier.FrontierPolicy`,
-untuned). Its map updates from whatever it sees, so it can label a trajectory it did not drive: at
-every state the student reaches it is shown the observation and says what it would do there. Those
-labels train the student only by cloning: the stored action is the teacher's, not the one taken, so
-the transitions are no RL data and never join the batches of ``demo_batch_fraction``.
+The teacher is the classical frontier searcher of ``demo_teacher`` (by default
+:class:`egosearch.searchers.frontier.FrontierPolicy`, untuned; see :data:`egosearch.rl.demos.TEACHERS`). Its
+map updates from whatever it sees, so it can label a trajectory it did not drive: at every state the student
+reaches it is shown the observation and says what it would do there. Those labels train the student only by
+cloning: the stored action is the teacher's, not the one taken, so the transitions are no RL data and never
+join the batches of ``demo_batch_fraction``.
 
 :func:`clone` is the cloning loop over any number of sources (the demonstrations, each DAgger round's
 labelled states), drawing from each in proportion to its size. :func:`dagger_round` runs one round.
@@ -81,7 +82,7 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
                                        int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
                                        state_dim=state_dim)
-            teacher = new_teacher(env)
+            teacher = new_teacher(env, cfg.demo_teacher)
             stored = stored_observation(obs, cfg)
             terminated = truncated = False
             while not (terminated or truncated):
