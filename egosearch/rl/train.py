@@ -400,6 +400,7 @@ class _Run:
             return False
         cfg = self.cfg
         wanted = {"env_id": self.env_id, "env_kwargs": json.loads(json.dumps(train_env_kwargs(cfg, self.env_kwargs))),
+                  "teacher": cfg.demo_teacher,
                   "seed": cfg.seed, "episodes": cfg.demo_episodes, "frame_history": cfg.frame_history,
                   "image_size": self.agent.replay_image_size}
         return path.exists() and all(held.get(key) == value for key, value in wanted.items())
