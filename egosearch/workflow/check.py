@@ -15,8 +15,14 @@ import sys
 from pathlib import Path
 
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
-from egosearch.sim.envs import REFERENCE_SEARCHERS
-from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
+from egosearch.variants import (
+    ABLATIONS_DIR,
+    REFERENCE_SEARCHERS,  # sim's, through variants: the workflow sits above variants, not above sim
+    Variant,
+    VariantError,
+    check_learner_config,
+    load_variant,
+)
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
 CLASSICAL_SEARCHERS = ("frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off")
