@@ -51,7 +51,7 @@ onstart:
     # Snakemake builds the first rule, `all`.
     from egosearch.cost.estimate import print_costs
 
-    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, workflow.cores)
+    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given())
 
 
 # A dry run is where a user plans (`snakemake -n screen --config variant=NAME`): it prints the same cost
@@ -63,7 +63,7 @@ if (workflow.is_main_process and workflow.output_settings.dryrun
     from egosearch.cost.estimate import print_costs
 
     named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}]
-    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, workflow.cores)
+    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, cores_given())
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

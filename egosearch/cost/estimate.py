@@ -35,11 +35,16 @@ from egosearch.rl.config import BODY_STEPS, DECISIONS
 from egosearch.workflow.dag import dag_jobs
 
 
-def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int) -> None:
+def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int | None) -> None:
     """What ``snakemake`` prints before the first job of ``targets`` (the Snakefile's ``onstart``, and a
     dry run's start): `all`'s whole DAG from scratch, simulated on ``cores`` (:func:`print_before_a_run`),
     and a comparison's trainings and evaluations still to run (:func:`print_variant_cost`: every one of
-    ``seeds`` for compare, ``screen_seed`` for screen). Where no estimate can be made, a line says why."""
+    ``seeds`` for compare, ``screen_seed`` for screen). Where no estimate can be made, a line says why:
+    ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate."""
+    if cores is None:
+        if "all" in targets or ({"compare", "screen"} & set(targets) and config.get("variant")):
+            print("(no estimate of the cost: the run names no --cores to lay its jobs out on)", file=sys.stderr)
+        return
     if "all" in targets:
         print_before_a_run(profile, cores)
     for target in ("compare", "screen"):

@@ -231,5 +231,5 @@ _DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
                              for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
                                        "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
                                        "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",
-                                       "target_memory")}
+                                       "target_memory", "critic_layer_norm", "demo_teacher")}
 """Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults."""

@@ -6,6 +6,8 @@
 # (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
 from pathlib import Path
 
+from snakemake.exceptions import WorkflowError
+
 from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.sim.envs import MODULAR_FLOORS, REFERENCE_SEARCHERS
@@ -54,6 +56,14 @@ def pathlength_files(variants=None):
     """`pathlength`'s outputs per variant: its numbers under results/, its table and figure under paper_figs/."""
     return [path for v in (variants or VARIANTS)
             for path in (f"{RESULTS}/pathlength/{v}.csv", *(f"{FIGS}/pathlength_{v}.{ext}" for ext in ("md", "png", "pdf")))]
+
+
+def cores_given():
+    """--cores, or None where a run names none (a cluster executor's: there workflow.cores raises)."""
+    try:
+        return workflow.cores
+    except WorkflowError:
+        return None
 
 
 def eval_files(variant, homes=None):
