@@ -380,14 +380,15 @@ class _Run:
             raise CheckpointError(f"{self.ckpt_path} needs the run's demonstrations {path}, which are gone")
         if ckpt is None and not self._own_demonstrations(path):  # kept when a run stopped before its checkpoint
             path.parent.mkdir(parents=True, exist_ok=True)
-            self.say(f"collecting {cfg.demo_episodes} demonstration episodes of the frontier searcher -> {path}")
+            self.say(f"collecting {cfg.demo_episodes} demonstration episodes of {cfg.demo_teacher} -> {path}")
             collect_demonstrations(self.env_id, cfg, self.env_kwargs, cfg.demo_episodes, path, seed=cfg.seed,
                                    progress=progress)
         demos = load_demonstrations(path, cfg, str(self.device))
         if ckpt is not None and "demo_rng" in ckpt:
             demos.buffers[0].rng.bit_generator.state = rng_from_plain(ckpt["demo_rng"])
         summary = json.loads(summary_path(path).read_text(encoding="utf-8"))
-        self.say(f"demonstrations: {summary['episodes']} frontier episodes, {summary['transitions']} transitions, "
+        self.say(f"demonstrations: {summary['episodes']} episodes of {summary.get('teacher', 'frontier')}, "
+                 f"{summary['transitions']} transitions, "
                  f"teacher success {summary['teacher_success']:.2f}, {summary['cpu_s']:.0f} CPU-s")
         return demos, summary
 
