@@ -20,7 +20,8 @@ import jsonschema
 import yaml
 
 from egosearch.rl.config import LearnerConfig, load_config
-from egosearch.sim.envs import REFERENCE_SEARCHERS, observed_env_id
+from egosearch.searchers import registry as searchers
+from egosearch.sim.envs import observed_env_id
 from egosearch.sim.home_pool import check_home_split
 
 #: ``ablations/`` of the working directory (where Snakemake runs), else of this checkout.
@@ -104,9 +105,9 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
         raise VariantError(f"{path}: {where}: {err.message}") from None
     if data["name"] != path.stem:
         raise VariantError(f"{path}: name={data['name']!r} must equal the file name {path.stem!r}")
-    if data["name"] in REFERENCE_SEARCHERS:
+    if data["name"] in searchers.SEARCHERS:
         raise VariantError(f"{path}: name={data['name']!r} is a reference searcher's, whose evaluations sit in the "
-                           f"same folders: name the variant otherwise (taken: {', '.join(REFERENCE_SEARCHERS)})")
+                           f"same folders: name the variant otherwise (taken: {', '.join(searchers.names())})")
     _check_objects(data["train_env"].get("objects") or [], path)
     _check_homes(data["train_env"], path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),
@@ -213,9 +214,9 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
     """Write ``<directory>/<name>.yaml``: a copy of ``template`` with ``name:`` set, ready to edit."""
     if not re.fullmatch(r"[A-Za-z0-9_\-]+", name):
         raise VariantError(f"variant name {name!r}: use letters, digits, '_' and '-' only (it names output folders)")
-    if name in REFERENCE_SEARCHERS:
+    if name in searchers.SEARCHERS:
         raise VariantError(f"variant name {name!r} is a reference searcher's, whose evaluations sit in the same "
-                           f"folders: name the variant otherwise (taken: {', '.join(REFERENCE_SEARCHERS)})")
+                           f"folders: name the variant otherwise (taken: {', '.join(searchers.names())})")
     path = _shown(Path(directory) / f"{name}.yaml")
     if path.exists():
         raise VariantError(f"{path} exists already; edit it, or choose another name")

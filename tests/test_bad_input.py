@@ -294,7 +294,7 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["evaluate", "--scenarios", "s.csv", "--weights", "missing.pt", "--out", "o.csv"],
          "egosearch evaluate: error: missing.pt: no such actor file"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "banana", "--out", "o.csv"],
-         "egosearch evaluate: error: --policy='banana'; allowed: oracle, random, frontier, frontier_head_off, "
+         "egosearch evaluate: error: --policy='banana'; allowed: random, oracle, frontier, frontier_head_off, "
          "frontier_tuned, frontier_tuned_head_off, modular_random, modular_random_head_off, actor"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "modular_random", "--weights", "a.pt", "--out", "o.csv"],
          "egosearch evaluate: error: --weights=a.pt is only read with --policy actor, not --policy modular_random: "

@@ -12,18 +12,8 @@ from egosearch.cli.checks import at_least, learner_profile_of
 from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
-from egosearch.searchers.frontier import FrontierPolicy
-from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
-from egosearch.searchers.policies import OraclePolicy, RandomPolicy
-from egosearch.sim.envs import (
-    ALL_ENV_IDS,
-    BODY_ENV_IDS,
-    ENV_IDS,
-    MODULAR_ENV_IDS,
-    MODULAR_FLOORS,
-    REFERENCE_SEARCHERS,
-    modular_decision_dim,
-)
+from egosearch.searchers import registry as searchers
+from egosearch.sim.envs import ALL_ENV_IDS, BODY_ENV_IDS, ENV_IDS, MODULAR_ENV_IDS
 
 
 def set_acting_threads(threads: int) -> None:
@@ -39,42 +29,21 @@ def check_threads(threads: int) -> None:
     at_least("--threads", threads, 0, "a number of threads (0: all cores)")
 
 
-MODULAR_RANDOM = {floor: BODY_ENV_IDS[env] for env, floor in MODULAR_FLOORS.items()}
-"""The body env each modular floor walks in (:data:`egosearch.sim.envs.MODULAR_FLOORS`)."""
-
-
-FRONTIER_SEARCHERS = {"frontier": FrontierPolicy, "frontier_head_off": FrontierPolicy,
-                      "frontier_tuned": FrontierTunedPolicy, "frontier_tuned_head_off": FrontierTunedPolicy}
-"""The classical searchers by name: the untuned one (Table 1's classical rows) and the one tuned on
-training-side sets (a bound row of its own); each ``*_head_off`` holds the head fixed (its env has none)."""
-
-
 def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
     """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
-    trained actor's is the one it was trained in). An actor that cannot act in the env id is refused
-    here, before any episode, and so are weights given to a policy that has none; an actor trained at
-    another learner profile than the results ``out`` is written beside gets a note."""
-    if weights and kind in REFERENCE_SEARCHERS:
-        # the oracle, random and frontier searchers would run and the weights be ignored without a word
-        raise ValueError(f"--weights={weights} is only read with --policy actor, not --policy {kind}: drop one of "
-                         "them")
-    check_searcher_env(kind, env_id)
-    if kind == "oracle":
-        return OraclePolicy, env_id or "EgoSearch-v0"
-    if kind == "random":
-        return (lambda env: RandomPolicy(env.action_space.shape[0], seed=seed)), env_id or "EgoSearch-v0"
-    if kind in FRONTIER_SEARCHERS:
-        head_env = "EgoSearchNoHead-v0" if kind.endswith("_head_off") else "EgoSearch-v0"
-        return FRONTIER_SEARCHERS[kind], env_id or head_env
-    if kind in MODULAR_RANDOM:
-        from egosearch.searchers.modular import ModularPolicy  # local: it loads the physics
-
-        def random_decisions(env):
-            head = env.unwrapped.spec_agent.head
-            return ModularPolicy(RandomPolicy(modular_decision_dim(head), seed=seed), env)
-
-        return random_decisions, env_id or MODULAR_RANDOM[kind]
-    if kind == "actor":
+    registered searcher's, :mod:`egosearch.searchers.registry`; a trained actor's is the one it was
+    trained in). An actor that cannot act in the env id is refused here, before any episode, and so
+    are weights given to a policy that has none; an actor trained at another learner profile than the
+    results ``out`` is written beside gets a note."""
+    if kind in searchers.SEARCHERS:
+        if weights:
+            # a searcher that is not learned would run and the weights be ignored without a word
+            raise ValueError(f"--weights={weights} is only read with --policy {searchers.ACTOR}, not --policy {kind}: "
+                             "drop one of them")
+        searcher = searchers.get(kind)
+        check_searcher_env(kind, env_id)
+        return searcher.maker(seed), env_id or searcher.env_id
+    if kind == searchers.ACTOR:
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
         actor = ActorPolicy(weights)
@@ -89,25 +58,19 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
         env_id = env_id or trained or "EgoSearch-v0"
         actor.check_env(env_id)
         return (lambda env: actor), env_id
-    raise ValueError(f"--policy={kind!r}; allowed: oracle, random, {', '.join(FRONTIER_SEARCHERS)}, "
-                     f"{', '.join(MODULAR_RANDOM)}, actor")
-
-
-HEAD_OF_SEARCHER = {"frontier": True, "frontier_head_off": False, "frontier_tuned": True,
-                    "frontier_tuned_head_off": False, "modular_random": True, "modular_random_head_off": False}
-"""Whether each reference searcher that is named by its head moves the head (the env decides it)."""
+    raise ValueError(f"--policy={kind!r}; allowed: {', '.join(searchers.names())}, {searchers.ACTOR}")
 
 
 def check_searcher_env(kind: str, env_id: str | None) -> None:
-    """A reference searcher named by its head runs in an env of that head, and every reference searcher
+    """A registered searcher named by its head runs in an env of that head, and every registered searcher
     acts at the body's steps: in another env it would search otherwise than its name says, and its rows
     would be read under that name (a head-off searcher's with a moving head)."""
-    if env_id is None or kind not in REFERENCE_SEARCHERS or env_id not in ALL_ENV_IDS:
+    if env_id is None or kind not in searchers.SEARCHERS or env_id not in ALL_ENV_IDS:
         return
     if env_id in MODULAR_ENV_IDS:
         raise ValueError(f"--env-id={env_id} takes a modular searcher's decisions, and --policy {kind} acts at every "
                          "body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out")
-    wanted, head = HEAD_OF_SEARCHER.get(kind), ENV_IDS[env_id]["head"]
+    wanted, head = searchers.get(kind).head, ENV_IDS[env_id]["head"]
     if wanted is not None and wanted != head:
         other = kind.removesuffix("_head_off") if not wanted else f"{kind}_head_off"
         raise ValueError(f"--env-id={env_id} {'moves' if head else 'fixes'} the head, and --policy {kind} is the "

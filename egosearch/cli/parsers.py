@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
+from egosearch.searchers import registry as searchers
 from egosearch.sim.agent import EVAL_HEIGHTS, HEIGHT_RANGE
 
 LAYOUTS = (f"{', '.join(LAYOUT_NAMES)} (the paper's homes), {', '.join(EASY_LAYOUTS)} (a small home for tests) "
@@ -46,20 +47,34 @@ def add_scenarios(sub) -> None:
     add_force(p)
 
 
+def policy_help() -> str:
+    """``egosearch evaluate --policy``'s choices: ``actor`` and every registered searcher (neighbours with the
+    same help said together)."""
+    groups: list[tuple[list[str], str]] = []
+    for s in searchers.SEARCHERS.values():
+        if groups and s.help and groups[-1][1] == s.help:
+            groups[-1][0].append(s.name)
+        else:
+            groups.append(([s.name], s.help))
+    words = [" / ".join(names) + (f" ({about})" if about else "") for names, about in groups]
+    return ", ".join([f"{searchers.ACTOR} (with --weights)", *words[:-1]]) + (f", or {words[-1]}" if words else "")
+
+
+def env_id_help() -> str:
+    """``--env-id``'s defaults: the env each registered searcher acts in."""
+    by_env: dict[str, list[str]] = {}
+    for s in searchers.SEARCHERS.values():
+        by_env.setdefault(s.env_id, []).append(s.name)
+    return "default: the actor's own env id; " + "; ".join(f"{env} for {', '.join(names)}"
+                                                         for env, names in by_env.items())
+
+
 def add_evaluate(sub) -> None:
     p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
     p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
-    p.add_argument("--policy", default="actor", help="actor (with --weights), oracle (privileged: knows the "
-                                                     "target), random, frontier / frontier_head_off (the "
-                                                     "classical searcher, head moving or fixed), "
-                                                     "frontier_tuned / frontier_tuned_head_off (the same tuned on "
-                                                     "training-side sets: a teacher and a bound of its own), or "
-                                                     "modular_random / modular_random_head_off (the modular "
-                                                     "searcher's walk with random decisions)")
+    p.add_argument("--policy", default="actor", help=policy_help())
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
-    p.add_argument("--env-id", help="default: the actor's own env id; EgoSearch-v0 for oracle/random/frontier/"
-                                    "frontier_tuned, EgoSearchNoHead-v0 for frontier_head_off, "
-                                    "frontier_tuned_head_off and modular_random_head_off")
+    p.add_argument("--env-id", help=env_id_help())
     p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
@@ -232,8 +247,9 @@ def add_report(sub) -> None:
                                             "{placement}/h{height}.csv")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .csv and .tex"))
     r.add_argument("--variant", help="the variant of the files (default: read from their paths)")
-    r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the random searcher and the oracle "
-                                               "(.../eval/{random,oracle}/...): rows that bound the policy")
+    r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the searchers Table 1 sets beside the policy "
+                                               f"({', '.join(searchers.bounds())}: .../eval/SEARCHER/...): rows that "
+                                               "bound the policy")
     add_force(r)
 
     r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")
@@ -243,8 +259,9 @@ def add_report(sub) -> None:
 
     r = reports.add_parser("fig6", help="Figure 6 (success vs env steps) from training curves")
     r.add_argument("files", nargs="+", help="curve.csv files: .../train/{variant}/seed{seed}/curve.csv")
-    r.add_argument("--levels", nargs="*", help="evaluation CSVs of searchers that do not train (random, frontier, "
-                   "frontier_head_off: .../eval/SEARCHER/seedN/...): a horizontal line each")
+    levels = ", ".join(s.name for s in searchers.SEARCHERS.values() if s.fig6_level)
+    r.add_argument("--levels", nargs="*", help=f"evaluation CSVs of searchers that do not train ({levels}: "
+                   ".../eval/SEARCHER/seedN/...): a horizontal line each")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
     add_force(r)
 
@@ -278,7 +295,8 @@ def add_report(sub) -> None:
     r.add_argument("--scenarios", nargs="+", required=True, help="the scenario sets they ran: .../scenarios/{home}/"
                                                                  "{placement}/h{height}.csv")
     r.add_argument("--bounds", nargs="*", help="the reference searchers' evaluation CSVs on the same scenarios "
-                                               "(.../eval/{random,frontier,oracle}/...): a line each")
+                                               f"({', '.join(searchers.bounds())}: .../eval/SEARCHER/...): a line "
+                                               "each")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .png and .pdf"))
     r.add_argument("--out-csv", help="the numbers (default: <out-prefix>.csv)")
     add_force(r)

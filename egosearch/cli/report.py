@@ -20,7 +20,7 @@ from egosearch.report import cli as report
 from egosearch.report.behaviour import behaviour_report, check_pairs, parse_pair, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
 from egosearch.report.data import parse_eval_path
-from egosearch.report.figures import FIG6_LEVELS
+from egosearch.report.figures import fig6_levels
 from egosearch.report.fresh import fresh_report
 from egosearch.report.generalise import generalise_report
 from egosearch.report.pathlength import by_length_path
@@ -449,7 +449,8 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
               if Path(p).exists()]
     # Figure 6's levels: the cells the reference is evaluated in while training (as in the DAG).
     train_env = load_variant(reference).train_env
-    fig6_levels = [p for p in bounds if Path(p).parts[-5] in FIG6_LEVELS and Path(p).parts[-2] == train_env["placement"]
+    levels = fig6_levels()
+    level_files = [p for p in bounds if Path(p).parts[-5] in levels and Path(p).parts[-2] == train_env["placement"]
                    and Path(p).parts[-3] in curve_homes(train_env)]
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
@@ -460,7 +461,7 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     if evals:
         report.cmd_table1(evals, figs / "table1", variant=reference, bounds=bounds)
     if curves:
-        report.cmd_fig6(curves, figs / "fig6", level_files=fig6_levels)
+        report.cmd_fig6(curves, figs / "fig6", level_files=level_files)
     if fullbody:
         report.cmd_fig7(fullbody, figs / "fig7")
     if fullbody_oracle:

@@ -17,7 +17,7 @@ from egosearch.report.data import cells_from_paths, group_eval_paths, output_bas
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
 from egosearch.report.pathlength import by_length_path, compare_by_length, format_by_length, pathlength_report
 from egosearch.report.provenance import check_stored
-from egosearch.report.tables import BOUNDS, compare_report, format_compare, table1, table2
+from egosearch.report.tables import bound_names, compare_report, format_compare, table1, table2
 
 PathLike = str | os.PathLike
 
@@ -34,11 +34,11 @@ def _say(paths: Iterable[Path]) -> None:
 def group_bounds(paths: Iterable[PathLike]) -> dict[str, dict]:
     """Evaluation CSVs of the reference searchers (``.../eval/{random|frontier|...|oracle}/seed{N}/...``) ->
     ``{bound: {(seed, height, placement): [paths]}}``, every bound present (empty when not run)."""
-    out: dict[str, list] = {bound: [] for bound in BOUNDS}
+    out: dict[str, list] = {bound: [] for bound in bound_names()}
     for path in paths:
         bound = parse_eval_path(path)["variant"]
         if bound not in out:
-            names = "|".join(BOUNDS)
+            names = "|".join(out)
             raise ValueError(f"{path}: not a reference searcher's evaluation (expected .../eval/{{{names}}}/...)")
         out[bound].append(path)
     return {bound: group_eval_paths(files) for bound, files in out.items()}

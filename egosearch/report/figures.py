@@ -31,6 +31,7 @@ from egosearch.report.data import (
     suffixed,
 )
 from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, scenario_seed_matrix, two_level_ci, wilson_ci
+from egosearch.searchers import registry as searchers
 
 PathLike = str | os.PathLike
 
@@ -65,13 +66,16 @@ PLANNER_TITLES = {"actor": None, "oracle": "Planner: privileged oracle (knows th
 
 RANDOM = "random"
 """Figure 6's row name of the random searcher (a dashed line: the level a policy must rise above)."""
-RANDOM_LABEL = "random searcher"
-FIG6_LEVELS = {RANDOM: (RANDOM_LABEL, "--", "#555555"),
-               "frontier": ("classical searcher, head moving", "-.", "#000000"),
-               "frontier_head_off": ("classical searcher, head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "#777777")}
-"""Figure 6's levels, searchers that do not train (a horizontal line each: label, line style, colour): the
-floor a policy must rise above and the classical searcher its learning is read against. The row name is
-the searcher's, read from its evaluation files' path (``eval/{searcher}/seed{N}/...``)."""
+
+
+def fig6_levels() -> dict[str, tuple]:
+    """Figure 6's levels, searchers that do not train (a horizontal line each: label, line style, colour): the
+    registered searchers with a ``fig6_level`` (:mod:`egosearch.searchers.registry`), the floor a policy must
+    rise above and the classical searcher its learning is read against. The row name is the searcher's, read
+    from its evaluation files' path (``eval/{searcher}/seed{N}/...``)."""
+    return {s.name: s.fig6_level for s in searchers.SEARCHERS.values() if s.fig6_level}
+
+
 START_LABEL = "policy at step 0"
 """Legend text of the dotted line at each curve's first point (its start: untrained, or cloned)."""
 FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "n_scenarios", "success_rate", "low", "high", "ci_unit")
@@ -126,12 +130,13 @@ def _curve_episodes(curve_paths: list) -> pd.DataFrame | None:
 
 def level_searcher(path: PathLike) -> str:
     """The searcher whose evaluation file ``path`` is (``.../eval/{searcher}/seed{N}/{home}/{placement}/h*.csv``),
-    one of :data:`FIG6_LEVELS`; ValueError otherwise."""
+    one of :func:`fig6_levels`; ValueError otherwise."""
     parts = Path(path).parts
     name = parts[-5] if len(parts) >= 5 else ""
-    if name not in FIG6_LEVELS:
+    levels = fig6_levels()
+    if name not in levels:
         raise ValueError(f"figure6: {path} is no level's evaluation file (.../eval/SEARCHER/seedN/HOME/PLACEMENT/"
-                         f"hH.csv, SEARCHER one of {', '.join(FIG6_LEVELS)})")
+                         f"hH.csv, SEARCHER one of {', '.join(levels)})")
     return name
 
 
@@ -145,7 +150,7 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     than 2 seeds were evaluated at that step).
 
     Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
-    ``level_files``: per-episode CSVs of searchers that do not train (:data:`FIG6_LEVELS`: the random
+    ``level_files``: per-episode CSVs of searchers that do not train (:func:`fig6_levels`: the random
     searcher, the classical searchers; which one a file is comes from its path, :func:`level_searcher`);
     each searcher's pooled success rate and Wilson interval become rows named after it, one at every
     step of the curves (the same level throughout).
@@ -179,14 +184,15 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     by_level: dict[str, list] = {}
     for path in level_files or []:
         by_level.setdefault(level_searcher(path), []).append(path)
-    for name in sorted(by_level, key=list(FIG6_LEVELS).index):
+    levels = fig6_levels()
+    for name in sorted(by_level, key=list(levels).index):
         if name in curves:
-            raise ValueError(f"figure6: a variant may not be called {name!r}, the {FIG6_LEVELS[name][0]}'s row")
+            raise ValueError(f"figure6: a variant may not be called {name!r}, the {levels[name][0]}'s row")
         eps = read_episodes(by_level[name])
         k, n = int(eps["success"].astype(int).sum()), len(eps)
         lo, hi = wilson_ci(k, n, confidence)
         for step in sorted({r["env_steps"] for r in rows}):
-            rows.append({"variant": name, "label": FIG6_LEVELS[name][0], "env_steps": step,
+            rows.append({"variant": name, "label": levels[name][0], "env_steps": step,
                          "n_seeds": int(eps["seed"].nunique()), "n_scenarios": n, "success_rate": k / n,
                          "low": lo, "high": hi, "ci_unit": CI_WILSON})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
@@ -235,12 +241,13 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
     with matplotlib.rc_context(STYLE):
         fig = Figure(figsize=(3.5, 2.5))
         ax = fig.add_subplot()
-        for name, (level_label, style, level_colour) in FIG6_LEVELS.items():
+        levels = fig6_levels()
+        for name, (level_label, style, level_colour) in levels.items():
             level = df[df["variant"] == name]
             if not level.empty:
                 ax.axhline(level["success_rate"].iloc[0], color=level_colour, linestyle=style, linewidth=1.1,
                            label=level_label)
-        trained = df[~df["variant"].isin(list(FIG6_LEVELS))]
+        trained = df[~df["variant"].isin(list(levels))]
         for i, (_variant, g) in enumerate(trained.groupby("variant", sort=False)):
             colour = OKABE_ITO[i % len(OKABE_ITO)]
             x, y = g["env_steps"].to_numpy(), g["success_rate"].to_numpy()

@@ -38,7 +38,8 @@ from matplotlib.figure import Figure
 from egosearch.report.data import HEIGHT_FILE, output_base, parse_eval_path, read_checked_csv, read_episodes, suffixed
 from egosearch.report.figures import OKABE_ITO, STYLE, save_figure
 from egosearch.report.stats import METRICS, compare_cells, scenario_seed_matrix, two_level_ci
-from egosearch.report.tables import BOUND_LABELS, holm_and_write
+from egosearch.report.tables import holm_and_write, searcher_label
+from egosearch.searchers import registry as searchers
 
 PathLike = str | os.PathLike
 
@@ -62,8 +63,14 @@ BY_LENGTH_COLUMNS = ("length_bin", "length_low", "length_high", "metric", "refer
 ``p_holm`` is Holm's adjustment over the rows of this file alone."""
 L_TOLERANCE = 1e-3
 """Largest |ℓ| difference (m) between an evaluation CSV and its scenario file (both round ℓ)."""
-BOUND_STYLE = {"random": ("#555555", "--", "v"), "frontier": ("#8c6d31", "-.", "s"),
-               "frontier_head_off": ("#bd9e39", ":", "D"), "oracle": ("#222222", ":", "^")}
+DEFAULT_STYLE = ("#777777", "--", "x")
+"""The line of a reference searcher without a ``path_style`` of its own (colour, line style, marker)."""
+
+
+def searcher_style(name: str) -> tuple:
+    """A reference searcher's line in the figure: its registered ``path_style``, else :data:`DEFAULT_STYLE`."""
+    searcher = searchers.SEARCHERS.get(name)
+    return searcher.path_style if searcher is not None and searcher.path_style else DEFAULT_STYLE
 
 
 def bin_labels(edges: tuple[float, ...]) -> list[str]:
@@ -220,7 +227,7 @@ def _markdown(df: pd.DataFrame, policy: str, success_radius: float, pct: str, cs
     for by in BINNINGS:
         part = df[df["by"] == by]
         head = (["bin (m)", "scenarios", f"{policy}, all cells"] + [f"{policy}, {h} m" for h in heights]
-                + [f"{BOUND_LABELS.get(b, b)}, all cells" for b in bounds])
+                + [f"{searcher_label(b)}, all cells" for b in bounds])
         md += [f"Success by {BY_LABELS[by]}, {policy}.", "", "| " + " | ".join(head) + " |",
                "|---" * len(head) + "|"]
         for label in bin_labels(BINNINGS[by]):
@@ -256,8 +263,7 @@ def _figure(df: pd.DataFrame, policy: str, base: Path) -> list[Path]:
             offsets = np.linspace(-0.18, 0.18, len(heights)) if len(heights) > 1 else [0.0]
             series += [(policy, h, f"{policy}, {h} m camera", OKABE_ITO[i % len(OKABE_ITO)], "-", "o", offsets[i],
                         0.9) for i, h in enumerate(heights)]
-            series += [(b, ALL_HEIGHTS, BOUND_LABELS.get(b, b), *BOUND_STYLE.get(b, ("#777777", "--", "x")), 0.0, 0.9)
-                       for b in bounds]
+            series += [(b, ALL_HEIGHTS, searcher_label(b), *searcher_style(b), 0.0, 0.9) for b in bounds]
             handles = []
             for searcher, height, label, colour, ls, marker, dx, lw in series:
                 rows = part[(part["searcher"] == searcher) & (part["height"] == height)].set_index("bin").loc[labels]

@@ -17,8 +17,8 @@ import pandas as pd
 from egosearch.core.machine import MACHINE_PLACEHOLDER, machine_folder_name
 from egosearch.report.data import counts_decisions
 from egosearch.report.provenance import WHOLE_RUN_SHARE
-from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import claims_pairs, variants_of_all, workflow_config
+from egosearch.searchers import registry as searchers
 
 ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
 """The issue's one-core targets for the sensor and the env."""
@@ -255,7 +255,7 @@ def _schedule_check_lines(root: Path, profile: str) -> list[str]:
 def block_speed(root: Path, profile: str) -> str:
     config = workflow_config()
     # the profile's pair, and the pairs its claims are also read on (at the cpu profile, the from-scratch one)
-    paired = [v for pair in claims_pairs({**config, "profile": profile}) for v in pair if v not in BOUNDS]
+    paired = [v for pair in claims_pairs({**config, "profile": profile}) for v in pair if v not in searchers.bounds()]
     sections = [_env_lines(root, profile), _learner_lines(root, profile), _hosts_lines(root, profile),
                 _schedule_check_lines(root, profile),
                 _training_lines(root, profile, list(dict.fromkeys(variants_of_all(config) + paired)))]

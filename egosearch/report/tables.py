@@ -21,6 +21,7 @@ from egosearch.report.stats import (
     two_level_ci,
     wilson_ci,
 )
+from egosearch.searchers import registry as searchers
 
 PAPER_TABLE1: dict[tuple[float, str], float] = {
     (0.45, "no_low_cabinets"): 0.50, (1.05, "no_low_cabinets"): 0.92, (1.65, "no_low_cabinets"): 0.90,
@@ -37,20 +38,35 @@ BOTH_HOMES = "both"
 """The ``home`` of Table 1's rows pooled over every home evaluated: the rows set beside the paper's column,
 because the paper tests in both of its homes (Section 6) and gives one number per cell."""
 
-BOUNDS = ("random", "frontier", "frontier_head_off", "oracle")
-"""The searchers Table 1 sets beside each policy, on the same scenario sets: uniform random actions, the
-classical frontier searcher from the actor's observation and its own pose (head moving, then held
-fixed: ``egosearch.searchers.frontier``), and the privileged oracle (knows the target and walks the shortest path
-to it)."""
-BOUND_LABELS = {"random": "random searcher", "frontier": "frontier searcher (classical)",
-                "frontier_head_off": "frontier searcher, head fixed", "oracle": "privileged oracle"}
-BOUND_WHAT = {"random": "uniform random actions",
-              "frontier": "maps depth with its own pose, walks to the nearest frontier, scans with its head, "
-                          "then walks to the target it saw (a reference, not tuned)",
-              "frontier_head_off": "the same with the camera fixed to the body",
-              "oracle": "knows the target and walks the shortest path to it"}
-BOUND_COLUMNS = tuple(f"{b}_{c}" for b in BOUNDS for c in ("n_episodes", "success_rate", "wilson_low",
-                                                            "wilson_high", "spl"))
+BOUND_STATS = ("n_episodes", "success_rate", "wilson_low", "wilson_high", "spl")
+"""Table 1's columns of each bound: ``{bound}_{stat}``."""
+
+
+def bound_names() -> tuple[str, ...]:
+    """The searchers Table 1 sets beside each policy, on the same scenario sets, in its order (the registered
+    bounds, :func:`egosearch.searchers.registry.bounds`): the random searcher (uniform random actions), the
+    classical frontier searcher from the actor's observation and its own pose (head moving, then held fixed:
+    ``egosearch.searchers.frontier``), and the privileged oracle (knows the target and walks the shortest path to
+    it)."""
+    return searchers.bounds()
+
+
+def searcher_label(name: str) -> str:
+    """A searcher's short label in the tables (its name when it is no registered searcher, or has no label)."""
+    searcher = searchers.SEARCHERS.get(name)
+    return searcher.label if searcher is not None and searcher.label else name
+
+
+def bound_columns(bounds: Iterable[str] | None = None) -> tuple[str, ...]:
+    """Table 1's columns of the bounds (every registered bound by default)."""
+    return tuple(f"{b}_{c}" for b in (bound_names() if bounds is None else bounds) for c in BOUND_STATS)
+
+
+def _always_shown(name: str) -> bool:
+    """The floor and the ceiling stand in Table 1 (as "not run") even without files."""
+    return searchers.get(name).table_row != searchers.BESIDE
+
+
 NOT_RUN = "not run"
 
 TABLE2_CAPTION = "A complete set of CURL hyperparameters used to conduct all of the training experiments."
@@ -140,7 +156,7 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
     rates (NaN with one seed); ``paper_success_rate`` the paper's value (NaN where it has none).
 
     ``bounds`` (``{"random" | "oracle": {(seed, height, placement): paths}}``, either side possibly
-    empty) adds :data:`BOUND_COLUMNS`: the bound searchers' pooled success rate, Wilson interval and
+    empty) adds :func:`bound_columns`: the bound searchers' pooled success rate, Wilson interval and
     SPL on each cell (NaN and 0 episodes where a bound was not run). A bound runs one seed, each
     scenario once, so its episodes are independent and the Wilson interval is right for it. They
     must have run on the policy's scenario sets: a cell the policy lacks is an error.
@@ -149,9 +165,10 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
         raise ValueError("table1: no evaluation files given")
     cells = _read_cells(episode_files, "table1")
     bound_cells = {}
+    all_bounds = bound_names()
     for bound, files in (bounds or {}).items():
-        if bound not in BOUNDS:
-            raise ValueError(f"table1: bound {bound!r}; allowed: {', '.join(BOUNDS)}")
+        if bound not in all_bounds:
+            raise ValueError(f"table1: bound {bound!r}; allowed: {', '.join(all_bounds)}")
         bound_cells[bound] = _read_cells(files, f"table1 {bound}")
         extra = set(bound_cells[bound]) - set(cells)
         if extra:
@@ -169,9 +186,9 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
                      "seed_boot_low": blo, "seed_boot_high": bhi, "spl": spl_mean, "spl_low": spl_lo,
                      "spl_high": spl_hi, "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
         if bounds is not None:
-            for bound in BOUNDS:
+            for bound in all_bounds:
                 rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((home, h, pl)), bound, confidence))
-    columns = list(TABLE1_COLUMNS) + (list(BOUND_COLUMNS) if bounds is not None else [])
+    columns = list(TABLE1_COLUMNS) + (list(bound_columns(all_bounds)) if bounds is not None else [])
     return pd.DataFrame(rows, columns=columns)
 
 
@@ -211,10 +228,11 @@ def _table1_section(df: pd.DataFrame, title: str, variant: str | None, with_boun
     heights, placements = _table1_grid(df)
     heads = [PLACEMENT_LABELS.get(p, p) for p in placements]
     ours = f"ours ({variant})" if variant else "ours"
-    present = [b for b in BOUNDS if with_bounds and (b in ("random", "oracle") or df[f"{b}_n_episodes"].any())]
-    searchers = ([("random", BOUND_LABELS["random"])] if "random" in present else []) + [("ours", ours)]
-    searchers += [(b, BOUND_LABELS[b]) for b in present if b not in ("random", "oracle")]
-    searchers += ([("oracle", BOUND_LABELS["oracle"])] if "oracle" in present else []) + [("paper", "paper")]
+    present = [b for b in bound_names() if with_bounds and (_always_shown(b) or df[f"{b}_n_episodes"].any())]
+    place = {b: searchers.get(b).table_row for b in present}
+    rows = ([(b, searcher_label(b)) for b in present if place[b] == searchers.FLOOR] + [("ours", ours)]
+            + [(b, searcher_label(b)) for b in present if place[b] == searchers.BESIDE]
+            + [(b, searcher_label(b)) for b in present if place[b] == searchers.CEILING] + [("paper", "paper")])
     md = [title, "", "| Head height | Searcher | " + " | ".join(heads) + " |", "|---|---|" + "---|" * len(heads)]
     tex = [r"\begin{table}[t]", r"\centering", r"\small", r"\begin{tabular}{ll" + "c" * len(heads) + "}",
            r"\toprule", "Head height & Searcher & " + " & ".join(_tex_escape(x) for x in heads) + r" \\",
@@ -222,7 +240,7 @@ def _table1_section(df: pd.DataFrame, title: str, variant: str | None, with_boun
     for i, h in enumerate(heights):
         if i:
             tex.append(r"\midrule")
-        for j, (who, name) in enumerate(searchers):
+        for j, (who, name) in enumerate(rows):
             cells = [_searcher_cell(df, h, p, who) for p in placements]
             md.append(f"| {_height_label(h)} | {name} | " + " | ".join(cells) + " |")
             tex.append(f"{_height_label(h) if j == 0 else ''} & {_tex_escape(name)} & "
@@ -270,10 +288,10 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
         if not i:
             if with_bounds:
                 bound_eps = {b: "/".join(str(int(n)) for n in sorted(set(part[f"{b}_n_episodes"])) if n) or "0"
-                             for b in BOUNDS}
-                shown = [b for b in BOUNDS if b in ("random", "oracle") or bound_eps[b] != "0"]
+                             for b in bound_names()}
+                shown = [b for b in bound_eps if _always_shown(b) or bound_eps[b] != "0"]
                 notes = " ".join(
-                    f"{BOUND_LABELS[b][0].upper() + BOUND_LABELS[b][1:]}: {BOUND_WHAT[b]}, "
+                    f"{searcher_label(b)[0].upper() + searcher_label(b)[1:]}: {searchers.get(b).what}, "
                     + (f"{bound_eps[b]} episodes per cell on the same scenarios, one seed (independent episodes: "
                        f"{pct} Wilson interval)." if bound_eps[b] != "0"
                        else f"{NOT_RUN} (no stored per-episode CSVs; rule `bound`).") for b in shown)

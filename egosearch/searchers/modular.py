@@ -36,6 +36,7 @@ import numpy as np
 from gymnasium import spaces
 
 from egosearch.searchers.frontier import FrontierPolicy
+from egosearch.searchers.policies import RandomPolicy
 from egosearch.sim.env import MASK_FEATURE_DIM, SearchEnv
 from egosearch.sim.envs import MODULAR_MAP_CELL_SIZE, MODULAR_MAP_CELLS, MODULAR_MAP_DIM, modular_decision_dim
 
@@ -219,3 +220,10 @@ class ModularPolicy:
             setattr(self.searcher, k, copy.deepcopy(v))
         self.searcher.map.set_state(snap["map"])
         self.decided = snap["decided"]
+
+
+def random_decisions(env, seed: int = 0) -> ModularPolicy:
+    """The modular searcher's floor (``--policy modular_random``, ``modular_random_head_off``): its walk in the
+    body env ``env``, each decision (of the head's size) drawn uniformly at random."""
+    head = env.unwrapped.spec_agent.head
+    return ModularPolicy(RandomPolicy(modular_decision_dim(head), seed=seed), env)

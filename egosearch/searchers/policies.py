@@ -38,6 +38,11 @@ class RandomPolicy:
         return self.rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32)
 
 
+def random_searcher(env, seed: int = 0) -> RandomPolicy:
+    """``--policy random``: uniform random actions of ``env``'s size."""
+    return RandomPolicy(env.action_space.shape[0], seed=seed)
+
+
 class OraclePolicy:
     """A privileged searcher that proves the task solvable: it knows the target, walks the
     geodesic shortest path to the nearest pose that sees it, and aims the camera at it.

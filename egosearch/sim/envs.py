@@ -39,18 +39,6 @@ def modular_decision_dim(head: bool) -> int:
 BODY_ENV_IDS = {"EgoSearchModular-v0": "EgoSearch-v0", "EgoSearchNoHeadModular-v0": "EgoSearchNoHead-v0"}
 """The body env of each decision env: where ``egosearch.searchers.modular.ModularPolicy`` acts step by step."""
 
-MODULAR_FLOORS = {"EgoSearchModular-v0": "modular_random", "EgoSearchNoHeadModular-v0": "modular_random_head_off"}
-"""A modular searcher's floor, by the decision env its high level was trained in: the same walk (and head
-sweep) with each decision drawn uniformly at random (``egosearch evaluate --policy modular_random``). What a
-trained high level beats it by is what its learned decisions add."""
-
-REFERENCE_SEARCHERS = ("random", "oracle", "frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off",
-                       *MODULAR_FLOORS.values())
-"""The names ``egosearch evaluate --policy`` runs without weights. Their evaluations sit where a variant's
-would (``results/<profile>/eval/<name>/``), so no variant may take one of these names. ``frontier_tuned``
-(and its head-fixed twin) is the frontier searcher tuned on training-side sets
-(:mod:`egosearch.searchers.frontier_tuned`): a teacher and a bound row of its own, never Table 1's classical row."""
-
 ALL_ENV_IDS = (*ENV_IDS, *MODULAR_ENV_IDS)
 """Every id a policy may be trained and evaluated in."""
 

@@ -15,19 +15,10 @@ import sys
 from pathlib import Path
 
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
-from egosearch.variants import (
-    ABLATIONS_DIR,
-    REFERENCE_SEARCHERS,  # sim's, through variants: the workflow sits above variants, not above sim
-    Variant,
-    VariantError,
-    check_learner_config,
-    load_variant,
-)
+from egosearch.searchers import registry as searchers
+from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
-CLASSICAL_SEARCHERS = ("frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off")
-"""The names in ``claims_pairs`` that are the classical searchers (traced by the ``trace_bound`` rule), not
-variant files."""
 
 
 class ConfigError(ValueError):
@@ -109,7 +100,7 @@ def workflow_variants(config: dict, compare: bool | str = False,
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
     claims = [(where, name) for where, pairs in every_claims_pairs(config) for pair in pairs for name in pair
-              if name not in CLASSICAL_SEARCHERS]
+              if name not in searchers.classical()]  # the classical searchers: traced by trace_bound
     # the config key that names each variant first: an unknown name's line says which key to fix
     named_by: dict[str, str] = {}
     for key, name in ([("variants", n) for n in config["variants"]]
@@ -144,7 +135,7 @@ def _named_variant(name: str, key: str, directory: Path) -> Variant:
     """The variant file ``name`` that the config's ``key`` names; a name with no file is refused naming
     the key (a reference searcher's name too: its evaluations are no variant's)."""
     if not (Path(directory) / f"{name}.yaml").is_file():
-        if name in REFERENCE_SEARCHERS:
+        if name in searchers.SEARCHERS:
             raise VariantError(f"config {key}: {name!r} is a reference searcher, not a variant (a file in "
                                f"{Path(directory).name}/, e.g. head_on)")
         try:

@@ -8,10 +8,9 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from egosearch.report.tables import BOUNDS
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
-from egosearch.sim.envs import MODULAR_FLOORS, REFERENCE_SEARCHERS
-from egosearch.workflow.check import CLASSICAL_SEARCHERS, claims_pairs
+from egosearch.searchers import registry as searchers
+from egosearch.workflow.check import claims_pairs
 
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"
@@ -146,9 +145,17 @@ def screen_candidate(wildcards):
 # The floor, the classical searcher and the ceiling of Table 1, on the very scenario sets the policies
 # are evaluated on.
 # Their CSVs sit beside the variants' (eval/random, eval/frontier, ...): a variant may not take those names.
-# BOUNDS: random, frontier, frontier_head_off, oracle. One seed (BOUND_SEEDS): the oracle is
-# deterministic, and the random searcher's spread over 100 scenarios per cell is far wider than its
-# spread over seeds. bound_eval_files is the order `egosearch report regenerate` reads them in too.
+# BOUNDS (the registered bounds, egosearch.searchers.registry: random, frontier, frontier_head_off,
+# oracle). One seed (BOUND_SEEDS): the oracle is deterministic, and the random searcher's spread over 100
+# scenarios per cell is far wider than its spread over seeds. bound_eval_files is the order `egosearch
+# report regenerate` reads them in too.
+# REFERENCE_SEARCHERS is every registered searcher (evaluated by the bound rule), CLASSICAL_SEARCHERS
+# those claims_pairs may name (traced by trace_bound), MODULAR_FLOORS a modular searcher's floor by the
+# decision env its high level trained in (read by decisions_floor).
+BOUNDS = searchers.bounds()
+REFERENCE_SEARCHERS = searchers.names()
+CLASSICAL_SEARCHERS = searchers.classical()
+MODULAR_FLOORS = searchers.modular_floors()
 
 
 def bound_files(bounds=BOUNDS, placements=None, homes=None):
@@ -162,7 +169,7 @@ def fig6_level_files():
 
     train_env = VARIANTS[REF].train_env
     homes = [h for h in curve_homes(train_env) if h in HOMES]
-    levels = [b for b in ("random", "frontier", "frontier_head_off") if b in BOUNDS]
+    levels = [b for b in BOUNDS if searchers.get(b).fig6_level]
     return bound_files(levels, [train_env["placement"]], homes) if train_env["placement"] in PLACEMENTS and homes else []
 
 

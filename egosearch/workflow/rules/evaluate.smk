@@ -46,8 +46,9 @@ rule evaluate_start:
         "--seed {wildcards.seed} --out {output} > {log} 2>&1"
 
 
-# eval/random/... and eval/oracle/... are the bounds' (BOUNDS in egosearch.report.tables), not variants; so are
-# eval/modular_random/... (REFERENCE_SEARCHERS: the modular searcher's floor, read by the decisions_floor rule).
+# eval/random/... and eval/oracle/... are the bounds' (BOUNDS), not variants; so are those of every other
+# registered searcher (REFERENCE_SEARCHERS, egosearch.searchers.registry), eval/modular_random/... among them (the
+# modular searcher's floor, read by the decisions_floor rule).
 ruleorder: bound > evaluate
 
 
