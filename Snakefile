@@ -35,6 +35,7 @@ rule all:
         # Every variant on every Table 1 cell: `compare --config variant=head_off` then needs no run.
         [eval_files(v) for v in VARIANTS],
         rules.table1.output,
+        rules.learning_adds.input,
         rules.table2.output,
         rules.table2_paper.output,
         rules.fig6.output,
@@ -51,7 +52,8 @@ onstart:
     # Snakemake builds the first rule, `all`.
     from egosearch.cost.estimate import print_costs
 
-    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given())
+    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given(),
+                trainings_per_gpu=TRAININGS_PER_GPU)
 
 
 # A dry run is where a user plans (`snakemake -n screen --config variant=NAME`): it prints the same cost
@@ -63,7 +65,7 @@ if (workflow.is_main_process and workflow.output_settings.dryrun
     from egosearch.cost.estimate import print_costs
 
     named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}]
-    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, cores_given())
+    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, cores_given(), trainings_per_gpu=TRAININGS_PER_GPU)
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

@@ -40,11 +40,12 @@ BAD_VARIANT_FILES = [
      "ablations/steps_float.yaml: config: total_env_steps='2.5e4' is not an int"),
     ("steps_below_warmup", HEAD + "config: {total_env_steps: 500}\n",
      "ablations/steps_below_warmup.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=500 is "
-     "out of range; allowed: >= 1000, the env step of the first update (after init_steps=1000 random steps, an "
-     "update every 1 steps): fewer train no update"),
-    ("cloning_without_teacher", HEAD + "config: {bc_updates: 5000}\n",
-     "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=5000 is "
-     "out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations)"),
+     "out of range; allowed: >= 4000, the env step of the first update (after init_steps=4000 random steps, an "
+     "update every 4 steps): fewer train no update"),
+    ("cloning_without_teacher", HEAD + "config: {demo_episodes: 0}\n",
+     "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=12000 "
+     "is out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations "
+     "set bc_updates: 0, critic_warmup_updates: 0, demo_batch_fraction: 0, bc_weight: 0, bc_decay_steps: 0"),
     ("half_batches_all_demos", HEAD + "config: {demo_episodes: 100, demo_batch_fraction: 1.0}\n",
      "ablations/half_batches_all_demos.yaml: config (on the cpu learner profile): "
      "LearnerConfig.demo_batch_fraction=1.0 is out of range; allowed: [0, 1) (the rest of each batch is online)"),

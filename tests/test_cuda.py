@@ -325,26 +325,33 @@ def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):
 
 @pytest.mark.gpu
 @needs_cuda
-def test_the_default_profiles_modular_searcher_trains_on_cuda_and_its_actor_walks_on_the_cpu(tmp_path):
-    """The ``cpu`` profile (the default) is a modular searcher: on a machine with CUDA its training runs there
-    (the decision env, the searcher's map in the observation, the privileged critic, one update per decision),
-    and the actor it leaves walks the body env on the CPU as evaluation runs it."""
+def test_the_default_profile_imitates_then_fine_tunes_on_cuda_and_its_actor_walks_on_the_cpu(tmp_path):
+    """The ``cpu`` profile (the default) learns from the frontier searcher's demonstrations, then fine-tunes
+    at every body step: on a machine with CUDA its training runs there (the teacher's episodes, the clone,
+    the critic's warm-up, SAC with demonstrations in every batch, the privileged critic), and the actor and
+    the start it leaves walk the body env on the CPU as evaluation runs them."""
     from egosearch.cli.acting import policy_factory
+    from egosearch.rl.run_files import START_ACTOR_NAME
     from egosearch.runs.evaluate import evaluate
     from egosearch.sim.scenarios import generate_scenarios
 
     cfg = load_config("cpu", {"device": "cuda", "total_env_steps": 64, "init_steps": 16, "eval_every": 64,
-                              "eval_episodes": 1, "checkpoint_every": 64, "log_every": 32, "curriculum_steps": 32})
-    assert cfg.modular_searcher and cfg.critic_privileged_state
-    done = train("EgoSearchModular-v0", cfg, tmp_path, {"layout": "kitchen_living"}, progress=False)
+                              "eval_episodes": 1, "checkpoint_every": 64, "log_every": 32, "curriculum_steps": 32,
+                              "demo_episodes": 2, "bc_updates": 8, "critic_warmup_updates": 2, "bc_decay_steps": 32})
+    assert not cfg.modular_searcher and cfg.demo_episodes and cfg.critic_privileged_state and cfg.target_memory
+    done = train("EgoSearch-v0", cfg, tmp_path, {"layout": "kitchen_living"}, progress=False)
     assert done["env_steps"] == 64 and done["updates"] > 0 and done["machine"]["gpu"] == torch.cuda.get_device_name()
-    state = torch.load(tmp_path / "actor.pt", weights_only=True)
-    assert all(v.device.type == "cpu" for v in state["state_dict"].values())
-    make_policy, env_id = policy_factory("actor", str(tmp_path / "actor.pt"), 0)
-    assert env_id == "EgoSearch-v0"
-    rows = evaluate(env_id, make_policy, generate_scenarios("kitchen_living", "everywhere", 1.05, n=2, seed=4), seed=0)
-    assert len(rows) == 2 and all(1 <= r["steps"] <= 100 for r in rows)
-    _report("modular_cpu_profile", {"env_steps": done["env_steps"], "updates": done["updates"]})
+    assert done["imitation"]["bc_updates"] == 8 and done["demonstrations"]["episodes"] == 2
+    for name in ("actor.pt", START_ACTOR_NAME):
+        state = torch.load(tmp_path / name, weights_only=True)
+        assert all(v.device.type == "cpu" for v in state["state_dict"].values())
+        make_policy, env_id = policy_factory("actor", str(tmp_path / name), 0)
+        assert env_id == "EgoSearchMemory-v0"
+        rows = evaluate(env_id, make_policy, generate_scenarios("kitchen_living", "everywhere", 1.05, n=2, seed=4),
+                        seed=0)
+        assert len(rows) == 2 and all(1 <= r["steps"] <= 100 for r in rows)
+    _report("cpu_profile", {"env_steps": done["env_steps"], "updates": done["updates"],
+                            "bc_updates": done["imitation"]["bc_updates"]})
 
 
 def test_an_actor_trained_on_cuda_loads_and_acts_on_this_machine():

@@ -795,3 +795,26 @@ def test_the_cuda_tests_of_a_later_tree_and_a_gpu_hosts_benchmark_are_read_from_
     assert "(64 decisions, 49 updates)" in lines[1]
     assert len(lines) == 3 and "(Some GPU, 16 cores, 2026-01-02;" in lines[2] and "**11.7 decisions per core-second**" \
         in lines[2]
+
+
+def test_table1_notes_say_what_learning_adds_from_the_comparison_against_the_start(tmp_path):
+    from egosearch.report.tables import learning_adds_note
+
+    rows = ["height,placement,metric,reference,candidate,difference,ci_low,ci_high,p_uncorrected,p_holm,"
+            "significant_holm,n_scenarios,n_seeds_ref,n_seeds_cand,detectable_80,homes"]
+    for h, d in ((0.45, 0.02), (1.05, 0.125)):
+        for placement in ("no_low_cabinets", "everywhere"):
+            rows.append(f"{h},{placement},success,0.5,{0.5 + d},{d},{d - 0.05},{d + 0.05},0.01,0.02,True,400,3,3,"
+                        "0.05,x")
+            rows.append(f"{h},{placement},spl,0.3,0.9,0.6,0.5,0.7,0.01,0.02,True,400,3,3,0.05,x")
+    path = tmp_path / "head_on_vs_its_start.csv"
+    path.write_text("\n".join(rows) + "\n")
+    note = learning_adds_note(path, "head_on")
+    assert note.startswith("What learning adds: ours (head_on) against its own start")
+    assert "3 seed(s)" in note and "(head_on_vs_its_start.csv)" in note
+    # success rows only (the SPL rows' +0.60 never shows), per height, excluding cabinets first
+    assert "0.45m +0.02 [-0.03, +0.07] excluding cabinets, +0.02 [-0.03, +0.07] everywhere" in note
+    assert "1.05m +0.12 [+0.07, +0.17] excluding cabinets" in note and "+0.60" not in note
+    (tmp_path / "bad.csv").write_text(rows[0] + "\n")
+    with pytest.raises(ValueError, match="no success rows"):
+        learning_adds_note(tmp_path / "bad.csv")

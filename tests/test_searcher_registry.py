@@ -63,7 +63,9 @@ def _cli_line(capsys, *argv) -> tuple[int, str]:
 def test_the_registered_searchers_are_todays_and_agree_with_their_envs():
     assert registry.names() == ("random", "oracle", "frontier", "frontier_head_off", "frontier_tuned",
                                 "frontier_tuned_head_off", "modular_random", "modular_random_head_off")
-    assert registry.bounds() == ("random", "frontier", "frontier_head_off", "oracle")  # Table 1's rows, in order
+    # Table 1's rows, in order: the floor, the classical searchers (the untuned, then the tuned), the ceiling
+    assert registry.bounds() == ("random", "frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off",
+                                 "oracle")
     assert registry.classical() == ("frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off")
     assert registry.modular_floors() == {"EgoSearchModular-v0": "modular_random",
                                          "EgoSearchNoHeadModular-v0": "modular_random_head_off"}
@@ -128,7 +130,7 @@ def test_a_registered_searcher_is_evaluated_by_the_cli_and_tabled_as_a_bound(toy
                       replace=True)
     assert TOY not in registry.bounds()
     with pytest.raises(ValueError, match="not a reference searcher's evaluation .*random\\|frontier\\|"
-                                         "frontier_head_off\\|oracle"):
+                                         "frontier_head_off\\|frontier_tuned\\|frontier_tuned_head_off\\|oracle"):
         group_bounds([out])
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import torch
 
 from egosearch.cli.checks import at_least
+from egosearch.core.gpu_share import SIDE_BY_SIDE, side_by_side_record
 from egosearch.core.machine import with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.bench import bench_learner, gpu_check
@@ -23,11 +24,13 @@ DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds"
 """Each benchmark's option defaults (the parser leaves them None, so that an option given to a
 benchmark that does not read it is told apart from one left alone)."""
 READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "out_dir": "gpu",
-           "cuda_graph": "gpu", "baseline_seconds": "gpu"}
+           "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu"}
 """The benchmark that reads each of the options that only one of them reads."""
 
 
 def run(args) -> None:
+    if args.what == "gpu" and args.side_by_side is not None and not args.out:
+        args.out = str(SIDE_BY_SIDE)  # the record the docs and the run's line about sharing read
     args.out = with_machine(args.out)
     check_outputs(files={"--out": args.out}, dirs={"--out-dir": args.out_dir})
     check_overwrites(files={"--out": args.out}, dirs={"--out-dir": args.out_dir}, force=args.force)
@@ -55,6 +58,8 @@ def run(args) -> None:
             return bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
         if args.what == "homes":
             return bench.bench_homes()
+        if args.what == "gpu" and args.side_by_side:
+            return measure_side_by_side(args)
         if args.what == "gpu":
             overrides = {"cuda_graph": True} if args.cuda_graph else {}
             resolved = resolve_variant(GPU_CHECK_VARIANT, "paper", {**overrides, "seed": 0})
@@ -64,10 +69,16 @@ def run(args) -> None:
 
     options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
     if args.what == "gpu":
-        options = f" --seconds {args.seconds:g}" + (" --cuda-graph" if args.cuda_graph else "") + (
-            f" --baseline-seconds {args.baseline_seconds:g}" if args.baseline_seconds else "")
+        options = (f" --side-by-side {args.side_by_side}" if args.side_by_side else "") + (
+            f" --seconds {args.seconds:g}" + (" --cuda-graph" if args.cuda_graph else "") + (
+                f" --baseline-seconds {args.baseline_seconds:g}" if args.baseline_seconds else ""))
     record = bench.recorded(f"egosearch bench {args.what}{options}", measure)
-    result = record["result"]
+    if args.what == "gpu" and args.side_by_side:
+        # flat: the measurement's fields beside the machine's, date and commit
+        result = {k: v for k, v in record["result"].items() if k != "runs"}
+        record = side_by_side_record(record)
+    else:
+        result = record["result"]
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
@@ -83,6 +94,11 @@ def run(args) -> None:
 def check_gpu_options(args) -> None:
     if not args.out_dir:
         raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
+    if args.side_by_side is not None:
+        at_least("--side-by-side", args.side_by_side, 2, "the trainings side by side on one GPU")
+        if args.cuda_graph:
+            raise ValueError("--cuda-graph is not read with --side-by-side: its trainings run the paper profile as "
+                             "the DAG does (cuda_graph on)")
     if not args.seconds > 0:
         raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
     if not args.baseline_seconds >= 0:
@@ -93,3 +109,19 @@ def check_gpu_options(args) -> None:
         built = f"built with CUDA {torch.version.cuda}" if torch.version.cuda else "a CPU-only build"
         raise ValueError(f"bench gpu needs a CUDA GPU, and torch {torch.__version__} ({built}) sees none on this "
                          "machine; `bench learner` times the learners on the CPU")
+
+
+def measure_side_by_side(args) -> dict:
+    """``--side-by-side N``: :func:`egosearch.cli.side_by_side.run_side_by_side` for the paper ``all``'s
+    trainings (their env steps, the projection's numerator)."""
+    from egosearch.cli.side_by_side import run_side_by_side
+    from egosearch.report.workflow_jobs import variants_of_all, workflow_config
+
+    config = workflow_config()
+    seeds = config["profiles"]["paper"]["seeds"]
+    variants = variants_of_all(config)
+    steps = sum(resolve_variant(v, "paper").config.total_env_steps for v in variants) * len(seeds)
+    return run_side_by_side(args.side_by_side, args.seconds, args.out_dir, variant=GPU_CHECK_VARIANT,
+                            all_env_steps=steps, all_trainings=len(variants) * len(seeds),
+                            baseline_seconds=args.baseline_seconds,
+                            say=lambda line: print(line, file=sys.stderr, flush=True))

@@ -162,7 +162,14 @@ def add_bench(sub) -> None:
                         "paper profile sets anyway)")
     p.add_argument("--baseline-seconds", type=float,
                    help="gpu: also train this long with the update launched eagerly (cuda_graph false; in "
-                        "<out-dir>/baseline), for the ratio on one machine; default 0: none")
+                        "<out-dir>/baseline), for the ratio on one machine; with --side-by-side: the N trainings "
+                        "side by side without CUDA MPS this long first; default 0: none")
+    p.add_argument("--side-by-side", type=int, metavar="N",
+                   help="gpu: instead of the learner benchmarks, one paper-profile training alone (all cores), then "
+                        "N side by side (cores / N threads each; each `egosearch train --max-wall-s` in "
+                        "<out-dir>/side_by_side/<i>), under CUDA MPS where the command can start it; --out defaults "
+                        "to results/paper/gpu_check/side_by_side.json (aggregate env steps/s, the paper `all`'s "
+                        "projected hours), N >= 2")
     add_record_outputs(p, "print one JSON object", "the result as JSON with the command, date, commit, CPU and the "
                        "machine's load", "learner.json", "which the docs' Speed page reads")
 
@@ -250,6 +257,9 @@ def add_report(sub) -> None:
     r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the searchers Table 1 sets beside the policy "
                                                f"({', '.join(searchers.bounds())}: .../eval/SEARCHER/...): rows that "
                                                "bound the policy")
+    r.add_argument("--learning-adds", metavar="CSV", help="the policy against its own start on the same scenarios "
+                                                         "(compare/{variant}_vs_its_start.csv, rule learning_adds): "
+                                                         "what its learning adds, said in the notes")
     add_force(r)
 
     r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")

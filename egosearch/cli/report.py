@@ -274,7 +274,8 @@ def success_radius() -> float:
 
 
 def _table1(args) -> None:
-    report.cmd_table1(args.files, args.out_prefix, variant=args.variant, bounds=args.bounds)
+    report.cmd_table1(args.files, args.out_prefix, variant=args.variant, bounds=args.bounds,
+                      learning_adds=args.learning_adds)
 
 
 def _table2(args) -> None:
@@ -452,14 +453,17 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     levels = fig6_levels()
     level_files = [p for p in bounds if Path(p).parts[-5] in levels and Path(p).parts[-2] == train_env["placement"]
                    and Path(p).parts[-3] in curve_homes(train_env)]
+    adds = results / "compare" / f"{reference}_vs_its_start.csv"
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
-    read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle]
+    read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle,
+            *([str(adds)] if adds.exists() else [])]
     if check_stored(read, require_record=True):
         print(f"note: {results}/provenance.json has no sha256 list: the stored files are used unverified")
     figs.mkdir(parents=True, exist_ok=True)
     if evals:
-        report.cmd_table1(evals, figs / "table1", variant=reference, bounds=bounds)
+        report.cmd_table1(evals, figs / "table1", variant=reference, bounds=bounds,
+                          learning_adds=adds if adds.exists() else None)
     if curves:
         report.cmd_fig6(curves, figs / "fig6", level_files=level_files)
     if fullbody:

@@ -20,6 +20,7 @@ import statistics
 import sys
 from pathlib import Path
 
+from egosearch.core.gpu_share import warn_gpu_sharing
 from egosearch.cost.calibration import cached_rate, this_machine
 from egosearch.cost.rates import (
     benchmark_ratio,
@@ -35,12 +36,16 @@ from egosearch.rl.config import BODY_STEPS, DECISIONS
 from egosearch.workflow.dag import dag_jobs
 
 
-def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int | None) -> None:
+def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int | None,
+                trainings_per_gpu: int = 1) -> None:
     """What ``snakemake`` prints before the first job of ``targets`` (the Snakefile's ``onstart``, and a
     dry run's start): `all`'s whole DAG from scratch, simulated on ``cores`` (:func:`print_before_a_run`),
     and a comparison's trainings and evaluations still to run (:func:`print_variant_cost`: every one of
     ``seeds`` for compare, ``screen_seed`` for screen). Where no estimate can be made, a line says why:
-    ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate."""
+    ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate.
+    First, once, where paper-profile trainings share one GPU (``trainings_per_gpu`` > 1): whether they do
+    under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`)."""
+    warn_gpu_sharing(profile, trainings_per_gpu)
     if cores is None:
         if "all" in targets or ({"compare", "screen"} & set(targets) and config.get("variant")):
             print("(no estimate of the cost: the run names no --cores to lay its jobs out on)", file=sys.stderr)

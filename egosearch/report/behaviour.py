@@ -606,7 +606,8 @@ def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, pairs: Ite
     written = [out.with_name(out.name + "_episodes.csv"), out.with_name(out.name + ".csv"),
                out.with_name(out.name + ".md"), out.with_name(out.name + "_claims.csv"),
                out.with_name(out.name + "_claims.md")]
-    episodes.to_csv(written[0], index=False)
+    # six significant digits: the per-episode record stays under the repository's 10 MB per file
+    episodes.to_csv(written[0], index=False, float_format="%.6g")
     summary.to_csv(written[1], index=False)
     written[2].write_text(behaviour_markdown(summary, tuple(v for pair in pairs for v in pair)), encoding="utf-8")
     claims.to_csv(written[3], index=False)

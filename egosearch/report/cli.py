@@ -45,13 +45,15 @@ def group_bounds(paths: Iterable[PathLike]) -> dict[str, dict]:
 
 
 def cmd_table1(episode_files: Mapping | Iterable[PathLike], out_prefix: PathLike, variant: str | None = None,
-               bounds: Iterable[PathLike] | None = None) -> pd.DataFrame:
+               bounds: Iterable[PathLike] | None = None, learning_adds: PathLike | None = None) -> pd.DataFrame:
     """Table 1 from ``{(seed, height, placement): path(s)}`` or a flat list of one variant's evaluation CSVs;
     ``bounds`` (a list, possibly empty) of the random searcher's and the oracle's evaluation CSVs puts the
-    policy between them."""
+    policy between them; ``learning_adds`` (the policy against its own start, a comparison CSV) adds what
+    its learning adds to the notes."""
     if not isinstance(episode_files, Mapping):
         episode_files = group_eval_paths(episode_files, variant=variant)
-    df = table1(episode_files, out_prefix, bounds=None if bounds is None else group_bounds(bounds), variant=variant)
+    df = table1(episode_files, out_prefix, bounds=None if bounds is None else group_bounds(bounds), variant=variant,
+                learning_adds=learning_adds)
     base = output_base(out_prefix, "table1")
     _say(suffixed(base, e) for e in (".csv", ".md", ".tex"))
     return df

@@ -23,6 +23,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from egosearch.searchers.registry import modular_floors
+
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
                    "episode_return")
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss", "curl_loss",
@@ -218,4 +220,5 @@ def counts_decisions(curve_path: str | os.PathLike) -> bool:
         stored = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return False
-    return bool(stored.get("config", {}).get("modular_searcher")) or "Modular" in str(stored.get("env_id", ""))
+    # runs stored before the field: their env id is one of the decision envs (the ids the modular floors are of)
+    return bool(stored.get("config", {}).get("modular_searcher")) or stored.get("env_id") in modular_floors()

@@ -14,13 +14,14 @@ import json
 import re
 from pathlib import Path
 
+from egosearch.core.gpu_share import SIDE_BY_SIDE, projected_hours, read_side_by_side
 from egosearch.report.speed import HOSTS
 from egosearch.report.workflow_jobs import job_cost_s, job_study, variants_of_all, workflow_config
 
 GPU_CHECK = Path("results") / "paper" / "gpu_check"
 """Where the GPU check is stored, under the project root."""
 CPU_PROFILE_GPU_CHECK = Path("results") / "cpu" / "gpu_check"
-"""Where the CUDA tests of a later tree are stored, the default (``cpu``) profile's modular searcher among them:
+"""Where the CUDA tests of a later tree are stored, the default (``cpu``) profile's training among them:
 ``cuda_tests.log`` and ``cuda_report.json`` as above (``pytest -q``: the summary line, no test names)."""
 
 
@@ -61,10 +62,20 @@ def projection(root: Path) -> dict | None:
             if job["rule"] != "train" and job_study(job, config) == "all":
                 other_s += job_cost_s(job) * (scale if job["rule"].startswith("fullbody") else 1.0)
     cores = int(record["machine"]["cores"])
-    return {"train_h": train_s / 3600, "trainings": trainings, "trainings_h": trainings * train_s / 3600,
-            "other_core_h": other_s / 3600, "other_h": other_s / cores / 3600, "cores": cores,
-            "fullbody_scale": scale, "total_h": (trainings * train_s + other_s / cores) / 3600,
-            "evaluations": evaluations}
+    out = {"train_h": train_s / 3600, "trainings": trainings, "trainings_h": trainings * train_s / 3600,
+           "other_core_h": other_s / 3600, "other_h": other_s / cores / 3600, "cores": cores,
+           "fullbody_scale": scale, "total_h": (trainings * train_s + other_s / cores) / 3600,
+           "evaluations": evaluations}
+    side = read_side_by_side(root)
+    if side is not None:
+        # the trainings side by side (egosearch bench gpu --side-by-side N): their env steps at the measured
+        # aggregate rate, then the other jobs over that machine's cores
+        side_cores = int((side.get("machine") or {}).get("cores") or cores)
+        trainings_h = projected_hours(side["all_env_steps"], side["aggregate_env_steps_per_s"])
+        out["side_by_side"] = {"n": side["side_by_side"], "mps": bool(side["mps"]), "cores": side_cores,
+                               "trainings_h": trainings_h, "other_h": other_s / side_cores / 3600,
+                               "total_h": trainings_h + other_s / side_cores / 3600}
+    return out
 
 
 def _machine(record: dict) -> str:
@@ -82,6 +93,8 @@ def block_gpu_projection(root: Path, profile: str) -> str:
     record, p = _record(root), projection(root)
     if record is None or p is None:
         return _missing(root)
+    if "side_by_side" in p:
+        return _side_by_side_projection(root, p)
     run = record["result"]["training"]
     return (f"On one {record['machine'].get('gpu', 'GPU')} ({record['machine']['cores']} CPU cores), "
             f"`snakemake --cores {p['cores']} --config profile=paper all` is projected at **about "
@@ -92,6 +105,53 @@ def block_gpu_projection(root: Path, profile: str) -> str:
             f"plus about {p['other_h']:.1f} h of CPU jobs. Derived from the stored GPU check "
             f"(`{GPU_CHECK}/`, {record['date_utc'][:10]}); how, and what `--executor slurm` needs: "
             "[docs/gpu.md](docs/gpu.md).\n")
+
+
+def _under_mps(side: dict) -> str:
+    return "under CUDA MPS" if side["mps"] else "without CUDA MPS"
+
+
+def _side_by_side_projection(root: Path, p: dict) -> str:
+    """The README's lines where a side-by-side record is stored: the trainings of ``all`` side by side at its
+    aggregate rate, and the CPU jobs."""
+    side, q = read_side_by_side(root), p["side_by_side"]
+    machine = side.get("machine") or {}
+    return (f"On one {machine.get('gpu', 'GPU')} ({q['cores']} CPU cores), `snakemake --cores {q['cores']} --config "
+            f"profile=paper all` is projected at **about {q['total_h']:.1f} h**: {side['all_trainings']} trainings, "
+            f"{side['all_env_steps']:,} env steps in all, {q['n']} side by side {_under_mps(side)} at the measured "
+            f"{side['aggregate_env_steps_per_s']:.0f} env steps/s in all ({q['trainings_h']:.1f} h; one training "
+            f"alone: {side['alone_env_steps_per_s']:.1f} env steps/s, "
+            f"{side['projected_all_hours_one_at_a_time']:.1f} h one at a time), plus about {q['other_h']:.1f} h of "
+            "CPU jobs. Derived from the stored side-by-side "
+            f"measurement (`{SIDE_BY_SIDE}`, {str(side.get('date_utc', '?'))[:10]}); how, and what `--executor slurm` "
+            "needs: [docs/gpu.md](docs/gpu.md).\n")
+
+
+def _side_by_side_lines(root: Path) -> list[str]:
+    """docs/gpu.md: the side-by-side measurement (``egosearch bench gpu --side-by-side N``), where stored."""
+    side = read_side_by_side(root)
+    if side is None:
+        return []
+    machine = side.get("machine") or {}
+    per = ", ".join(f"{r:.1f}" for r in side["per_training_env_steps_per_s"])
+    lines = [f"Trainings side by side (`{side.get('command', '?')}` on {machine.get('gpu', 'a GPU')} with "
+             f"{machine.get('cores', '?')} cores, {str(side.get('date_utc', '?'))[:16]} UTC, commit "
+             f"`{str(side.get('commit', '?'))[:7]}`; `{SIDE_BY_SIDE}`): one training alone with "
+             f"{side.get('threads_alone')} threads, {side['alone_env_steps_per_s']:.1f} env steps/s while updating; "
+             f"{side['side_by_side']} side by side with {side.get('threads_per_training')} threads each "
+             f"{_under_mps(side)}, {per} env steps/s, **{side['aggregate_env_steps_per_s']:.1f} in all** "
+             f"({side['speedup_vs_alone']:.1f}x the one alone). MPS: {side.get('mps_note', '?')}."]
+    if side.get("without_mps"):
+        w = side["without_mps"]
+        lines.append(f"- the same {side['side_by_side']} side by side without MPS, run first for "
+                     f"{w.get('seconds') or 0:g} s: {', '.join(f'{r:.1f}' for r in w['per_training_env_steps_per_s'])} "
+                     f"env steps/s, {w['aggregate_env_steps_per_s']:.1f} in all ({w['projected_all_hours']:.1f} h "
+                     "for the trainings of `all`)")
+    lines.append(f"- the trainings of `all` ({side['all_trainings']}, {side['all_env_steps']:,} env steps) at "
+                 f"{side['aggregate_env_steps_per_s']:.1f} env steps/s: **{side['projected_all_hours']:.1f} h**, "
+                 f"against {side['projected_all_hours_one_at_a_time']:.1f} h one at a time (curve evaluations "
+                 "left out: a few minutes)")
+    return lines
 
 
 def _compile_line(root: Path) -> str | None:
@@ -207,6 +267,7 @@ def block_gpu(root: Path, profile: str) -> str:
          f"profile's motion generators and seeds), {p['other_h']:.1f} h on {p['cores']} cores;",
          f"- **about {p['total_h']:.0f} h in all**, an estimate from the measured rates, not a measured run."],
     ]
+    sections.append(_side_by_side_lines(root))
     sections.append(_cpu_profile_lines(root))
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"
 
@@ -223,9 +284,15 @@ def _cpu_profile_lines(root: Path) -> list[str]:
     r = json.loads(report.read_text(encoding="utf-8")) if report.exists() else {}
     if "modular_cpu_profile" in r:
         m = r["modular_cpu_profile"]
-        lines.append(f"- the default `cpu` profile's modular searcher trained on CUDA in the decision env "
+        lines.append(f"- the `cpu` profile of the time, a modular searcher, trained on CUDA in the decision env "
                      f"({m['env_steps']} decisions, {m['updates']} updates), and its actor walked the body env on the "
                      "CPU as evaluation runs it")
+    if "cpu_profile" in r:
+        m = r["cpu_profile"]
+        lines.append(f"- the default `cpu` profile (the frontier searcher's demonstrations, the clone, then SAC "
+                     f"fine-tuning at every body step) trained on CUDA ({m['bc_updates']} cloning steps, "
+                     f"{m['env_steps']} env steps, {m['updates']} updates), and its actor and start walked the body "
+                     "env on the CPU as evaluation runs them")
     for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu profile")):
         if key in r:
             u = r[key]

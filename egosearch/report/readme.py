@@ -51,19 +51,22 @@ def block_table1(root: Path, profile: str) -> str:
 
 
 def block_fig6(root: Path, profile: str) -> str:
-    """Per variant: success at the first and the last evaluation and the best mean along the way."""
+    """Per variant: success at the first and the last evaluation, the rise between them (what the curve
+    says learning adds to its start), and the best mean along the way."""
     path = root / "paper_figs" / profile / "fig6.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
-    lines = ["| variant | seeds | success at step 0 | success at the last step (95% CI) | CI resamples | best mean |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| variant | seeds | success at step 0 | success at the last step (95% CI) | rise | CI resamples | "
+             "best mean |",
+             "|---|---|---|---|---|---|---|"]
     for variant, g in df.groupby("variant", sort=False):
         g = g.sort_values("env_steps")
         first, last = g.iloc[0], g.iloc[-1]
         best = g.loc[g["success_rate"].idxmax()]
         lines.append(f"| {variant} | {int(last.n_seeds)} | {_fmt(first.success_rate)} | "
                      f"{_fmt(last.success_rate)} [{_fmt(last.low)}, {_fmt(last.high)}] at {int(last.env_steps):,} | "
+                     f"{last.success_rate - first.success_rate:+.2f} | "
                      f"{last.get('ci_unit', 'seeds')} | {_fmt(best.success_rate)} at {int(best.env_steps):,} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 

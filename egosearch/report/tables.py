@@ -250,8 +250,34 @@ def _table1_section(df: pd.DataFrame, title: str, variant: str | None, with_boun
     return md, tex
 
 
+def learning_adds_note(compare_csv: PathLike, variant: str | None = None) -> str:
+    """One sentence of Table 1's notes from a stored comparison of the policy against its own start
+    (``compare/{variant}_vs_its_start.csv``, rule ``learning_adds``): the success difference, final minus
+    step 0, with its interval, per height and placement."""
+    df = pd.read_csv(compare_csv)
+    df = df[df["metric"] == "success"]
+    if df.empty:
+        raise ValueError(f"{compare_csv}: no success rows (not a comparison written by `egosearch report compare`)")
+    name = f"ours ({variant})" if variant else "ours"
+    parts = []
+    for h in sorted(set(df["height"])):
+        cells = []
+        for placement, label in (("no_low_cabinets", "excluding cabinets"), ("everywhere", "everywhere")):
+            row = df[(df["height"] == h) & (df["placement"] == placement)]
+            if len(row):
+                r = row.iloc[0]
+                cells.append(f"{r['difference']:+.2f} [{r['ci_low']:+.2f}, {r['ci_high']:+.2f}] {label}")
+        parts.append(f"{_height_label(h)} " + ", ".join(cells))
+    seeds = int(df["n_seeds_cand"].iloc[0])
+    return (f"What learning adds: {name} against its own start (each seed's policy at step 0, before any RL "
+            f"update: the clone after imitation, else the untrained net) on the same scenarios and {seeds} "
+            f"seed(s), success difference, final minus start [95% interval, same bootstrap]: {'; '.join(parts)} "
+            f"({Path(compare_csv).name}).")
+
+
 def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.95, n_resamples: int = 10_000,
-           seed: int = 0, bounds: Mapping[str, Mapping] | None = None, variant: str | None = None) -> pd.DataFrame:
+           seed: int = 0, bounds: Mapping[str, Mapping] | None = None, variant: str | None = None,
+           learning_adds: PathLike | None = None) -> pd.DataFrame:
     """Write ``{prefix}.csv``, ``.md`` and ``.tex`` (see :func:`output_base`; a directory gets ``table1.*``); return
     the frame.
 
@@ -262,8 +288,10 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
     a table per home follows when there are several.
 
     With ``bounds`` (see :func:`table1_frame`; ``{}`` when none is stored) each height also gets the
-    random searcher and the privileged oracle, a bound that was not run saying so.
+    random searcher and the privileged oracle, a bound that was not run saying so. ``learning_adds``: the
+    stored comparison of the policy against its own start, said in the notes (:func:`learning_adds_note`).
     """
+    adds = learning_adds_note(learning_adds, variant) + " " if learning_adds is not None else ""
     df = table1_frame(episode_files, confidence, n_resamples, seed, bounds=bounds)
     base = output_base(out_prefix, "table1")
     out_csv = suffixed(base, ".csv")
@@ -299,7 +327,7 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
                 notes = ""
             md_all += [f"Ours: {scen} scenarios per cell, each run by {seeds_s} seed(s); brackets: {pct} two-level "
                        "bootstrap interval (scenarios resampled, then seeds: the seeds ran the same scenarios, so "
-                       f"the scenario is the unit that repeats). {notes} "
+                       f"the scenario is the unit that repeats). {adds}{notes} "
                        + ("The paper's column is set beside both homes pooled: the paper tests its policy in both "
                           "homes (Section 6) and gives one number per cell. " if BOTH_HOMES in homes else "")
                        + f"SPL and its interval, and the {pct} bootstrap over per-seed success rates, are in "

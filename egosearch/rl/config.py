@@ -80,10 +80,9 @@ class LearnerConfig:
     """Table 2 "Discount rate gamma"."""
     total_env_steps: int = 750_000
     """Table 2 "Number of training steps" 0.75M: environment steps (simulation samples, paper
-    4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` profile trains a modular
-    searcher (``modular_searcher``), whose env step is a decision of several body steps: 30k decisions,
-    about the body steps of the 200k that its from-scratch learner took for the 2-core budget (see
-    :func:`cpu_profile`)."""
+    4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` profile trains 200k body
+    steps, the 2-core budget's (see :func:`cpu_profile`); a modular searcher (``modular_searcher``) counts
+    decisions of several body steps instead (``head_on_modular``: 30k)."""
     batch_size: int = 32
     """Table 2 "Batch-size": transitions per gradient update (also the CURL negatives + 1)."""
 
@@ -223,14 +222,14 @@ class LearnerConfig:
     (EgoSearch-v0 -> EgoSearchMemory-v0, EgoSearchNoHead-v0 -> EgoSearchNoHeadMemory-v0), whose
     observation also carries where the target was last seen, by the searcher's own odometry, and
     the steps since (``egosearch.sim.env``): the same as naming that id in the variant file. This
-    CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile set it until it
-    became a modular searcher (whose frontier searcher remembers the target itself), with
+    CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
     ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
     profile never."""
     modular_searcher: bool = False
     """Paper: False (the policy acts at every body step: its steps, turns and head). True: a modular
-    searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the
-    ``cpu`` profile's, see :func:`cpu_profile`): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
+    searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the stored
+    ``head_on_modular`` pair, the ``cpu`` profile's before it learned at every body step, see
+    :func:`cpu_profile`): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
     its variant's head (EgoSearch-v0 -> EgoSearchModular-v0, EgoSearchNoHead-v0 ->
     EgoSearchNoHeadModular-v0; ``egosearch.searchers.modular``): it decides only where to explore (a
     point on its own floor map, walked to as the nearest reachable frontier) and how to sweep the head,
@@ -351,15 +350,17 @@ class LearnerConfig:
     TRAINING ONLY: evaluation uses the stored scenarios' fixed heights."""
 
     # ---- learning from the classical searcher ("sac_drq" only; the paper has no teacher) ---------
-    # The levers of learning from demonstrations: TRAINING ONLY, each a CHANGE OF ALGORITHM (a teacher
-    # the paper's learner does not have). The actor, its file and every evaluation are as without them.
+    # Learning from demonstrations, the cpu profile's (see cpu_profile): TRAINING ONLY, each a CHANGE OF
+    # ALGORITHM (a teacher the paper's learner does not have). The actor, its file and every evaluation are
+    # as without them.
     demo_episodes: int = 0
     """Paper: 0 (no demonstrations). N > 0: a fresh training first runs the classical frontier searcher
     (``demo_teacher``: by default ``egosearch.searchers.frontier``, untuned; head moving where the body has a
     head) for N episodes of its own training envs and keeps their transitions (``egosearch.rl.demos``,
     seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
     frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
-    kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time."""
+    kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time. The
+    ``cpu`` profile: 1,500 (see :func:`cpu_profile`)."""
     demo_teacher: str = "frontier"
     """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
     of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
@@ -371,7 +372,8 @@ class LearnerConfig:
     before the first env step, this many behaviour-cloning steps of the encoder and the actor on
     ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
     its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
-    act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy."""
+    act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy. The
+    ``cpu`` profile: 12,000."""
     dagger_rounds: int = 0
     """Paper: 0. DAgger (Ross, Gordon & Bagnell 2011), after ``bc_updates``: this many rounds in which the
     cloned student drives ``dagger_episodes`` training-side episodes (its mean action), the teacher labels
@@ -384,18 +386,22 @@ class LearnerConfig:
     critic_warmup_updates: int = 0
     """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
     the first policy steps follow a critic fitted to it): the first this many RL updates train only
-    the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned."""
+    the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned. The
+    ``cpu`` profile: 2,500."""
     demo_batch_fraction: float = 0.0
     """RLPD (Ball et al. 2023: 0.5, "symmetric sampling"): this fraction of every update's batch is
-    drawn from the demonstrations, the rest from the online replay. 0: online only (the paper)."""
+    drawn from the demonstrations, the rest from the online replay. 0: online only (the paper). The ``cpu``
+    profile: 0.5."""
     bc_weight: float = 0.0
     """TD3+BC (Fujimoto & Gu 2021: the actor's loss plus a squared error to the data's action, weighted
     against the critic's scale; their alpha 2.5 is a weight of 1 / 2.5 = 0.4 here), the optional term of
     RLPD-style training: the actor's SAC loss plus ``bc_weight`` x mean |Q| x the squared error
     between its mean action and the teacher's on the batch's demonstration rows. It decays linearly to
-    0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none."""
+    0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none. The ``cpu``
+    profile: 0.4."""
     bc_decay_steps: int = 0
-    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0."""
+    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0. The ``cpu``
+    profile: 100k, half its run."""
 
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
@@ -406,13 +412,14 @@ class LearnerConfig:
     """Ours (CURL: 1): gradient updates done each time updates are due; the update-to-data
     ratio is ``updates_per_step / update_every``."""
     eval_every: int = 10_000
-    """Ours: environment steps between evaluations (a row of curve.csv each)."""
+    """Ours: environment steps between evaluations (a row of curve.csv each; the ``cpu`` profile: 20k)."""
     eval_episodes: int = 10
     """Ours (CURL: 10): deterministic episodes of the default evaluation."""
     log_every: int = 1_000
     """Ours: environment steps between rows of train.csv / progress-bar refreshes."""
     checkpoint_every: int = 10_000
-    """Ours: environment steps between resumable checkpoints (atomic writes)."""
+    """Ours: environment steps between resumable checkpoints (atomic writes). A checkpoint ends every env's
+    episode, so that a resumed run equals one that was not stopped: the ``cpu`` profile checkpoints every 20k."""
     seed: int = 1
     """Ours: seeds torch, numpy, python's random, the env and its action space."""
 
@@ -587,7 +594,11 @@ class LearnerConfig:
                 "bc_weight": self.bc_weight > 0}
         for name, used in uses.items():
             if used and self.demo_episodes == 0:
-                bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations)")
+                # the cpu profile sets them all: name every one that needs turning off with the teacher
+                on = [n for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
+                                  "bc_decay_steps") if getattr(self, n)]
+                bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations set "
+                    + ", ".join(f"{n}: 0" for n in on))
         if self.dagger_rounds and not self.bc_updates:
             bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
         if bool(self.dagger_rounds) != bool(self.dagger_episodes):
@@ -676,7 +687,7 @@ def paper_profile() -> dict[str, Any]:
 
 
 def cpu_profile() -> dict[str, Any]:
-    """The default: a learner that searches, sized for the 2-core reference CPU.
+    """The default: a learner that searches at every body step, sized for the 2-core reference CPU.
 
     Why it is not Table 2 resized: SAC + CURL at Table 2 sizes costs ~0.33 s per update per core
     here (28 GFLOP, conv-bound), so a run of a few core-hours buys a few percent of the paper's
@@ -691,27 +702,23 @@ def cpu_profile() -> dict[str, Any]:
       augmentation, NO CURL and no target encoder. This changes the paper's algorithm;
     - depth average-pooled 100 -> 50 px (``obs_downsample`` 2) into a 2-layer stride-2 encoder of
       32 filters, 3-layer MLPs of 256 units (CURL's layer count);
-    - (until the modular searcher below) **a memory in the observation** (``target_memory``):
-      where the target was last seen, by the searcher's own odometry, and the steps since, which
-      changed the paper's observation; the from-scratch pair keeps it
-      (``ablations/head_on_from_scratch.yaml``). With 50 px depth it raised success in every Table 1 cell against
-      the same profile at 25 px without it (3 seeds each, ``ablations/head_on_memory_50px.yaml``
-      against ``ablations/head_on_25px.yaml``, which keeps that profile;
-      ``results/cpu/compare/head_on_memory_50px_vs_head_on_25px.csv``): at 1.05 m excluding low
-      cabinets from 0.59 to 0.67, most on searches whose shortest path is longer than 4 m. Neither
-      half passed alone (the memory: 3 seeds, ``head_on_target_memory``; 50 px: one seed);
-    - (until the modular searcher below) 200k env steps (``total_env_steps``; Table 2: 750k): at
-      50 px an env step costs 2.3 (Intel
+    - **a memory in the observation** (``target_memory``): where the target was last seen, by the
+      searcher's own odometry, and the steps since, which changes the paper's observation. With
+      50 px depth it raised success in every Table 1 cell against the same profile at 25 px
+      without it (3 seeds each, ``ablations/head_on_memory_50px.yaml`` against
+      ``ablations/head_on_25px.yaml``, which keeps that profile;
+      ``results/cpu/compare/head_on_memory_50px_vs_head_on_25px.csv``), most on searches whose
+      shortest path is longer than 4 m. Neither half passed alone (the memory: 3 seeds,
+      ``head_on_target_memory``; 50 px: one seed);
+    - 200k env steps (``total_env_steps``; Table 2: 750k): at 50 px an env step costs 2.3 (Intel
       Xeon) to 3.6 (AMD EPYC) times the CPU time of the 25 px profile's (the stored trainings'
-      benchmarks), so 300k steps overran ``snakemake --cores 2 all``'s budget. The
-      three-seed training curves at 300k were flat from about 200k on, and a one-seed screen at
-      200k searched as well as 300k in every cell
-      (``results/cpu/compare/screen_head_on_memory_50px_200k_seed0_vs_head_on_memory_50px_seed0.csv``),
-      and so did the three seeds (no cell differs after Holm:
-      ``results/cpu/compare/head_on_from_scratch_vs_head_on_memory_50px.csv``);
+      benchmarks), so 300k steps overran ``snakemake --cores 2 all``'s budget. The three-seed
+      training curves at 300k were flat from about 200k on, and a one-seed screen at 200k searched
+      as well as 300k in every cell
+      (``results/cpu/compare/screen_head_on_memory_50px_200k_seed0_vs_head_on_memory_50px_seed0.csv``);
     - 8 envs stepped in lockstep with batched acting (``num_envs``), batch 64 (``batch_size``) every
-      decision (``update_every``; every 4 env steps before the modular searcher), 3-step returns
-      (``n_step``, DrQ-v2), the actor and targets updated every update (DrQ-v2);
+      4 env steps (``update_every``), 3-step returns (``n_step``, DrQ-v2), the actor and targets
+      updated every update (DrQ-v2);
     - the temperature's learning rate 1e-3 (``alpha_lr``; Table 2: 1e-4): Adam moves log alpha
       by at most ~lr per update, so with ~100x fewer updates than the paper Table 2's rate
       leaves alpha near 0.05 after 10k updates (measured), where the entropy bonus outweighs the
@@ -730,35 +737,41 @@ def cpu_profile() -> dict[str, Any]:
       (``train_height_min``, training only): trained on the paper's range, this learner's Table 1
       success at the 0.45 m camera was 0.16 against 0.48-0.56 at 1.05 and 1.65 m (the stored run
       of commit 1a639e5), where the paper's learner transferred (0.50-0.58);
-    - **a modular searcher** (``modular_searcher``; SemExp, Chaplot et al. NeurIPS 2020; Gervet et
-      al. 2023): the policy learns only where to explore (a point on its own floor map, walked to as
-      the nearest reachable frontier) and how to sweep the head, at most every 10 body steps; the
-      frontier searcher maps, plans and walks the body, and walks to the target once seen. This
-      CHANGES WHAT IS LEARNED AND THE OBSERVATION (the searcher's map around the body; no
-      ``target_memory``: the frontier searcher remembers the target itself), at evaluation too, and
-      the paper's claims about the body's steps cannot be read on it. It is the one lever of the
-      issue "learn from the classical searcher" that met its Must: three seeds each against the
-      profile before it (now ``ablations/head_on_from_scratch.yaml``), success rose in every Table 1
-      cell (``results/cpu/compare/head_on_modular_vs_head_on_from_scratch.csv``) to the frontier
-      searcher's level (no cell differs after Holm: ``head_on_modular_vs_frontier.csv``);
-      imitation, DAgger, fine-tuning and demonstrations in replay did not reach it (their rows in
-      ``docs/ablations.md``). So its counts are **decisions**: 30k (about 7 body steps
-      each, about the body steps of the previous 200k), the curriculum over the first 15k, 1k of
-      warm-up, one update per decision, evaluations and checkpoints every 5k.
+    - **imitation, then SAC fine-tuning** (``demo_episodes``, ``bc_updates``,
+      ``critic_warmup_updates``, ``demo_batch_fraction``, ``bc_weight``, ``bc_decay_steps``; the
+      paper learns from scratch): a TEACHER THE PAPER'S LEARNER DOES NOT HAVE. A training first
+      runs the untuned classical frontier searcher (``demo_teacher``; head fixed for the head-off
+      variant) for 1,500 episodes of its training envs, clones it (12,000 steps; PIRLNav, Ramrakhya
+      et al. CVPR 2023), trains the critic alone for 2,500 updates, then runs SAC with half of every
+      batch from the demonstrations (RLPD, Ball et al. ICML 2023) and a cloning term of weight 0.4
+      on the actor (TD3+BC) that decays to 0 over the first 100k env steps. The policy acts at every
+      body step, the paper's policy class, and its step-0 policy (the clone) is stored
+      (``actor_start.pt``) so that what the RL phase adds is measured (``snakemake learning_adds``).
+      Against learning from scratch (``ablations/head_on_from_scratch.yaml``, 3 seeds each,
+      ``results/cpu/compare/head_on_imitation_finetune_vs_head_on_from_scratch.csv``) it raised
+      success at 1.05 and 1.65 m in every cell after Holm, and the best of the issue "learning
+      carries the result"'s levers measured (``docs/ablations.md``) did not beat it;
+    - evaluations and checkpoints every 20k env steps, logs every 2k (``eval_every``,
+      ``checkpoint_every``, ``log_every``): a checkpoint cuts every env's episode.
+
+    Before this, the ``cpu`` profile was a modular searcher (``modular_searcher``;
+    ``ablations/head_on_modular.yaml`` keeps it): the policy chose only where the frontier
+    searcher walks next and how to sweep the head. Its learned decisions added nothing
+    measurable: the same walk with random decisions scored the same
+    (``results/cpu/compare/head_on_modular_vs_modular_random.csv``).
 
     Throughput on one core of the reference machine: ``egosearch bench learner``
-    (``env_steps_per_core_s_cpu_profile``: decisions, at this profile).
+    (``env_steps_per_core_s_cpu_profile``: body steps, at this profile).
     """
     return {
         "algorithm": "sac_drq",
-        "total_env_steps": 30_000,
+        "total_env_steps": 200_000,
         "num_envs": 8,
         "n_step": 3,
         "batch_size": 64,
-        "update_every": 1,
+        "update_every": 4,
         "obs_downsample": 2,
-        "target_memory": False,
-        "modular_searcher": True,
+        "target_memory": True,
         "encoder_num_layers": 2,
         "encoder_stride2_layers": 2,
         "encoder_num_filters": 32,
@@ -771,14 +784,20 @@ def cpu_profile() -> dict[str, Any]:
         "critic_target_update_freq": 1,
         "alpha_lr": 1e-3,
         "train_distance_reward": "progress",
-        "curriculum_steps": 15_000,
+        "curriculum_steps": 100_000,
         "train_height_min": 0.45,
         "critic_privileged_state": True,
-        "init_steps": 1000,
-        "eval_every": 5000,
+        "demo_episodes": 1500,
+        "bc_updates": 12_000,
+        "critic_warmup_updates": 2500,
+        "demo_batch_fraction": 0.5,
+        "bc_weight": 0.4,
+        "bc_decay_steps": 100_000,
+        "init_steps": 4000,
+        "eval_every": 20_000,
         "eval_episodes": 30,
-        "log_every": 500,
-        "checkpoint_every": 5000,
+        "log_every": 2000,
+        "checkpoint_every": 20_000,
         "num_threads": 1,
     }
 

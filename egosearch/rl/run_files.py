@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 from egosearch.rl.config import LearnerConfig
+from egosearch.sim.envs import ENV_IDS, MODULAR_ENV_IDS
 
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
@@ -215,12 +216,12 @@ def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str
     if saved.get("env_kwargs") != env_kwargs_key(env_kwargs):
         raise CheckpointError(f"{what} {path} was written with env_kwargs {saved.get('env_kwargs')}, "
                               f"not {env_kwargs_key(env_kwargs)}; use another out_dir")
-    # runs saved before these fields existed ran without them, i.e. as their defaults
-    theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
-    # runs saved before modular_searcher was a field named the modular searcher in their env id only
-    theirs.setdefault("modular_searcher", "Modular" in str(saved.get("env_id")))
+    theirs = saved_config(saved)
     mine = cfg.to_dict()
-    diff = sorted(k for k in set(mine) | set(theirs) if k not in RESUMABLE_FIELDS and mine.get(k) != theirs.get(k))
+    # the env id, compared above, is what these two fields select (observed_env_id): a run stored under its
+    # *Memory-v0 id observed the memory whatever its flag said
+    diff = sorted(k for k in set(mine) | set(theirs)
+                  if k not in RESUMABLE_FIELDS + ENV_ID_FIELDS and mine.get(k) != theirs.get(k))
     if diff:
         shown = ", ".join(f"{k}={theirs.get(k)!r} (now {mine.get(k)!r})" for k in diff[:4])
         raise CheckpointError(f"{what} {path} was written with a different config: {shown}"
@@ -231,5 +232,23 @@ _DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
                              for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
                                        "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
                                        "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",
-                                       "target_memory", "critic_layer_norm", "demo_teacher")}
-"""Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults."""
+                                       "target_memory", "critic_layer_norm", "demo_teacher",
+                                       "critic_privileged_state", "demo_episodes", "bc_updates", "dagger_rounds",
+                                       "dagger_episodes", "critic_warmup_updates", "demo_batch_fraction",
+                                       "bc_weight", "bc_decay_steps")}
+"""Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults (each
+default is the field's "off")."""
+
+ENV_ID_FIELDS = ("target_memory", "modular_searcher")
+"""Config fields whose whole effect is the env id a run observes (``observed_env_id``)."""
+
+
+def saved_config(saved: dict) -> dict:
+    """The config a checkpoint or done.json ran with, fields added after it was stored at their defaults."""
+    theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
+    env_id = str(saved.get("env_id"))
+    # runs saved before these fields existed named them in their env id only: read them from the id's table
+    theirs.setdefault("modular_searcher", env_id in MODULAR_ENV_IDS)
+    if "target_memory" not in saved.get("config", {}):
+        theirs["target_memory"] = bool(ENV_IDS.get(env_id, {}).get("target_memory", False))
+    return theirs

@@ -9,9 +9,9 @@ one module with its policy (``reset(seed=None)`` and ``act(obs)``:
 :class:`egosearch.searchers.policies.Policy`) and one :func:`register` line below; the CLI, Table 1,
 the path-length report, Figure 6, the workflow's checks and the Snakemake rules read this registry.
 
-``frontier_tuned`` and ``frontier_tuned_head_off`` (:mod:`egosearch.searchers.frontier_tuned`) are registered
-with ``bound=False`` for now: the stored Table 1 has no row of theirs (their evaluations are compared with the
-untuned searcher's instead); they become bound rows (``bound=True``) when Table 1 is regenerated.
+``frontier_tuned`` and ``frontier_tuned_head_off`` (:mod:`egosearch.searchers.frontier_tuned`, tuned on
+training-side sets only) are bound rows of their own, beside the untuned classical rows, which stay Table 1's
+classical reference.
 
 Every stage may read this module, the report layer and the workflow included (tests/test_layout.py
 allows it, and only it, of searchers/): it imports nothing of egosearch nor any package outside the
@@ -168,15 +168,18 @@ register("frontier_head_off", "egosearch.searchers.frontier:FrontierPolicy", env
          what="the same with the camera fixed to the body", bound=True, classical=True,
          path_style=("#bd9e39", ":", "D"),
          fig6_level=("classical searcher, head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "#777777"))
-# The frontier searcher tuned on training-side sets: a teacher, not yet a Table 1 row (the module docstring).
+# The frontier searcher tuned on training-side sets (egosearch.searchers.frontier_tuned), a bound row of its
+# own: the untuned rows above stay Table 1's classical reference.
 register("frontier_tuned", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy", head=True,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
-         label="frontier searcher, tuned", what="the frontier searcher tuned on training-side sets", classical=True)
+         label="frontier searcher, tuned", bound=True, classical=True, path_style=("#637939", "-.", "P"),
+         what="the frontier searcher with its parameters tuned on training-side sets only (generated homes, "
+              "other scenario seeds), never on Table 1's")
 register("frontier_tuned_head_off", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy",
          env_id="EgoSearchNoHead-v0", head=False,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
          label="frontier searcher, tuned, head fixed", what="the same with the camera fixed to the body",
-         classical=True)
+         bound=True, classical=True, path_style=("#8ca252", ":", "X"))
 register("modular_random", "egosearch.searchers.modular:random_decisions", head=True, takes_seed=True,
          help="the modular searcher's walk with random decisions", label="modular searcher's walk, random decisions",
          what="the modular searcher's walk with each decision drawn uniformly at random",

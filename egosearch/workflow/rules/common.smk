@@ -8,6 +8,7 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
+from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
 from egosearch.workflow.check import claims_pairs
@@ -106,13 +107,38 @@ def provenance_file():
     return f"{RESULTS}/provenance.json"
 
 
+# Paper-profile trainings side by side on one GPU (config trainings_per_gpu; egosearch.core.gpu_share): on one
+# machine each asks for one of `gpu_slots`, which the run offers that many of (unless the command line's
+# --resources names gpu_slots: then that many), and takes a fair share of --cores; under a cluster executor each
+# training is a job asking for a whole GPU. Outputs and paths are the same either way.
+LOCAL_RUN = workflow.local_exec
+if PROFILE == "paper":
+    try:
+        TRAININGS_PER_GPU = resolve_trainings_per_gpu(config.get("trainings_per_gpu", "auto"), LOCAL_RUN)
+    except ValueError as err:
+        import sys
+
+        print(f"egosearch: error: {err}", file=sys.stderr)
+        sys.exit(1)
+    if LOCAL_RUN and "gpu_slots" in workflow.global_resources:
+        TRAININGS_PER_GPU = max(1, int(workflow.global_resources["gpu_slots"].value))
+    elif LOCAL_RUN:
+        workflow.register_resource("gpu_slots", TRAININGS_PER_GPU)
+else:
+    TRAININGS_PER_GPU = 1
+TRAIN_THREADS = train_threads(PROFILE, cores_given() if LOCAL_RUN else None, TRAININGS_PER_GPU)
+
+
 def train_resources(profile):
     """Portable resources: the same DAG runs locally, under slurm or cluster-generic."""
     if profile == "paper":
-        # a few times the training's length on the one GPU measured (docs/gpu.md), for slower GPUs
-        return dict(mem_mb=8000, runtime=12 * 60, gpu=1)
+        # a few times the training's length on the one GPU measured (docs/gpu.md), for slower GPUs; on one
+        # machine a share of its GPU (gpu_slots, above), under a cluster executor a whole one
+        return dict(mem_mb=8000, runtime=12 * 60, **(dict(gpu_slots=1) if LOCAL_RUN else dict(gpu=1)))
     if profile == "cpu":
-        return dict(mem_mb=3000, runtime=90, gpu=0)
+        # a per-step training with its teacher's episodes takes about an hour alone on the reference CPU;
+        # hosts differ up to 3x
+        return dict(mem_mb=3000, runtime=180, gpu=0)
     return dict(mem_mb=1500, runtime=10, gpu=0)
 
 
@@ -228,17 +254,20 @@ def fresh_files(kind):
 
 
 def decisions_floors():
-    """(variant, floor) for each variant of the profile's first claims pair that is a modular searcher: its
-    floor is the same walk with random decisions (MODULAR_FLOORS), on the same stored sets."""
+    """(variant, floor) for each variant of the profile's claims pairs that is a modular searcher (at the cpu
+    profile the stored modular pair, head_on_modular and head_off_modular): its floor is the same walk with
+    random decisions (MODULAR_FLOORS), on the same stored sets."""
     from egosearch.variants import resolve_variant
 
-    pairs = claims_pairs({**config, "profile": PROFILE})
     learner = PROF["learner"]
     out = []
-    for variant in pairs[0] if pairs else []:
-        env_id = resolve_variant(CHECKED_VARIANTS[variant], learner).env_id
-        if env_id in MODULAR_FLOORS:
-            out.append((variant, MODULAR_FLOORS[env_id]))
+    for pair in claims_pairs({**config, "profile": PROFILE}):
+        for variant in pair:
+            if variant not in CHECKED_VARIANTS:  # a classical searcher's pair
+                continue
+            env_id = resolve_variant(CHECKED_VARIANTS[variant], learner).env_id
+            if env_id in MODULAR_FLOORS and (variant, MODULAR_FLOORS[env_id]) not in out:
+                out.append((variant, MODULAR_FLOORS[env_id]))
     return out
 
 

@@ -2,10 +2,12 @@
 
 rule table1:
     """Success rate per camera height x placement scheme, pooled over seeds (paper Table 1), with
-    the random searcher and the privileged oracle on the same scenarios."""
+    the random searcher and the privileged oracle on the same scenarios, and in its notes what the
+    policy's learning adds (its comparison against its own start, rule learning_adds)."""
     input:
         policy=ancient(eval_files(REF)),
         bounds=ancient(bound_files()),
+        learning_adds=ancient(f"{RESULTS}/compare/{REF}_vs_its_start.csv"),
     output:
         expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
     log:
@@ -19,7 +21,7 @@ rule table1:
         CONDA_ENV
     shell:
         "egosearch report table1 --force {input.policy} --variant {params.variant} --bounds {input.bounds} "
-        "--out-prefix {params.prefix} > {log} 2>&1"
+        "--learning-adds {input.learning_adds} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule table2:
@@ -227,7 +229,7 @@ rule provenance:
 rule learning_adds:
     """What learning adds: the profile's pair (head on, head off) against its own start (each seed's
     policy at step 0: the clone after imitation, else the untrained net) on the same stored sets, per
-    cell and per shortest-path bin. Needs trainings that wrote actor_start.pt."""
+    cell and per shortest-path bin (part of `all`; Table 1's notes say the reference's)."""
     input:
         [f"{RESULTS}/compare/{variant}_vs_its_start.csv" for variant in VARIANTS],
 
@@ -250,9 +252,9 @@ rule learning_adds_compare:
 
 
 rule decisions_floor:
-    """What a modular searcher's learned decisions add: the profile's pair (head on, head off) against the
-    same walk with random decisions, per cell and per shortest-path bin. Nothing to do at a profile whose
-    pair acts at every body step."""
+    """What a modular searcher's learned decisions add: each modular pair of the claims pairs (at the cpu
+    profile the stored head_on_modular and head_off_modular) against the same walk with random decisions,
+    per cell and per shortest-path bin. Nothing to do where no claims pair is a modular searcher."""
     input:
         [f"{RESULTS}/compare/{variant}_vs_{floor}.csv" for variant, floor in DECISIONS_FLOORS],
 

@@ -13,7 +13,8 @@ rule train:
         learner=lambda wc: config["profiles"][wc.profile]["learner"],
         out_dir=lambda wc, output: str(Path(output.actor).parent),
         work_dir=lambda wc, output: str(Path(output.actor).parent / "partial"),
-    threads: 1
+    # 1; at the paper profile on one machine, --cores / trainings_per_gpu (common.smk)
+    threads: TRAIN_THREADS
     resources:
         **train_resources(PROFILE),
     conda:
