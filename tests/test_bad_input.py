@@ -551,7 +551,7 @@ GEN = [ev("head_on", "generated_heldout"), "--bounds", ev("random", "generated_h
 CURVE, CELL = "{t}/train/head_on/seed0/curve.csv", "{t}/eval/head_on/seed0/kitchen_living/no_low_cabinets/h1.05.csv"
 EMPTY_EVAL = "{t}/emptyeval/cand/seed0/kitchen_living/everywhere/h1.05.csv"
 CHECKPOINT = ("egosearch train: error: --out-dir: {t}/run/done.json belongs to variant='head_on' "
-              "env_id='EgoSearchModular-v0', not variant={variant} env_id={env}; use another out_dir")
+              "env_id='EgoSearchMemory-v0', not variant={variant} env_id={env}; use another out_dir")
 STORED = r"\((tracked by git|listed in the results' provenance\.json)[^)]*\)"
 
 ISSUE_CASES = [
@@ -590,7 +590,7 @@ ISSUE_CASES = [
      ["evaluate", "--scenarios", S3, "--policy", "oracle", "--threads", "-3", "--out", "{t}/o.csv"],
      "egosearch evaluate: error: --threads=-3: a number of threads (0: all cores) must be >= 0"),
     ("train_into_another_variants_run", "traceback", ["train", "--variant", "head_off", "--out-dir", "{t}/run"],
-     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadModular-v0'")),
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
     ("train_into_a_run_of_another_profile", "traceback",
      ["train", "--variant", "head_on", "--profile", "smoke", "--out-dir", "{t}/run"],
      CHECKPOINT.format(t="{t}", variant="'head_on'", env="'EgoSearch-v0'")),
@@ -600,7 +600,7 @@ ISSUE_CASES = [
      "(now 5); use another out_dir"),
     ("train_work_dir_beside_another_run", "silent",
      ["train", "--variant", "head_off", "--work-dir", "{t}/partial", "--out-dir", "{t}/run"],
-     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadModular-v0'")),
+     CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
     ("scenarios_seed_negative", "cryptic", ["scenarios", "--seed", "-7", "--out", "{t}/s.csv"],
      "egosearch scenarios: error: --seed=-7: a seed must be >= 0"),
     ("binary_scenario_csv", "cryptic", ["evaluate", "--scenarios", "{t}/bin.csv", "--policy", "oracle", "--out",
@@ -916,16 +916,16 @@ NEW48_CASES = [
      "searcher with the head moving: its rows would be read under that name; leave --env-id out, or use --policy "
      "modular_random_head_off"),
     ("evaluate_a_modular_actor_in_a_head_off_env", "clear",
-     ["evaluate", "--scenarios", "{t}/missing.csv", "--weights", "results/cpu/train/head_on/seed0/actor.pt",
+     ["evaluate", "--scenarios", "{t}/missing.csv", "--weights", "results/cpu/train/head_on_modular/seed0/actor.pt",
       "--env-id", "EgoSearchNoHead-v0", "--out", "{t}/o.csv"],
-     "egosearch evaluate: error: results/cpu/train/head_on/seed0/actor.pt: this actor was trained in "
+     "egosearch evaluate: error: results/cpu/train/head_on_modular/seed0/actor.pt: this actor was trained in "
      "EgoSearchModular-v0 (4 action values, 466 observation values besides depth), not in EgoSearchNoHead-v0 (3 and "
      "34): run it in EgoSearchModular-v0"),
     ("demos_of_a_modular_variant", "cryptic",
-     ["demos", "--variant", "head_on", "--episodes", "1", "--out", "{t}/d.replay.npz"],
-     "egosearch demos: error: --variant=head_on at the cpu profile is a modular searcher (its env step is a decision, "
-     "not a body step): demonstrations are the frontier searcher's body steps, which it cannot learn from; give a "
-     "variant that acts at every body step (e.g. head_on_from_scratch)"),
+     ["demos", "--variant", "head_on_modular", "--episodes", "1", "--out", "{t}/d.replay.npz"],
+     "egosearch demos: error: --variant=head_on_modular at the cpu profile is a modular searcher (its env step is a "
+     "decision, not a body step): demonstrations are the frontier searcher's body steps, which it cannot learn "
+     "from; give a variant that acts at every body step (e.g. head_on_from_scratch)"),
     ("scenarios_layout_and_homes", "silent",
      ["scenarios", "--layout", "studio", "--homes", "0:2", "--n", "1", "--out", "{t}/s.csv"],
      "egosearch scenarios: error: --layout=studio and --homes=0:2 both name the homes: give one"),

@@ -80,7 +80,8 @@ def test_the_readme_is_a_two_minute_read_and_the_test_time_lives_there_only():
     import re
 
     readme = (REPO / "README.md").read_text(encoding="utf-8")
-    assert len(readme.splitlines()) <= 230
+    # 250: Table 1's three generated tables carry the tuned teacher's two bound rows per height
+    assert len(readme.splitlines()) <= 250
     command = 'python -m pytest -q -n auto -m "not slow"'
     timed = re.compile(r"\d+ min \d+ s")
     after = readme.split(f"```bash\n{command}\n```", 1)[1]

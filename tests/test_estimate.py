@@ -51,13 +51,13 @@ def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypat
     monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     assert "egosearch estimate all" in estimate.training_time_line(200_000, "cpu")
     here = estimate.machine_key({"cpu": cpu_model(), "vector_unit": cpu_vector_unit(), "cores": os.cpu_count()})
-    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "decisions"}))
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "body steps"}))
     assert estimate.training_time_line(180_000, "cpu").startswith("estimate: about 0.5 h of CPU time")
     (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0,
                                                     "steps": "decisions"}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
-    # a calibration of the profile before it was a modular searcher timed body steps, not its decisions
-    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0}))
+    # a calibration made while the profile was a modular searcher timed its decisions, not body steps
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "decisions"}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
     assert estimate.training_time_line(180_000, "smoke") is None
 
@@ -118,9 +118,9 @@ def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_pa
     (results / "bench" / "learner.json").write_text(json.dumps(bench))
     cfg = load_config("cpu", {"modular_searcher": False, "demo_episodes": 100, "bc_updates": 500,
                               "dagger_rounds": 1, "dagger_episodes": 20})
-    # the calibration times the profile's decisions, this training's env steps are body steps: no stored one here
+    # the calibration times the profile's body steps, as this training's: its RL phase at the calibrated rate
     line = estimate.training_time_line(200_000, "cpu", cfg)
-    assert "no stored training's env steps are body steps" in line and "teacher's 100 episodes" in line
+    assert "calibrated at 50 body steps per CPU-second" in line and "teacher's 100 episodes" in line
     run = results / "train" / "cloned" / "seed0"
     run.mkdir(parents=True)
     (run / "done.json").write_text(json.dumps({"demonstrations": {"episodes": 1500, "cpu_s": 375.0}}))
@@ -159,7 +159,7 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
     lines = out.splitlines()
     assert "nan" not in out and lines[0].startswith("snakemake --cores 2 all from a fresh clone, cpu profile")
     here = estimate.machine_key(calibration.this_machine())
-    assert lines[1].startswith(f"  on this machine ({here}): about ") and "40 decisions per CPU-second" in lines[1]
+    assert lines[1].startswith(f"  on this machine ({here}): about ") and "40 body steps per CPU-second" in lines[1]
     assert ("  the machine was busy while it calibrated: other processes used 1.5 cores meanwhile, so the rate here "
             "may be low and the estimate long (calibrate again when it is idle)") in lines
     assert err.startswith("calibrating: ")
@@ -182,7 +182,7 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
     (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0}]}))
     (results / "bench" / "learner.json").write_text(json.dumps({"result": {
-        "env_steps_per_core_s_cpu_profile": 10.0, "cpu_profile_steps": "decisions"}}))
+        "env_steps_per_core_s_cpu_profile": 100.0, "cpu_profile_steps": "body steps"}}))  # 0.01 CPU-s a step
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     monkeypatch.setattr(estimate, "stored_cpu_s_per_step", lambda record, results, kind: 0.01)

@@ -197,12 +197,14 @@ def test_the_modular_searcher_field_trains_in_the_modular_env_of_the_variants_he
     assert observed_env_id("EgoSearch-v0", False, True) == "EgoSearchModular-v0"
     assert observed_env_id("EgoSearchNoHead-v0", False, True) == "EgoSearchNoHeadModular-v0"
     assert observed_env_id("EgoSearchModular-v0", False, False) == "EgoSearchModular-v0"
-    assert resolve_variant("head_off", "cpu").env_id == "EgoSearchNoHeadModular-v0"  # the cpu profile's
+    assert resolve_variant("head_off_modular", "cpu").env_id == "EgoSearchNoHeadModular-v0"
     assert resolve_variant("head_off_from_scratch", "cpu").env_id == "EgoSearchNoHeadMemory-v0"
+    modular = dict(resolve_variant("head_off_modular", "cpu").variant.config)
+    load_config("cpu", modular)  # the stored pair's settings are valid
     with pytest.raises(ValueError, match="target_memory"):
-        load_config("cpu", {"target_memory": True})  # the frontier searcher remembers the target itself
+        load_config("cpu", {**modular, "target_memory": True})  # the frontier searcher remembers the target itself
     with pytest.raises(ValueError, match="demo_episodes"):
-        load_config("cpu", {"demo_episodes": 10})
+        load_config("cpu", {**modular, "demo_episodes": 10})
 
 
 def test_a_run_stored_before_the_field_is_the_same_run_as_the_variant_that_names_it(tmp_path):
@@ -212,11 +214,11 @@ def test_a_run_stored_before_the_field_is_the_same_run_as_the_variant_that_names
     from egosearch.rl.run_files import check_same_run
     from egosearch.variants import resolve_variant
 
-    # head_on's stored runs were trained as the lever head_on_modular, before the cpu profile became it
-    stored = Path(__file__).resolve().parent.parent / "results/cpu/train/head_on/seed0/done.json"
+    # head_on_modular's stored runs were trained before the field existed
+    stored = Path(__file__).resolve().parent.parent / "results/cpu/train/head_on_modular/seed0/done.json"
     done = json.loads(stored.read_text())
     assert "modular_searcher" not in done["config"] and done["variant"] == "head_on_modular"
-    resolved = resolve_variant("head_on", "cpu", {"seed": 0})
+    resolved = resolve_variant("head_on_modular", "cpu", {"seed": 0})
     check_same_run("finished run", stored, done, done["variant"], resolved.env_id, resolved.variant.train_env,
                    resolved.config)
 

@@ -77,8 +77,8 @@ def test_blocks_are_filled_from_the_stored_files(tmp_path):
     out = render_readme(README, tmp_path, "p")
     assert "stale" not in out and "| 0.42 | 0.17 |" in out and "text kept" in out
     # fig6: first, last (with its seed CI) and best evaluation of each variant
-    assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | seeds | 0.30 at 4,000 |" in out
-    assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | seeds | 0.05 at 0 |" in out
+    assert "| v | 3 | 0.10 | 0.30 [0.20, 0.40] at 4,000 | +0.20 | seeds | 0.30 at 4,000 |" in out
+    assert "| w | 1 | 0.05 | 0.05 [–, –] at 0 | +0.00 | seeds | 0.05 at 0 |" in out
     assert "commit `0123456`" in out and "10 jobs, 3.02 h" in out and "eval 1.0 min, train 180.0 min" in out
     # `all` trains head_on and head_off only: my_variant's hour is a comparison, not part of it; the
     # generated-homes variant, the generated groups and the generalise report are `generalise`'s

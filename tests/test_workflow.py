@@ -252,7 +252,8 @@ def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
 
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
     assert claims_pairs({**config, "profile": "cpu"}) == [
-        ["head_on", "head_off"], ["head_on_from_scratch", "head_off_from_scratch"], ["frontier", "frontier_head_off"]]
+        ["head_on", "head_off"], ["head_on_from_scratch", "head_off_from_scratch"],
+        ["head_on_modular", "head_off_modular"], ["frontier", "frontier_head_off"]]
     assert claims_pairs({**config, "profile": "smoke"}) == config["claims_pairs"] == [
         ["head_on", "head_off"], ["frontier", "frontier_head_off"]]
 
@@ -264,7 +265,7 @@ def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_ran
     out = run(["-n", "-p", "decisions_floor", "-R", "decisions_floor_compare"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
-    for variant, floor in (("head_on", "modular_random"), ("head_off", "modular_random_head_off")):
+    for variant, floor in (("head_on_modular", "modular_random"), ("head_off_modular", "modular_random_head_off")):
         assert f"--out results/cpu/compare/{variant}_vs_{floor}.csv" in text
         assert f"results/cpu/eval/{floor}/seed0/bedroom_bath/everywhere/h1.65.csv" in text
         assert f"results/cpu/eval/{variant}/seed2/kitchen_living/no_low_cabinets/h0.45.csv" in text

@@ -21,7 +21,7 @@ from egosearch.rl.config import BODY_STEPS, DECISIONS, load_config
 
 def steps_of_profile(profile: str) -> str:
     """What an env step of ``profile``'s trainings counts (:data:`DECISIONS` at a modular searcher's
-    profile, the cpu profile's since it became one; else :data:`BODY_STEPS`)."""
+    profile, the cpu profile's while it was one; else :data:`BODY_STEPS`, every profile's today)."""
     return load_config(profile, {}).env_step_unit
 
 
