@@ -55,6 +55,7 @@ import torch
 
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
+from egosearch.envs import observed_env_id
 from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
@@ -81,7 +82,6 @@ from egosearch.rl.run_files import (
     to_tensors,
 )
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
-from egosearch.sim.envs import observed_env_id
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
