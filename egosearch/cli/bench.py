@@ -24,7 +24,7 @@ DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds"
 """Each benchmark's option defaults (the parser leaves them None, so that an option given to a
 benchmark that does not read it is told apart from one left alone)."""
 READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "out_dir": "gpu",
-           "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu"}
+           "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu", "stacked": "gpu"}
 """The benchmark that reads each of the options that only one of them reads."""
 
 
@@ -70,6 +70,7 @@ def run(args) -> None:
     options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
     if args.what == "gpu":
         options = (f" --side-by-side {args.side_by_side}" if args.side_by_side else "") + (
+            f" --stacked {args.stacked}" if args.stacked else "") + (
             f" --seconds {args.seconds:g}" + (" --cuda-graph" if args.cuda_graph else "") + (
                 f" --baseline-seconds {args.baseline_seconds:g}" if args.baseline_seconds else ""))
     record = bench.recorded(f"egosearch bench {args.what}{options}", measure)
@@ -99,6 +100,11 @@ def check_gpu_options(args) -> None:
         if args.cuda_graph:
             raise ValueError("--cuda-graph is not read with --side-by-side: its trainings run the paper profile as "
                              "the DAG does (cuda_graph on)")
+    if args.stacked is not None:
+        at_least("--stacked", args.stacked, 2, "the seeds stacked in one training")
+        if args.side_by_side is None:
+            raise ValueError("--stacked is measured beside the trainings side by side: give --side-by-side N too "
+                             "(the record it writes into is theirs)")
     if not args.seconds > 0:
         raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
     if not args.baseline_seconds >= 0:
@@ -123,5 +129,5 @@ def measure_side_by_side(args) -> dict:
     steps = sum(resolve_variant(v, "paper").config.total_env_steps for v in variants) * len(seeds)
     return run_side_by_side(args.side_by_side, args.seconds, args.out_dir, variant=GPU_CHECK_VARIANT,
                             all_env_steps=steps, all_trainings=len(variants) * len(seeds),
-                            baseline_seconds=args.baseline_seconds,
+                            baseline_seconds=args.baseline_seconds, stacked=args.stacked or 0,
                             say=lambda line: print(line, file=sys.stderr, flush=True))

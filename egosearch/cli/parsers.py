@@ -97,6 +97,10 @@ def add_train(sub) -> None:
                                       "is complete (the DAG does: a killed job never leaves a partial output)")
     p.add_argument("--max-wall-s", type=float, help="stop after this many seconds with a checkpoint written (inside "
                                                     "a cluster's time limit); the same command resumes it")
+    p.add_argument("--stack-seeds", metavar="SEEDS",
+                   help="train these seeds (comma-separated, e.g. 0,1,2) in one process, their updates stacked as one "
+                        "model (sac_curl, sac_drq; docs/gpu.md); --out-dir (and --work-dir) must then hold {seed}, "
+                        "e.g. results/paper/train/head_on/seed{seed}; replaces --seed")
     add_force(p)
 
 
@@ -170,6 +174,10 @@ def add_bench(sub) -> None:
                         "<out-dir>/side_by_side/<i>), under CUDA MPS where the command can start it; --out defaults "
                         "to results/paper/gpu_check/side_by_side.json (aggregate env steps/s, the paper `all`'s "
                         "projected hours), N >= 2")
+    p.add_argument("--stacked", type=int, metavar="N",
+                   help="gpu, with --side-by-side: last, one training of N seeds with their updates stacked as one "
+                        "model (`egosearch train --stack-seeds`, all cores), into the same record (its aggregate env "
+                        "steps/s and projected hours under \"stacked\"), N >= 2")
     add_record_outputs(p, "print one JSON object", "the result as JSON with the command, date, commit, CPU and the "
                        "machine's load", "learner.json", "which the docs' Speed page reads")
 

@@ -267,7 +267,7 @@ def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
 def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
            progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None) -> dict:
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
-    run = TrainingRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
+    run = LiveRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
     own_eval = evaluate_fn is None
     evaluate_fn = evaluate_fn or default_evaluator(env_id, env_kwargs, cfg.eval_episodes)
     bar = run.open_progress(progress)
@@ -307,7 +307,7 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
     return run.finish(last_row)
 
 
-class TrainingRun:
+class LiveRun:
     """One training run's live state (agent, replay, envs, counters, CSV logs) and the steps of its
     loop, each a method, after DrQ-v2's ``Workspace``.
 

@@ -1,7 +1,7 @@
 """Several seeds of one variant trained in one process, their updates stacked
 (:mod:`egosearch.rl.stacked`; issue 47, item 4).
 
-``train_stacked(env_id, cfgs, out_dirs)`` runs one :class:`egosearch.rl.train.TrainingRun` per seed:
+``train_stacked(env_id, cfgs, out_dirs)`` runs one :class:`egosearch.rl.train.LiveRun` per seed:
 each has its own envs, replay, CSV logs, evaluator, checkpoint and actor files in its own folder,
 written exactly as :func:`egosearch.rl.train.train` writes them (the same paths,
 ``results/<profile>/train/<variant>/seed<k>/``, and the same formats), and each draws from its own
@@ -25,7 +25,7 @@ import torch
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.stacked import SeedStreams, StackingError, stack_agents
-from egosearch.rl.train import TrainingRun, default_evaluator, open_run, torch_threads
+from egosearch.rl.train import LiveRun, default_evaluator, open_run, torch_threads
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.sim.envs import observed_env_id
 
@@ -103,12 +103,12 @@ def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list]
     """The loop of :func:`egosearch.rl.train.train`'s ``_train``, the seeds in turn for everything
     but the updates, which are stacked."""
     device = torch.device("cpu")
-    runs: list[TrainingRun] = []
+    runs: list[LiveRun] = []
     streams: SeedStreams | None = None
     for cfg, d, seed_envs, ckpt in zip(cfgs, dirs, envs, ckpts):
-        # TrainingRun seeds the global generators and builds the agent as a separate run does; what
+        # LiveRun seeds the global generators and builds the agent as a separate run does; what
         # they hold after it (a resumed run: the checkpoint's states) becomes this seed's stream
-        run = TrainingRun(seed_envs, env_id, cfg, d, env_kwargs, variant, ckpt)
+        run = LiveRun(seed_envs, env_id, cfg, d, env_kwargs, variant, ckpt)
         run.say = lambda line, seed=cfg.seed: print(f"[seed {seed}] {line}", flush=True)
         if streams is None:
             device = run.device
