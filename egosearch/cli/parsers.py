@@ -149,14 +149,17 @@ def add_fullbody(sub) -> None:
 
 
 def add_bench(sub) -> None:
-    about = "speed benchmarks: env (sensor + physics), homes (building one), learner or gpu (needs CUDA)"
+    about = ("speed benchmarks: env (sensor + physics), homes (building one), learner, gpu (needs CUDA) or stacked "
+             "(seeds' updates stacked)")
     p = sub.add_parser("bench", help=about, description=about)
-    p.add_argument("what", choices=("env", "homes", "learner", "gpu"),
+    p.add_argument("what", choices=("env", "homes", "learner", "gpu", "stacked"),
                    help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
                         f"against a training episode; learner: updates/s of {LEARNERS}, and of SAC+CURL at Table "
                         "2's sizes; gpu (needs CUDA): the learner benchmarks and a paper-profile training of "
-                        "--seconds on this machine's GPU (results/paper/gpu_check)")
+                        "--seconds on this machine's GPU (results/paper/gpu_check); stacked: --seeds seeds' updates "
+                        "stacked as one model against their separate updates, at the cpu profile")
     p.add_argument("--layout", help=f"env: the home ({LAYOUTS}; default kitchen_living)")
+    p.add_argument("--seeds", type=int, help="stacked: the seeds stacked, >= 2 (default 3)")
     p.add_argument("--frames", type=int, help="env: sensor frames to time, >= 1 (default 3000)")
     p.add_argument("--steps", type=int, help="env: env steps to time, >= 1 (default 3000)")
     p.add_argument("--seconds", type=float, help="gpu: the training's wall time, > 0 (default 150)")
