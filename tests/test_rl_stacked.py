@@ -38,6 +38,10 @@ def curl_agent(seed: int, **overrides) -> SacCurlAgent:
     return SacCurlAgent(load_config("paper", {**CURL_SMALL, **overrides}), 5)
 
 
+def curl_cuda_agent(seed: int, graphed: bool = False) -> SacCurlAgent:
+    return curl_agent(seed, device="cuda", cuda_graph=graphed)
+
+
 def drq_agent(seed: int) -> SacDrqAgent:
     torch.manual_seed(seed)
     agent = SacDrqAgent(load_config("cpu", DRQ_SMALL), 5, state_dim=STATE_DIM)
@@ -69,22 +73,32 @@ def flat(state, prefix=""):
     return {prefix: state}
 
 
-def run_both(make, side: int, updates: int, drq: bool = False):
-    """(separate agents after their updates, the stacked agents after theirs, the metrics of each,
-    the seeds' torch generator states after each)."""
-    separate = [make(seed) for seed in SEEDS]
-    members = [copy.deepcopy(a) for a in separate]
-    streams = SeedStreams(torch.device("cpu"))
+def generator_state(device: torch.device) -> torch.Tensor:
+    return torch.cuda.get_rng_state(device) if device.type == "cuda" else torch.get_rng_state()
+
+
+def seeded_streams(device: torch.device) -> SeedStreams:
+    streams = SeedStreams(device)
     for k in range(len(SEEDS)):
         torch.manual_seed(STREAM_BASE + k)
         streams.capture()
-    stacked = stack_agents(members, streams)
-    batches = [[batch(100 * u + k, side, drq=drq) for k in range(len(SEEDS))] for u in range(updates)]
+    return streams
+
+
+def run_both(make, side: int, updates: int, drq: bool = False, device: str = "cpu"):
+    """(separate agents after their updates, the stacked agents after theirs, the metrics of each,
+    the seeds' torch generator states (the device's) after each)."""
+    dev = torch.device(device)
+    separate = [make(seed) for seed in SEEDS]
+    members = [copy.deepcopy(a) for a in separate]
+    stacked = stack_agents(members, seeded_streams(dev))
+    batches = [[{k: v.to(dev) for k, v in batch(100 * u + k, side, drq=drq).items()} for k in range(len(SEEDS))]
+               for u in range(updates)]
     separate_metrics, separate_rng = [], []
     for k, agent in enumerate(separate):
         torch.manual_seed(STREAM_BASE + k)
         separate_metrics.append([agent.update(batches[u][k]) for u in range(updates)])
-        separate_rng.append(torch.get_rng_state())
+        separate_rng.append(generator_state(dev))
     outside = torch.get_rng_state()
     stacked_metrics = [stacked.update(batches[u]) for u in range(updates)]
     assert torch.equal(torch.get_rng_state(), outside)  # the process's own stream is left alone
@@ -98,7 +112,7 @@ def assert_same_runs(separate, stacked, separate_metrics, stacked_metrics, separ
         assert mine.keys() == theirs.keys()
         for key, value in theirs.items():
             if torch.is_tensor(value):
-                a, b = mine[key].float(), value.float()
+                a, b = mine[key].float().cpu(), value.float().cpu()
                 off = ~torch.isclose(a, b, **ROUNDING)
                 assert off.float().mean() <= AMPLIFIED_SHARE, (k, key, off.float().mean().item())
                 assert (a - b).abs().max() <= AMPLIFIED_MAX, (k, key, (a - b).abs().max().item())
@@ -111,7 +125,8 @@ def assert_same_runs(separate, stacked, separate_metrics, stacked_metrics, separ
                 else:
                     assert m1[k][name] == pytest.approx(value, rel=1e-4, abs=1e-5), (k, u, name)
         # each seed drew exactly what its separate update drew
-        assert torch.equal(stacked.streams.states[k].torch_cpu, separate_rng[k])
+        state = stacked.streams.states[k]
+        assert torch.equal(state.torch_cuda if state.torch_cuda is not None else state.torch_cpu, separate_rng[k])
     # not trivially equal: the seeds differ from one another, and the updates moved them
     states = [flat(agent.state_dict()) for agent in separate]
     assert not torch.allclose(states[0]["critic/q1.0.weight/"], states[1]["critic/q1.0.weight/"])
@@ -181,3 +196,33 @@ def test_seed_streams_round_trip_through_a_checkpoint():
     restored.load_plain(0, plain)
     with restored.stream(0):
         assert torch.equal(torch.rand(3), expected[0]) and np.array_equal(np.random.rand(3), expected[1])
+
+
+# ---- on a GPU (the ``gpu`` marker: skipped without CUDA) -----------------------------------------
+
+needs_cuda = pytest.mark.skipif(not torch.cuda.is_available(), reason="CUDA is not available")
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_stacked_sac_curl_on_cuda_equals_separate_updates():
+    assert_same_runs(*run_both(curl_cuda_agent, 100, updates=4, device="cuda"))
+
+
+@pytest.mark.gpu
+@needs_cuda
+def test_the_stacked_update_recorded_as_cuda_graphs_equals_the_eager_one():
+    """Its random numbers are drawn before the graph, from the seeds' streams, so the recorded stacked
+    update and the eager one see the same draws: 8 updates warm up, record and replay both patterns."""
+    device = torch.device("cuda")
+    graphed = stack_agents([curl_cuda_agent(seed, graphed=True) for seed in SEEDS], seeded_streams(device))
+    eager = stack_agents([curl_cuda_agent(seed) for seed in SEEDS], seeded_streams(device))
+    assert graphed.graphed is not None and eager.graphed is None
+    for u in range(8):
+        batches = [{k: v.to(device) for k, v in batch(100 * u + k, 100).items()} for k in range(len(SEEDS))]
+        for m1, m2 in zip(graphed.update(batches), eager.update(batches)):
+            for name, value in m2.items():
+                assert math.isnan(m1[name]) if math.isnan(value) else m1[name] == pytest.approx(value, rel=1e-3), name
+    assert graphed.graphed.captures == 2
+    for name, tensor in eager.params.items():
+        assert torch.allclose(graphed.params[name], tensor, rtol=1e-3, atol=1e-4), name

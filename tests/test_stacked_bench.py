@@ -91,3 +91,16 @@ def test_train_help_names_the_option(option, capsys):
     with pytest.raises(SystemExit):
         main(["train", "--help"])
     assert option in capsys.readouterr().out
+
+
+def test_bench_stacked_times_both_ways_at_small_sizes():
+    from egosearch.rl.bench import bench_stacked
+
+    small = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32, "actor_hidden_dim": 64,
+             "critic_hidden_dim": 64, "batch_size": 16}
+    r = bench_stacked(seeds=2, warmup=1, rounds=2, overrides=small)
+    assert r["algorithm"] == "sac_drq" and r["seeds"] == 2 and r["batch_size"] == 16 and r["rounds"] == 2
+    assert 0 < r["stacked_round_s_best"] <= r["stacked_round_s"] and 0 < r["separate_round_s_best"] <= r[
+        "separate_round_s"]
+    # the ratio of the unrounded medians: the rounded ones give it to within their rounding
+    assert r["stacked_speedup"] == pytest.approx(r["separate_round_s"] / r["stacked_round_s"], rel=0.05, abs=0.01)
