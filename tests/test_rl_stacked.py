@@ -180,22 +180,27 @@ def test_what_cannot_be_stacked_is_refused():
         stack_agents([curl_agent(0)], streams)
 
 
-def test_seed_streams_round_trip_through_a_checkpoint():
+def test_seed_streams_keep_each_seeds_draws_apart():
     streams = SeedStreams(torch.device("cpu"))
+    for seed in (3, 3, 4):
+        torch.manual_seed(seed)
+        np.random.seed(seed)
+        streams.capture()
+    torch.manual_seed(9)
+    outside = torch.rand(2)
+    torch.manual_seed(9)
+    draws = []
+    for k in (0, 2, 1, 0):
+        with streams.stream(k):
+            draws.append((torch.rand(3), np.random.rand(2)))
+    assert torch.equal(torch.rand(2), outside)  # the process's own stream went on as if nothing was drawn
     torch.manual_seed(3)
     np.random.seed(3)
-    streams.capture()
-    with streams.stream(0):
-        torch.rand(5)
-        np.random.rand(2)
-    plain = streams.to_plain(0)
-    with streams.stream(0):
-        expected = (torch.rand(3), np.random.rand(3))
-    restored = SeedStreams(torch.device("cpu"))
-    restored.capture()
-    restored.load_plain(0, plain)
-    with restored.stream(0):
-        assert torch.equal(torch.rand(3), expected[0]) and np.array_equal(np.random.rand(3), expected[1])
+    first, second = (torch.rand(3), np.random.rand(2)), (torch.rand(3), np.random.rand(2))
+    # seeds 0 and 1 start alike and each goes on from its own last draw, whatever drew in between
+    assert torch.equal(draws[0][0], first[0]) and np.array_equal(draws[0][1], first[1])
+    assert torch.equal(draws[2][0], first[0]) and torch.equal(draws[3][0], second[0])
+    assert not torch.equal(draws[1][0], first[0])  # seed 2's stream is another
 
 
 # ---- on a GPU (the ``gpu`` marker: skipped without CUDA) -----------------------------------------

@@ -108,20 +108,6 @@ class SeedStreams:
             self.states[k] = self._now()
             self._set(outside)
 
-    def to_plain(self, k: int) -> dict[str, Any]:
-        """Seed ``k``'s states for a checkpoint (tensors and plain python values)."""
-        s = self.states[k]
-        return {"torch_cpu": s.torch_cpu.clone(), "torch_cuda": None if s.torch_cuda is None else s.torch_cuda.clone(),
-                "numpy": [s.numpy_state[0], np.asarray(s.numpy_state[1]).tolist(), *s.numpy_state[2:]],
-                "python": [s.python_state[0], list(s.python_state[1]), s.python_state[2]]}
-
-    def load_plain(self, k: int, plain: dict[str, Any]) -> None:
-        """Restore seed ``k``'s states from :meth:`to_plain`."""
-        numpy_state = (plain["numpy"][0], np.asarray(plain["numpy"][1], np.uint32), *plain["numpy"][2:])
-        python_state = (plain["python"][0], tuple(plain["python"][1]), plain["python"][2])
-        cuda = plain["torch_cuda"] if self.device.type == "cuda" else None
-        self.states[k] = SeedState(plain["torch_cpu"], cuda, numpy_state, python_state)
-
 
 # ---- stacked parameters -------------------------------------------------------------------
 
@@ -344,10 +330,6 @@ def stack_crop(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -
     return flat.reshape(n, b, *flat.shape[1:])
 
 
-def mse(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    return F.mse_loss(a, b)
-
-
 # ---- SAC + CURL ---------------------------------------------------------------------------
 
 class StackedSacCurl(StackedAgents):
@@ -419,7 +401,7 @@ class StackedSacCurl(StackedAgents):
             z = nets("critic.proj", nets("critic.convs", anchor))
             x = torch.cat([torch.cat([z, extra], dim=-1), action], dim=-1)
             q1, q2 = nets("critic.q1", x), nets("critic.q2", x)
-            return mse(q1, target_q) + mse(q2, target_q), q1.mean()
+            return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean()
 
         critic_loss, out["q_mean"] = self.seeds(critic, anchor, extra, inputs["action"], target_q)
         self.step_with("critic", critic_loss)
@@ -560,7 +542,7 @@ class StackedSacDrq(StackedAgents):
             with torch.set_grad_enabled(not warming_up):  # PIRLNav's critic warm-up: the encoder stays
                 h = nets("encoder", obs)
             q1, q2 = nets("critic", h, critic_extra, action)
-            return mse(q1, target_q) + mse(q2, target_q), q1.mean(), h
+            return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean(), h
 
         critic_loss, out["q_mean"], h = self.seeds(critic, obs, critic_extra, inputs["action"], target_q)
         self.step_with("critic", critic_loss, allow_unused=warming_up)

@@ -15,6 +15,7 @@ out of the stack). What runs per seed, in turn: imitation before RL, acting, env
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -83,7 +84,8 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
         for _ in todo:
             envs.append([make_train_env(env_id, train_env_kwargs(cfg, env_kwargs)) for _ in range(cfg.num_envs)])
         done = _train_stacked([cfgs[k] for k in todo], [dirs[k] for k in todo], envs, env_id, env_kwargs, variant,
-                              [opened[k][1] for k in todo], [evaluators[k] for k in todo], on_step, max_wall_s)
+                              [opened[k][1] for k in todo], [evaluators[k] for k in todo], on_step, max_wall_s,
+                              progress)
         for k, summary in zip(todo, done):
             summaries[k] = summary
         return [s for s in summaries if s is not None]
@@ -99,23 +101,38 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
 
 def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list], env_id: str, env_kwargs: dict,
                    variant: str, ckpts: list[dict | None], evaluators: list[Evaluator],
-                   on_step: Callable[[int], None] | None, max_wall_s: float | None) -> list[dict]:
+                   on_step: Callable[[int], None] | None, max_wall_s: float | None, progress: bool) -> list[dict]:
     """The loop of :func:`egosearch.rl.train.train`'s ``_train``, the seeds in turn for everything
     but the updates, which are stacked."""
-    device = torch.device("cpu")
     runs: list[LiveRun] = []
     streams: SeedStreams | None = None
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=cfgs[0].total_env_steps, unit="step", dynamic_ncols=True, mininterval=1.0,
+                   desc=f"{variant} seeds {','.join(str(c.seed) for c in cfgs)} stacked")
+    write = bar.write if bar is not None else functools.partial(print, flush=True)
     for cfg, d, seed_envs, ckpt in zip(cfgs, dirs, envs, ckpts):
         # LiveRun seeds the global generators and builds the agent as a separate run does; what
         # they hold after it (a resumed run: the checkpoint's states) becomes this seed's stream
         run = LiveRun(seed_envs, env_id, cfg, d, env_kwargs, variant, ckpt)
-        run.say = lambda line, seed=cfg.seed: print(f"[seed {seed}] {line}", flush=True)
-        if streams is None:
-            device = run.device
-            streams = SeedStreams(device)
+        run.say = lambda line, seed=cfg.seed: write(f"[seed {seed}] {line}")
+        streams = streams or SeedStreams(run.device)
         streams.capture()
         runs.append(run)
     assert streams is not None
+    try:
+        return _loop(runs, streams, cfgs, evaluators, on_step, max_wall_s, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _loop(runs: list[LiveRun], streams: SeedStreams, cfgs: list[LearnerConfig], evaluators: list[Evaluator],
+          on_step: Callable[[int], None] | None, max_wall_s: float | None, bar: Any) -> list[dict]:
+    """Imitation and the step-0 evaluation seed by seed, then the rounds: every seed's env steps in
+    turn, the stacked updates, then each seed's logs, evaluations and checkpoints."""
     last_rows: list[dict | None] = [None] * len(runs)
     for k, run in enumerate(runs):
         with streams.stream(k):
@@ -128,6 +145,8 @@ def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list]
     # stacked after imitation: the clones' weights are where the stacked parameters start
     stack = stack_agents([run.agent for run in runs], streams)
     cfg, first = cfgs[0], runs[0]
+    if bar is not None:
+        bar.update(first.step)  # a resumed run's steps so far
     t_start = time.perf_counter()
     while first.step < cfg.total_env_steps:
         before = first.step
@@ -157,6 +176,8 @@ def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list]
                     run.save_checkpoint()
                     if run.step < cfg.total_env_steps:
                         run.restart_episodes()
+        if bar is not None:
+            bar.update(first.step - before)
         if on_step is not None:
             on_step(first.step)
         if stop:
