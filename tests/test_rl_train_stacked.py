@@ -113,3 +113,21 @@ def test_stacked_sac_drq_training_with_lockstep_envs_and_n_step_returns(tmp_path
         assert torch.load(folder / "actor.pt", weights_only=True)["format"] == "egosearch-sac-drq-actor-v1"
         rows = read_csv(folder / "train.csv")[1]
         assert int(rows[-1]["updates"]) == summary["updates"] > 0
+
+
+def test_a_stacked_seeds_checkpoint_resumes_as_a_separate_run(tmp_path):
+    cfgs = configs()
+    folders = [tmp_path / f"seed{s}" for s in SEEDS]
+
+    def stop(step: int) -> None:
+        if step >= 120:  # after the checkpoint at step 80
+            raise Interrupt(step)
+
+    with pytest.raises(Interrupt):
+        train_stacked(FAKE_ENV_ID, cfgs, folders, variant="head-on", progress=False, on_step=stop)
+    summary = train(FAKE_ENV_ID, cfgs[1], folders[1], variant="head-on", progress=False)
+    assert summary == check_complete_run(folders[1], cfgs[1])
+    # seed 0 alone is then at another step than seed 1's finished run: the stack takes seed 0 only
+    assert [s["env_steps"] for s in train_stacked(FAKE_ENV_ID, cfgs, folders, variant="head-on",
+                                                  progress=False)] == [160, 160]
+    check_complete_run(folders[0], cfgs[0])
