@@ -5,6 +5,7 @@ stream has consumed, for SAC + CURL and for SAC-DrQ."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 
 import numpy as np
@@ -14,7 +15,7 @@ import torch
 from egosearch.rl.config import load_config
 from egosearch.rl.sac_curl import SacCurlAgent
 from egosearch.rl.sac_drq import SacDrqAgent
-from egosearch.rl.stacked import SeedStreams, StackedSacCurl, StackingError, stack_agents
+from egosearch.rl.stacked import SeedStreams, StackedSacCurl, StackingError, check_stackable, stack_agents
 
 SEEDS = (0, 1, 2)
 STREAM_BASE = 500
@@ -173,6 +174,10 @@ def test_what_cannot_be_stacked_is_refused():
     streams.capture()
     with pytest.raises(StackingError, match="different architectures"):
         StackedSacCurl([curl_agent(0), curl_agent(1, critic_hidden_dim=32)], streams)
+    with pytest.raises(StackingError, match="algorithm ppo is not stacked; stacked: sac_curl, sac_drq"):
+        check_stackable(dataclasses.replace(load_config("smoke"), algorithm="ppo"))
+    with pytest.raises(StackingError, match="reconstruction decoder"):
+        check_stackable(load_config("cpu", {"encoder_aux_loss": "reconstruction"}))
     with pytest.raises(StackingError, match="share_encoder_forward"):
         StackedSacCurl([curl_agent(0, share_encoder_forward=True), curl_agent(1, share_encoder_forward=True)],
                        streams)

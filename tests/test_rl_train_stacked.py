@@ -99,6 +99,10 @@ def test_seeds_that_cannot_be_stacked_are_refused(tmp_path):
                       [tmp_path / "a", tmp_path / "b"], progress=False)
     with pytest.raises(StackingError, match="repeated"):
         train_stacked(FAKE_ENV_ID, [cfgs[0], cfgs[0]], [tmp_path / "a", tmp_path / "b"], progress=False)
+    with pytest.raises(StackingError, match="algorithm sac_drq_recurrent is not stacked"):
+        train_stacked(FAKE_ENV_ID, configs(algorithm="sac_drq_recurrent", obs_downsample=2, curl_latent=32,
+                                           encoder_stride2_layers=2, num_envs=2),
+                      [tmp_path / "a", tmp_path / "b"], progress=False)
     assert not (tmp_path / "a").exists()  # refused before anything is written
 
 

@@ -109,6 +109,23 @@ class SeedStreams:
             self._set(outside)
 
 
+# ---- what can be stacked ------------------------------------------------------------------
+
+ALGORITHMS = ("sac_curl", "sac_drq")
+"""The learners (``LearnerConfig.algorithm``) whose seeds can be stacked: the SAC learners without memory."""
+
+
+def check_stackable(cfg: Any) -> None:
+    """Raise :class:`StackingError` (one line) for a learner config whose update is not stacked; the
+    stacked training asks before it writes anything."""
+    if cfg.algorithm not in ALGORITHMS:
+        raise StackingError(f"algorithm {cfg.algorithm} is not stacked; stacked: {', '.join(ALGORITHMS)}")
+    if cfg.algorithm == "sac_curl" and (cfg.share_encoder_forward or cfg.compile):
+        raise StackingError("SAC+CURL with share_encoder_forward or compile is not stacked")
+    if cfg.algorithm == "sac_drq" and cfg.encoder_aux_loss != "none":
+        raise StackingError("SAC-DrQ's reconstruction decoder (encoder_aux_loss) is not stacked")
+
+
 # ---- stacked parameters -------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -147,7 +164,7 @@ class StackedAgents:
     does, each member drawing its random numbers from its own stream of ``streams``.
 
     A subclass names its ``parts``, the member class it stacks, the sub-network paths its update calls
-    (``paths``), checks the members' config (:meth:`check_config`), draws one seed's random numbers
+    (``paths``), draws one seed's random numbers
     (:meth:`draw`) and writes the stacked update (:meth:`update_tensors`)."""
 
     parts: ClassVar[StackedParts]
@@ -166,7 +183,7 @@ class StackedAgents:
             raise StackingError("the agents have different architectures")
         if len({m.num_updates for m in members}) != 1:
             raise StackingError("the agents are at different updates")
-        self.check_config(first.cfg)
+        check_stackable(first.cfg)
         self.members, self.streams = members, streams
         self.cfg, self.device, self.n = first.cfg, first.device, len(members)
         self.num_updates = first.num_updates
@@ -186,9 +203,6 @@ class StackedAgents:
         self.graphed = self._graphed()
 
     # ---- set-up --------------------------------------------------------------------------
-    def check_config(self, cfg: Any) -> None:
-        """Refuse an option the stacked update does not do (a subclass's)."""
-
     def _graphed(self) -> GraphedUpdate | None:
         """The update recorded as CUDA graphs where the members' own would be (their optimisers can be
         recorded); never on a CPU."""
@@ -365,10 +379,6 @@ class StackedSacCurl(StackedAgents):
         return {"anchor_oy": ay, "anchor_ox": ax, "next_oy": ny, "next_ox": nx, "pos_oy": py, "pos_ox": px,
                 "noise_next": noise_next, "noise_pi": noise_pi}
 
-    def check_config(self, cfg: Any) -> None:
-        if cfg.share_encoder_forward or cfg.compile:
-            raise StackingError("share_encoder_forward and compile are not stacked")
-
     def update_tensors(self, inputs: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
         cfg = self.cfg
         do_curl, do_actor, do_polyak = self.step_flags()
@@ -476,10 +486,6 @@ class StackedSacDrq(StackedAgents):
         super().__init__(members, streams)
         self.target_entropy = members[0].target_entropy
         self.templates["encoder"].channels_last = False  # a layout only; vmap gives it stacked inputs
-
-    def check_config(self, cfg: Any) -> None:
-        if cfg.encoder_aux_loss != "none":
-            raise StackingError("SAC-DrQ's reconstruction decoder (encoder_aux_loss) is not stacked")
 
     def warming_up(self) -> bool:
         return self.num_updates <= self.cfg.critic_warmup_updates

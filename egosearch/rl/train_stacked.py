@@ -25,7 +25,7 @@ import torch
 
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.rl.config import LearnerConfig
-from egosearch.rl.stacked import SeedStreams, StackingError, stack_agents
+from egosearch.rl.stacked import SeedStreams, StackingError, check_stackable, stack_agents
 from egosearch.rl.train import LiveRun, default_evaluator, open_run, torch_threads
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.sim.envs import observed_env_id
@@ -58,6 +58,7 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
         raise ValueError("one config, one out_dir (and one evaluator, if any) per seed")
     cfgs = [cfg.validate() for cfg in cfgs]
     same_but_seed(cfgs)
+    check_stackable(cfgs[0])
     env_id = observed_env_id(env_id, cfgs[0].target_memory, cfgs[0].modular_searcher)
     env_kwargs = dict(env_kwargs or {})
     variant = variant or env_id
