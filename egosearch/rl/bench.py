@@ -123,6 +123,56 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         torch.set_num_threads(before)
 
 
+def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds: int = 15,
+                  overrides: dict | None = None) -> dict:
+    """``egosearch bench stacked``: the update of ``seeds`` seeds stacked as one model
+    (:mod:`egosearch.rl.stacked`) against the same seeds' separate updates one after the other, at
+    ``profile``'s learner, batch and sizes and its thread count, each seed sampling its own replay. The
+    two alternate round by round (a round: one update of every seed), so that a shared machine's load
+    falls on both alike; the medians and the fastest rounds are reported. The critic warm-up is off
+    (``critic_warmup_updates`` 0) so that every update is a whole one, actor and temperature included."""
+    from egosearch.rl.stacked import SeedStreams, stack_agents
+
+    cfg = load_config(profile, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
+    before = torch.get_num_threads()
+    torch.set_num_threads(torch_threads(cfg.num_threads))
+    try:
+        device = resolve_device(cfg.device)
+        state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+        streams, separate, members, replays = SeedStreams(device), [], [], []
+        for seed in range(seeds):
+            for agents in (separate, members):
+                torch.manual_seed(seed)
+                agents.append(make_agent(cfg, 5, 30, 4, device, state_dim))
+            streams.capture()
+            replays.append(_filled_replay(5, device, seed=seed, size=separate[-1].replay_image_size,
+                                          state_dim=state_dim))
+        stack = stack_agents(members, streams)
+        sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+        times: dict[str, list[float]] = {"separate": [], "stacked": []}
+        for i in range(warmup + rounds):
+            t0 = time.perf_counter()
+            for agent, replay in zip(separate, replays):
+                agent.update(replay.sample(cfg.batch_size))
+            sync()
+            t1 = time.perf_counter()
+            stack.update([replay.sample(cfg.batch_size) for replay in replays])
+            sync()
+            t2 = time.perf_counter()
+            if i >= warmup:
+                times["separate"].append(t1 - t0)
+                times["stacked"].append(t2 - t1)
+        median = {k: float(np.median(v)) for k, v in times.items()}
+        return {"profile": profile, "algorithm": cfg.algorithm, "seeds": seeds, "batch_size": cfg.batch_size,
+                "torch_threads": torch.get_num_threads(), "device": str(device), "rounds": rounds,
+                "separate_round_s": round(median["separate"], 4), "stacked_round_s": round(median["stacked"], 4),
+                "separate_round_s_best": round(min(times["separate"]), 4),
+                "stacked_round_s_best": round(min(times["stacked"]), 4),
+                "stacked_speedup": round(median["separate"] / median["stacked"], 2)}
+    finally:
+        torch.set_num_threads(before)
+
+
 def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: dict | None = None) -> dict:
     """Env steps per core-second of a short REAL training run of ``profile`` (head-on,
     kitchen_living, everywhere): env stepping, acting and updates all in, its own evaluations

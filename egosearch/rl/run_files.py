@@ -24,7 +24,7 @@ CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
 CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
 START_ACTOR_NAME = "actor_start.pt"
-"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train._Run.write_start_actor`)."""
+"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train.LiveRun.write_start_actor`)."""
 """The resumable state inside ``out_dir`` (``*.ckpt`` is git-ignored: it holds the replay)."""
 
 
