@@ -24,11 +24,11 @@ from typing import Any
 import torch
 
 from egosearch.core.allocator import keep_freed_memory
+from egosearch.envs import observed_env_id
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.stacked import SeedStreams, StackingError, check_stackable, stack_agents
 from egosearch.rl.train import LiveRun, default_evaluator, open_run, torch_threads
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
-from egosearch.sim.envs import observed_env_id
 
 Evaluator = Callable[[Any], dict]
 
