@@ -34,23 +34,23 @@ register_fake_envs()
 TINY_RUN = {"device": "cpu", "num_threads": 1, "seed": 3, "total_env_steps": 48, "init_steps": 16,
             "eval_every": 48, "eval_episodes": 1, "log_every": 16, "checkpoint_every": 48, "replay_capacity": 256,
             "batch_size": 8, "actor_hidden_dim": 16, "critic_hidden_dim": 16, "encoder_num_filters": 4,
-            "encoder_latent_dim": 8, "curl_latent": 8, "encoder_num_layers": 2}
+            "encoder_latent_dim": 8, "encoder_num_layers": 2}
 """What every pinned training shares: 48 env steps, 16 of them random, batches of 8, 16-unit MLPs."""
 
 POOLED = {"obs_downsample": 4, "encoder_stride2_layers": 2, "aug_pad": 1}
 """The pooled learners' input: 100 px depth pooled to 25 px, two stride-2 convs."""
 
 PINNED: dict[str, tuple[str, dict]] = {
-    "sac_curl": ("smoke", {}),
-    "sac_curl_nstep_single_step": ("smoke", {"n_step": 2, "curl_double_encoder_step": False,
+    "sac_curl": ("smoke", {"curl_latent": 8}),
+    "sac_curl_nstep_single_step": ("smoke", {"curl_latent": 8, "n_step": 2, "curl_double_encoder_step": False,
                                              "actor_update_freq": 1, "critic_target_update_freq": 1}),
-    "sac_curl_shared_forward": ("smoke", {"share_encoder_forward": True, "channels_last": False}),
+    "sac_curl_shared_forward": ("smoke", {"curl_latent": 8, "share_encoder_forward": True, "channels_last": False}),
     "sac_drq": ("smoke", {"algorithm": "sac_drq", **POOLED, "num_envs": 2, "n_step": 3, "update_every": 2}),
     "sac_drq_ln_aux": ("smoke", {"algorithm": "sac_drq", **POOLED, "critic_layer_norm": True,
                                             "encoder_aux_loss": "reconstruction", "encoder_aux_weight": 0.5}),
     "sac_drq_recurrent": ("smoke", {"algorithm": "sac_drq_recurrent", **POOLED, "recurrent_hidden_dim": 8,
                                     "sequence_length": 4, "burn_in": 2}),
-    "ppo": ("smoke", {"algorithm": "ppo", **POOLED, "init_steps": 0, "num_envs": 2, "update_every": 16,
+    "ppo": ("smoke", {"algorithm": "ppo", "obs_downsample": 4, "encoder_stride2_layers": 2, "init_steps": 0, "num_envs": 2, "update_every": 16,
                       "replay_capacity": 64, "ppo_epochs": 2, "ppo_minibatches": 2}),
 }
 """Name -> (profile, overrides on top of :data:`TINY_RUN`): every learner, and its own options."""
