@@ -231,8 +231,8 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
             "env_id": base.env_id, "train_env": base.train_env, "config": base.config}
     path.write_text(
         f"# A variant of {template}: edit what differs. env_id: EgoSearch-v0 (head on) or EgoSearchNoHead-v0;\n"
-        "# train_env: the training home and placement scheme; config: LearnerConfig fields\n"
-        "# (egosearch/rl/config.py) overridden on top of the profile.\n"
+        "# train_env: the training home and placement scheme; config: run settings (egosearch/rl/run_settings.py)\n"
+        "# and the learner's own fields (egosearch/rl/*_settings.py) overridden on top of the profile.\n"
         + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
     try:
         load_variant(path)

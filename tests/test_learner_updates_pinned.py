@@ -50,8 +50,8 @@ PINNED: dict[str, tuple[str, dict]] = {
                                             "encoder_aux_loss": "reconstruction", "encoder_aux_weight": 0.5}),
     "sac_drq_recurrent": ("smoke", {"algorithm": "sac_drq_recurrent", **POOLED, "recurrent_hidden_dim": 8,
                                     "sequence_length": 4, "burn_in": 2}),
-    "ppo": ("smoke", {"algorithm": "ppo", "obs_downsample": 4, "encoder_stride2_layers": 2, "init_steps": 0, "num_envs": 2, "update_every": 16,
-                      "replay_capacity": 64, "ppo_epochs": 2, "ppo_minibatches": 2}),
+    "ppo": ("smoke", {"algorithm": "ppo", "obs_downsample": 4, "encoder_stride2_layers": 2, "init_steps": 0,
+                      "num_envs": 2, "update_every": 16, "replay_capacity": 64, "ppo_epochs": 2, "ppo_minibatches": 2}),
 }
 """Name -> (profile, overrides on top of :data:`TINY_RUN`): every learner, and its own options."""
 
