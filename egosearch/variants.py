@@ -19,9 +19,9 @@ from pathlib import Path
 import jsonschema
 import yaml
 
+from egosearch.envs import observed_env_id
 from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
 from egosearch.searchers import registry as searchers
-from egosearch.sim.envs import observed_env_id
 from egosearch.sim.home_pool import check_home_split
 
 #: ``ablations/`` of the working directory (where Snakemake runs), else of this checkout.

@@ -522,7 +522,7 @@ def test_an_actor_in_the_wrong_env_is_one_line_naming_its_env(tmp_path, capsys, 
 def test_the_sizes_an_actor_is_checked_against_are_the_envs():
     import gymnasium
 
-    from egosearch.sim.envs import env_space_dims
+    from egosearch.envs import env_space_dims
 
     env = gymnasium.make("EgoSearchNoHeadMap-v0")
     try:

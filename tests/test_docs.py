@@ -97,7 +97,11 @@ def test_the_readme_shows_making_the_env_in_one_line():
 
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     block = readme.split("```python\n", 1)[1].split("\n```", 1)[0]
-    assert "\n" not in block and 'gymnasium.make("EgoSearch-v0")' in block
+    # gymnasium imports the package named before the colon, which registers the ids: no other import
+    # (tests/test_env_ids.py runs it in a fresh interpreter, where nothing was imported before)
+    assert "\n" not in block and 'gymnasium.make("egosearch:EgoSearch-v0")' in block and "import egosearch" not in block
+    import egosearch.envs  # noqa: F401  (this process imported egosearch before gymnasium: the ids come from here)
+
     scope: dict = {}
     exec(block, scope)  # the line as a reader pastes it
     try:

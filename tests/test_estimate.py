@@ -25,7 +25,8 @@ def test_the_estimate_simulates_the_schedule_and_scales_trainings_to_the_machine
     fast = estimate_all(record, RECORD.parent, 2, "cpu", rate=2 * base)
     # waiting and imperfect packing: the schedule is never shorter than CPU time / cores
     assert slow["hours_as_recorded"] >= slow["hours_cpu_over_cores"]
-    assert slow["hours_at_slowest_recorded_rate"] >= slow["hours_as_recorded"]
+    # each training at the slowest rate costs at least its own CPU time, so its cores are never less busy
+    assert slow["hours_at_slowest_recorded_rate"] >= slow["hours_cpu_over_cores"]
     assert fast["hours_here"] < slow["hours_here"]
     # the trainings, scaled, still dominate: the slowest jobs are trainings
     assert all(name.startswith("train/") for name, _ in fast["slowest_jobs_here"])
@@ -98,6 +99,35 @@ def test_a_training_that_learned_from_the_teacher_is_rated_on_its_rl_phase(tmp_p
     assert stored_training_rates({"jobs": jobs}, results, DECISIONS) == {"modular/seed0": 12.5}
     assert stored_cpu_s_per_step({"jobs": jobs}, results, DECISIONS) == pytest.approx(0.08)
     assert stored_cpu_s_per_step({"jobs": jobs[:1]}, results, DECISIONS) is None
+
+
+def test_a_cloning_that_was_not_timed_is_priced_at_the_stored_runs_cost_per_cloning_step(tmp_path):
+    """Hand-worked: run A recorded its cloning, 120 CPU-s for 12,000 steps (0.01 s each), and spent 300 on
+    demonstrations: 60,000 env steps in 1,020 CPU-s make 60,000 / 600 = 100 per CPU-s. Run B cloned 6,000
+    steps before trainings timed it: 60 CPU-s at A's price, plus its 200 s of demonstrations, leave 400 of its
+    660 CPU-s to 40,000 env steps: 100 per CPU-s."""
+    import json
+
+    from egosearch.cost.rates import cpu_s_outside_rl, stored_training_rates
+
+    results = tmp_path / "results" / "cpu"
+    jobs = []
+    for job, steps, cpu_s, done in (
+            ("a/seed0", 60_000, 1020.0, {"demonstrations": {"cpu_s": 300.0},
+                                         "imitation": {"cpu_s": 120.0, "bc_updates": 12000},
+                                         "config": {"bc_updates": 12000}}),
+            ("b/seed0", 40_000, 660.0, {"demonstrations": {"cpu_s": 200.0}, "config": {"bc_updates": 6000}})):
+        run = results / "train" / job
+        run.mkdir(parents=True)
+        (run / "curve.csv").write_text(f"env_steps,success_rate\n0,0.1\n{steps},0.5\n")
+        (run / "config.json").write_text(json.dumps({"env_id": "EgoSearch-v0", "config": {"demo_episodes": 1500}}))
+        (run / "done.json").write_text(json.dumps(done))
+        jobs.append({"rule": "train", "job": job, "wall_s": cpu_s, "cpu_s": cpu_s})
+    assert cpu_s_outside_rl(results / "train" / "b/seed0") == pytest.approx(260.0)
+    assert stored_training_rates({"jobs": jobs}, results) == pytest.approx({"a/seed0": 100.0, "b/seed0": 100.0})
+    # without a run that timed its cloning, B has no price: left out, as before
+    (results / "train" / "a/seed0" / "done.json").unlink()
+    assert cpu_s_outside_rl(results / "train" / "b/seed0") is None
 
 
 def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_path, monkeypatch):

@@ -114,14 +114,14 @@ def test_a_training_with_demonstrations_clones_mixes_batches_and_resumes_as_one_
     from egosearch.rl import train as train_module
 
     drawn = []
-    sample = train_module._Run.sample
+    sample = train_module.LiveRun.sample
 
     def counting(run):
         batch = sample(run)
         drawn.append(int(batch["demo"].sum()))
         return batch
 
-    monkeypatch.setattr(train_module._Run, "sample", counting)
+    monkeypatch.setattr(train_module.LiveRun, "sample", counting)
     whole, resumed = tmp_path / "whole", tmp_path / "resumed"
     probe_obs = gymnasium.make("EgoSearchMemory-v0", **ENV).reset(seed=3)[0]  # target_memory: the env it trains in
     evaluated = []

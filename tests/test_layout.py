@@ -16,17 +16,23 @@ LAYERS = {
     "scene": set(),
     "sim": {"core", "scene"},
     "searchers": {"core", "scene", "sim"},
-    "runs": {"core", "scene", "sim", "searchers"},
-    "rl": {"core", "scene", "sim", "searchers", "runs"},
-    "motion": {"core", "scene", "sim", "searchers", "runs"},
+    "envs": {"core", "scene", "sim", "searchers"},
+    "runs": {"core", "scene", "sim", "searchers", "envs"},
+    "rl": {"core", "scene", "sim", "searchers", "envs", "runs"},
+    "motion": {"core", "scene", "sim", "searchers", "envs", "runs"},
     "report": {"core", "scene"},
-    "variants": {"core", "scene", "sim", "rl"},
+    "variants": {"core", "scene", "sim", "envs", "rl"},
     "workflow": {"core", "scene", "variants", "report"},
     "cost": {"core", "rl", "variants", "report", "workflow"},
-    "cli": {"core", "scene", "sim", "searchers", "runs", "rl", "motion", "report", "variants", "workflow", "cost"},
+    "cli": {"core", "scene", "sim", "searchers", "envs", "runs", "rl", "motion", "report", "variants", "workflow",
+            "cost"},
+    # the package's __init__: it registers the gymnasium ids (egosearch.envs) where gymnasium is loaded, for
+    # gymnasium.make("egosearch:EgoSearch-v0"), and imports nothing else
+    "(root)": {"envs"},
 }
-"""Each stage and the stages it may import: the pipeline's order (scene -> sim -> searchers -> runs ->
-rl -> motion), the report layer apart (files in, files out), variants, the workflow, the cost model (it
+"""Each stage and the stages it may import: the pipeline's order (scene -> sim -> searchers -> envs (every
+gymnasium id and the env options, ``egosearch/envs.py``) -> runs -> rl -> motion), the report layer apart
+(files in, files out), variants, the workflow, the cost model (it
 simulates the workflow's DAG: the env step units of rl, a comparison's variant, the report's readers of
 the workflow's config and stored jobs) and the CLI on top."""
 

@@ -7,10 +7,11 @@ import gymnasium
 import numpy as np
 import pytest
 
-import egosearch.sim.envs  # noqa: F401
+import egosearch.envs  # noqa: F401
+from egosearch.envs import env_space_dims
+from egosearch.searchers.decision_envs import BODY_ENV_IDS, MODULAR_ENV_IDS, MODULAR_MAP_DIM
 from egosearch.searchers.modular import GoalFrontierPolicy, ModularSearchEnv
 from egosearch.sim.env import MASK_FEATURE_DIM, SearchEnv
-from egosearch.sim.envs import BODY_ENV_IDS, MODULAR_ENV_IDS, MODULAR_MAP_DIM, env_space_dims
 from egosearch.sim.scenarios import generate_scenarios
 
 
@@ -190,8 +191,8 @@ def test_the_replanners_look_ahead_leaves_the_modular_searcher_as_it_was():
 
 
 def test_the_modular_searcher_field_trains_in_the_modular_env_of_the_variants_head():
+    from egosearch.envs import observed_env_id
     from egosearch.rl.config import load_config
-    from egosearch.sim.envs import observed_env_id
     from egosearch.variants import resolve_variant
 
     assert observed_env_id("EgoSearch-v0", False, True) == "EgoSearchModular-v0"

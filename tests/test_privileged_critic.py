@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.envs import env_space_dims, observed_env_id
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.config import load_config
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
@@ -17,7 +18,6 @@ from egosearch.rl.train import train, train_env_kwargs
 from egosearch.scene.parts import Part
 from egosearch.sim.agent import AgentState
 from egosearch.sim.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
-from egosearch.sim.envs import env_space_dims, observed_env_id
 from egosearch.variants import load_variant
 
 DRQ = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 4, "encoder_num_layers": 2,

@@ -236,6 +236,19 @@ def test_training_throughput_counts_env_steps_per_core_second():
     assert r["env_steps_per_core_s"] == pytest.approx(120 / r["core_s"], rel=0.01)
 
 
+def test_training_throughput_leaves_the_imitation_phase_out():
+    """A profile that learns from the classical searcher first is timed in its RL phase alone (what the stored
+    rates count), with a token imitation phase whatever the profile's (its 1,500 demonstrations would take
+    many minutes of a one-minute benchmark)."""
+    from egosearch.rl.bench import training_throughput
+
+    big = {**DRQ, "num_threads": 1, "demo_episodes": 500, "bc_updates": 5000, "demo_batch_fraction": 0.5,
+           "critic_warmup_updates": 1000}
+    r = training_throughput("smoke", env_steps=120, overrides=big)
+    assert 0 < r["core_s_before_rl"] < 30  # a few episodes and a token cloning, not 500 and 5,000
+    assert r["env_steps_per_core_s"] == pytest.approx(120 / r["core_s"], rel=0.01)
+
+
 @pytest.mark.parametrize("overrides", [{}, DRQ, {**DRQ, "encoder_aux_loss": "reconstruction"}],
                          ids=["sac_curl", "sac_drq", "sac_drq_reconstruction"])
 def test_killed_and_resumed_run_equals_the_run_that_was_not_stopped(tmp_path, overrides):

@@ -216,6 +216,25 @@ def test_trainings_scaled_to_the_slowest_machine():
     assert half["eval/v/seed0/x"] == d["eval/v/seed0/x"]
 
 
+def test_on_cores_of_their_own_jobs_take_their_cpu_time_and_trainings_their_steps_at_a_rate():
+    from egosearch.cost.schedule import trainings_at_rate
+
+    own = durations_from_provenance(RECORD, DAG, own_cores=True)
+    assert own["train/v/seed0"] == 900.0  # its CPU time, not its 1,000 s of wall time
+    assert own["train/v/seed1"] == 800.0  # 400 CPU-s of a 400 s part, scaled to the 800 s run
+    assert own["eval/v/seed0/x"] == 30.0  # no CPU time recorded: its wall time
+    assert "CPU time" in own.note()
+    # at 20 env steps per CPU-s: seed0's 9,000 steps take 450 s, plus its 100 s of imitation; seed1 has no
+    # imitation recorded (it is left as it was, and said so); seed2 has no steps
+    at = trainings_at_rate(own, {"v/seed0": 9000, "v/seed1": 16000}, {"v/seed0": 100.0}, 20.0)
+    assert at["train/v/seed0"] == 550.0
+    assert at["train/v/seed1"] == 800.0 and at["train/v/seed2"] == own["train/v/seed2"]
+    assert at.at_rate == ["train/v/seed0"] and at.unscaled == ["train/v/seed1", "train/v/seed2"]
+    assert "1 trainings at the rate" in at.note()
+    with pytest.raises(ValueError, match="positive"):
+        trainings_at_rate(own, {}, {}, 0.0)
+
+
 def test_machine_key_names_what_was_not_recorded():
     assert machine_key(None) == "unknown"
     assert machine_key({"cpu": "AMD EPYC", "vector_unit": None, "cores": 2}) == "AMD EPYC / ? / 2 cores"

@@ -9,11 +9,12 @@ from pathlib import Path
 import torch
 
 from egosearch.cli.checks import at_least, learner_profile_of
+from egosearch.envs import ALL_ENV_IDS, env_options
 from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
 from egosearch.searchers import registry as searchers
-from egosearch.sim.envs import ALL_ENV_IDS, BODY_ENV_IDS, ENV_IDS, MODULAR_ENV_IDS
+from egosearch.searchers.decision_envs import BODY_ENV_IDS
 
 
 def set_acting_threads(threads: int) -> None:
@@ -67,10 +68,10 @@ def check_searcher_env(kind: str, env_id: str | None) -> None:
     would be read under that name (a head-off searcher's with a moving head)."""
     if env_id is None or kind not in searchers.SEARCHERS or env_id not in ALL_ENV_IDS:
         return
-    if env_id in MODULAR_ENV_IDS:
+    if env_options(env_id).modular:
         raise ValueError(f"--env-id={env_id} takes a modular searcher's decisions, and --policy {kind} acts at every "
                          "body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out")
-    wanted, head = searchers.get(kind).head, ENV_IDS[env_id]["head"]
+    wanted, head = searchers.get(kind).head, env_options(env_id).head
     if wanted is not None and wanted != head:
         other = kind.removesuffix("_head_off") if not wanted else f"{kind}_head_off"
         raise ValueError(f"--env-id={env_id} {'moves' if head else 'fixes'} the head, and --policy {kind} is the "

@@ -12,7 +12,7 @@ from egosearch.cli.checks import at_least
 from egosearch.core.gpu_share import SIDE_BY_SIDE, side_by_side_record
 from egosearch.core.machine import with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
-from egosearch.rl.bench import bench_learner, gpu_check
+from egosearch.rl.bench import bench_learner, bench_stacked, gpu_check
 from egosearch.scene.layouts import get_scene
 from egosearch.sim import bench
 from egosearch.variants import resolve_variant
@@ -20,11 +20,13 @@ from egosearch.variants import resolve_variant
 GPU_CHECK_VARIANT = "head_on"
 """The variant whose paper-profile training ``bench gpu`` times (seed 0)."""
 
-DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds": 150.0, "baseline_seconds": 0.0}
+DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds": 150.0, "baseline_seconds": 0.0,
+            "seeds": 3}
 """Each benchmark's option defaults (the parser leaves them None, so that an option given to a
 benchmark that does not read it is told apart from one left alone)."""
 READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "out_dir": "gpu",
-           "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu"}
+           "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu", "stacked": "gpu",
+           "seeds": "stacked"}
 """The benchmark that reads each of the options that only one of them reads."""
 
 
@@ -45,6 +47,8 @@ def run(args) -> None:
             setattr(args, name, value)
     if args.what == "gpu":
         check_gpu_options(args)
+    if args.what == "stacked":
+        at_least("--seeds", args.seeds, 2, "the seeds stacked")
     if args.what == "env":
         at_least("--frames", args.frames, 1, "the number of sensor frames to time")
         at_least("--steps", args.steps, 1, "the number of env steps to time")
@@ -58,6 +62,8 @@ def run(args) -> None:
             return bench.bench_env(args.layout, frames=args.frames, steps=args.steps)
         if args.what == "homes":
             return bench.bench_homes()
+        if args.what == "stacked":
+            return bench_stacked(args.seeds)
         if args.what == "gpu" and args.side_by_side:
             return measure_side_by_side(args)
         if args.what == "gpu":
@@ -68,8 +74,11 @@ def run(args) -> None:
         return bench_learner()
 
     options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
+    if args.what == "stacked":
+        options = f" --seeds {args.seeds}"
     if args.what == "gpu":
         options = (f" --side-by-side {args.side_by_side}" if args.side_by_side else "") + (
+            f" --stacked {args.stacked}" if args.stacked else "") + (
             f" --seconds {args.seconds:g}" + (" --cuda-graph" if args.cuda_graph else "") + (
                 f" --baseline-seconds {args.baseline_seconds:g}" if args.baseline_seconds else ""))
     record = bench.recorded(f"egosearch bench {args.what}{options}", measure)
@@ -99,6 +108,11 @@ def check_gpu_options(args) -> None:
         if args.cuda_graph:
             raise ValueError("--cuda-graph is not read with --side-by-side: its trainings run the paper profile as "
                              "the DAG does (cuda_graph on)")
+    if args.stacked is not None:
+        at_least("--stacked", args.stacked, 2, "the seeds stacked in one training")
+        if args.side_by_side is None:
+            raise ValueError("--stacked is measured beside the trainings side by side: give --side-by-side N too "
+                             "(the record it writes into is theirs)")
     if not args.seconds > 0:
         raise ValueError(f"--seconds must be a positive number, got {args.seconds}")
     if not args.baseline_seconds >= 0:
@@ -123,5 +137,5 @@ def measure_side_by_side(args) -> dict:
     steps = sum(resolve_variant(v, "paper").config.total_env_steps for v in variants) * len(seeds)
     return run_side_by_side(args.side_by_side, args.seconds, args.out_dir, variant=GPU_CHECK_VARIANT,
                             all_env_steps=steps, all_trainings=len(variants) * len(seeds),
-                            baseline_seconds=args.baseline_seconds,
+                            baseline_seconds=args.baseline_seconds, stacked=getattr(args, "stacked", None) or 0,
                             say=lambda line: print(line, file=sys.stderr, flush=True))

@@ -5,10 +5,10 @@ from __future__ import annotations
 from egosearch.cli.acting import check_threads, policy_factory, set_acting_threads
 from egosearch.cli.checks import check_seed, check_suffix
 from egosearch.core.outputs import check_outputs, check_overwrites
+from egosearch.envs import ALL_ENV_IDS
 from egosearch.runs.evaluate import evaluate, write_episodes
 from egosearch.runs.metrics import spl
 from egosearch.runs.trace import TraceRecorder
-from egosearch.sim.envs import ALL_ENV_IDS
 from egosearch.sim.scenarios import read_scenarios
 
 

@@ -97,6 +97,10 @@ def add_train(sub) -> None:
                                       "is complete (the DAG does: a killed job never leaves a partial output)")
     p.add_argument("--max-wall-s", type=float, help="stop after this many seconds with a checkpoint written (inside "
                                                     "a cluster's time limit); the same command resumes it")
+    p.add_argument("--stack-seeds", metavar="SEEDS",
+                   help="train these seeds (comma-separated, e.g. 0,1,2) in one process, their updates stacked as one "
+                        "model (sac_curl, sac_drq; docs/gpu.md); --out-dir (and --work-dir) must then hold {seed}, "
+                        "e.g. results/paper/train/head_on/seed{seed}; replaces --seed")
     add_force(p)
 
 
@@ -145,14 +149,17 @@ def add_fullbody(sub) -> None:
 
 
 def add_bench(sub) -> None:
-    about = "speed benchmarks: env (sensor + physics), homes (building one), learner or gpu (needs CUDA)"
+    about = ("speed benchmarks: env (sensor + physics), homes (building one), learner, gpu (needs CUDA) or stacked "
+             "(seeds' updates stacked)")
     p = sub.add_parser("bench", help=about, description=about)
-    p.add_argument("what", choices=("env", "homes", "learner", "gpu"),
+    p.add_argument("what", choices=("env", "homes", "learner", "gpu", "stacked"),
                    help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
                         f"against a training episode; learner: updates/s of {LEARNERS}, and of SAC+CURL at Table "
                         "2's sizes; gpu (needs CUDA): the learner benchmarks and a paper-profile training of "
-                        "--seconds on this machine's GPU (results/paper/gpu_check)")
+                        "--seconds on this machine's GPU (results/paper/gpu_check); stacked: --seeds seeds' updates "
+                        "stacked as one model against their separate updates, at the cpu profile")
     p.add_argument("--layout", help=f"env: the home ({LAYOUTS}; default kitchen_living)")
+    p.add_argument("--seeds", type=int, help="stacked: the seeds stacked, >= 2 (default 3)")
     p.add_argument("--frames", type=int, help="env: sensor frames to time, >= 1 (default 3000)")
     p.add_argument("--steps", type=int, help="env: env steps to time, >= 1 (default 3000)")
     p.add_argument("--seconds", type=float, help="gpu: the training's wall time, > 0 (default 150)")
@@ -170,6 +177,10 @@ def add_bench(sub) -> None:
                         "<out-dir>/side_by_side/<i>), under CUDA MPS where the command can start it; --out defaults "
                         "to results/paper/gpu_check/side_by_side.json (aggregate env steps/s, the paper `all`'s "
                         "projected hours), N >= 2")
+    p.add_argument("--stacked", type=int, metavar="N",
+                   help="gpu, with --side-by-side: last, one training of N seeds with their updates stacked as one "
+                        "model (`egosearch train --stack-seeds`, all cores), into the same record (its aggregate env "
+                        "steps/s and projected hours under \"stacked\"), N >= 2")
     add_record_outputs(p, "print one JSON object", "the result as JSON with the command, date, commit, CPU and the "
                        "machine's load", "learner.json", "which the docs' Speed page reads")
 

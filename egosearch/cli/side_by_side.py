@@ -23,7 +23,7 @@ ENTRY = "import sys; from egosearch.cli import main; sys.exit(main())"
 PROBE = "import torch; x = torch.ones(8, device='cuda'); torch.cuda.synchronize(); print(float((2 * x).sum()))"
 """A CUDA process's smallest work: where an MPS daemon starts but its clients cannot connect (a container),
 this fails, and the trainings run without MPS instead of failing."""
-FOLDERS = ("alone", "without_mps", "side_by_side")
+FOLDERS = ("alone", "without_mps", "side_by_side", "stacked")
 """The subfolders of ``--out-dir`` the trainings run in (one folder per training under the last two)."""
 
 
@@ -45,6 +45,23 @@ def training(out_dir: Path, log: Path, seed: int, threads: int, seconds: float, 
             "--threads", str(threads), "--out-dir", str(out_dir), "--max-wall-s", f"{seconds:g}"]
     env = {**env, "OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
     return Training(str(out_dir), str(log), seed, threads, argv, env)
+
+
+def stacked_training(out_dir: Path, log: Path, seeds: int, threads: int, seconds: float, variant: str,
+                     env: dict) -> Training:
+    """One process training seeds 0..``seeds``-1 of ``variant`` at the paper profile, their updates stacked
+    (``egosearch train --stack-seeds``), each seed in ``out_dir/seed<k>``, for ``seconds`` of wall time."""
+    run = training(out_dir / "seed{seed}", log, 0, threads, seconds, variant, env)
+    at = run.argv.index("--seed")
+    run.argv[at:at + 2] = ["--stack-seeds", ",".join(str(k) for k in range(seeds))]
+    return run
+
+
+def _measure_stacked(run: Training, seeds: int, seconds: float, runner: Callable) -> list[dict]:
+    """Each stacked seed's rate, read from its own folder's train.csv."""
+    code = runner([run], seconds + max(600.0, seconds))[0]
+    return [{"out_dir": run.out_dir.format(seed=k), "log": run.log, "seed": k, "threads": run.threads,
+             "returncode": code, **median_rate(Path(run.out_dir.format(seed=k)) / "train.csv")} for k in range(seeds)]
 
 
 def run_together(trainings: list[Training], timeout_s: float) -> list[int]:
@@ -166,9 +183,12 @@ def _measure(trainings: list[Training], seconds: float, runner: Callable) -> lis
 
 def run_side_by_side(n: int, seconds: float, out_dir: str | os.PathLike, *, variant: str, all_env_steps: int,
                      all_trainings: int, baseline_seconds: float = 0.0, cores: int | None = None,
-                     runner: Callable = run_together, mps: MpsDaemon | None = None, say=print) -> dict:
+                     runner: Callable = run_together, mps: MpsDaemon | None = None, say=print,
+                     stacked: int = 0) -> dict:
     """The measurement (see the module's docstring): returns
-    :func:`egosearch.core.gpu_share.side_by_side_result`. ``say`` reports each phase as it starts."""
+    :func:`egosearch.core.gpu_share.side_by_side_result`. ``say`` reports each phase as it starts. With
+    ``stacked`` >= 2, last, one process trains that many seeds with their updates stacked (all the cores,
+    after the MPS daemon this command started is stopped: one process has nothing to share)."""
     if n < 2:
         raise ValueError(f"--side-by-side={n}: the trainings side by side must be >= 2")
     out = Path(out_dir)
@@ -200,6 +220,12 @@ def run_side_by_side(n: int, seconds: float, out_dir: str | os.PathLike, *, vari
                                   seconds, variant, mps.env) for i in range(n)], seconds, runner)
     finally:
         mps.stop()
+    stacked_runs = None
+    if stacked:
+        say(f"{stacked} seeds stacked in one training for {seconds:g} s, {cores} threads")
+        stacked_runs = _measure_stacked(stacked_training(out / "stacked", out / "logs" / "stacked.log", stacked,
+                                                         cores, seconds, variant, mps.env), stacked, seconds, runner)
     return side_by_side_result(alone, side, all_env_steps=all_env_steps, all_trainings=all_trainings,
                                mps=under_mps, mps_note=words + note, seconds=seconds, variant=variant,
-                               without_mps=without, without_mps_seconds=baseline_seconds if without else None)
+                               without_mps=without, without_mps_seconds=baseline_seconds if without else None,
+                               stacked=stacked_runs)

@@ -11,12 +11,16 @@ from egosearch.core.staging import publish_run
 from egosearch.cost.estimate import training_time_line
 from egosearch.rl.run_files import CheckpointError, check_same_run
 from egosearch.rl.train import train
+from egosearch.rl.train_stacked import train_stacked
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.home_pool import curve_homes
 from egosearch.variants import resolve_variant
 
 
 def run(args) -> None:
+    if args.stack_seeds is not None:
+        run_stacked(args)
+        return
     check_outputs(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir})
     check_overwrites(dirs={"--out-dir": args.out_dir, "--work-dir": args.work_dir}, force=args.force)
     if args.max_wall_s is not None and not args.max_wall_s > 0:
@@ -77,3 +81,62 @@ class LazyEvaluator:
     def close(self) -> None:
         if self.evaluate is not None:
             self.evaluate.close()
+
+
+def stacked_seeds(args) -> list[int]:
+    """``--stack-seeds``' seeds, checked with the folders it fills (``{seed}`` in each)."""
+    try:
+        seeds = [int(part) for part in args.stack_seeds.split(",") if part.strip()]
+    except ValueError:
+        raise ValueError(f"--stack-seeds={args.stack_seeds!r}: comma-separated seeds, e.g. 0,1,2") from None
+    if not seeds or len(set(seeds)) != len(seeds):
+        raise ValueError(f"--stack-seeds={args.stack_seeds!r}: one or more seeds, none repeated")
+    for seed in seeds:
+        check_seed("--stack-seeds", seed, numpy_legacy=True)
+    if args.seed:
+        raise ValueError("--seed and --stack-seeds: give the seeds in --stack-seeds only")
+    for option, folder in (("--out-dir", args.out_dir), ("--work-dir", args.work_dir)):
+        if folder is not None and "{seed}" not in folder:
+            raise ValueError(f"{option}={folder!r}: with --stack-seeds it must hold {{seed}} (one folder per seed), "
+                             "e.g. results/paper/train/head_on/seed{seed}")
+    return seeds
+
+
+def run_stacked(args) -> None:
+    """``egosearch train --stack-seeds``: the seeds trained in one process, their updates stacked
+    (:func:`egosearch.rl.train_stacked.train_stacked`); each seed's folder is the one a separate
+    ``egosearch train --seed`` writes."""
+    seeds = stacked_seeds(args)
+    outs = [args.out_dir.format(seed=s) for s in seeds]
+    works = [args.work_dir.format(seed=s) for s in seeds] if args.work_dir else None
+    for k, out in enumerate(outs):
+        dirs = {"--out-dir": out, "--work-dir": works[k] if works else None}
+        check_outputs(dirs=dirs)
+        check_overwrites(dirs=dirs, force=args.force)
+    if args.max_wall_s is not None and not args.max_wall_s > 0:
+        raise ValueError(f"--max-wall-s must be a positive number of seconds, got {args.max_wall_s}")
+    at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
+    threads = {"num_threads": args.threads} if args.threads else {}
+    resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}) for s in seeds]
+    env = resolved[0].train_env
+    evaluators = [LazyEvaluator(lambda r=r: scenario_evaluator(r.env_id, curve_homes(env), env["placement"],
+                                                               n=r.config.eval_episodes)) for r in resolved]
+    if works and not args.force:
+        for out, r in zip(outs, resolved):
+            try:
+                check_published_run(Path(out), r)
+            except CheckpointError as err:
+                raise ValueError(f"--out-dir: {err}") from None
+    try:
+        summaries = train_stacked(resolved[0].env_id, [r.config for r in resolved], works or outs, env_kwargs=env,
+                                  evaluate_fns=evaluators, variant=resolved[0].name, max_wall_s=args.max_wall_s)
+    except CheckpointError as err:
+        raise ValueError(f"{'--work-dir' if works else '--out-dir'}: {err}") from None
+    finally:
+        for evaluator in evaluators:
+            evaluator.close()
+    if works and not any(s.get("stopped") for s in summaries):
+        for work, out in zip(works, outs):
+            publish_run(work, out)
+    for summary in summaries:
+        print(json.dumps(summary))

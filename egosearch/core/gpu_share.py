@@ -242,7 +242,7 @@ def _rates(runs: list[dict], what: str) -> list[float]:
 
 def side_by_side_result(alone: dict, side: list[dict], *, all_env_steps: int, all_trainings: int, mps: bool,
                         mps_note: str, seconds: float, variant: str, without_mps: list[dict] | None = None,
-                        without_mps_seconds: float | None = None) -> dict:
+                        without_mps_seconds: float | None = None, stacked: list[dict] | None = None) -> dict:
     """The record's measurement: ``alone`` (one training's run: its rate, threads, folder), ``side`` (the N
     run together, under MPS when ``mps``) and, where run, ``without_mps`` (the N together without it). The
     aggregate is the sum of the trainings' rates; ``projected_all_hours`` is ``all_env_steps`` (the paper
@@ -270,6 +270,17 @@ def side_by_side_result(alone: dict, side: list[dict], *, all_env_steps: int, al
             "aggregate_env_steps_per_s": round(sum(plain), 1),
             "projected_all_hours": round(projected_hours(all_env_steps, sum(plain)), 2)}
         runs["without_mps"] = without_mps
+    if stacked:
+        # one process, its seeds' updates one stacked model (issue 47, item 4): each seed's rate is its own
+        # train.csv's, and the seeds' sum is the process's aggregate
+        rates = _rates(stacked, "stacked")
+        result["stacked"] = {
+            "seeds": len(stacked), "threads": stacked[0].get("threads"),
+            "per_seed_env_steps_per_s": [round(r, 1) for r in rates],
+            "aggregate_env_steps_per_s": round(sum(rates), 1),
+            "speedup_vs_alone": round(sum(rates) / alone_rate, 2),
+            "projected_all_hours": round(projected_hours(all_env_steps, sum(rates)), 2)}
+        runs["stacked"] = stacked
     result["runs"] = runs
     return result
 

@@ -24,13 +24,21 @@ from egosearch.core.gpu_share import warn_gpu_sharing
 from egosearch.cost.calibration import cached_rate, this_machine
 from egosearch.cost.rates import (
     benchmark_ratio,
+    cpu_s_outside_rl,
     steps_of_bench,
     steps_of_profile,
     stored_cpu_s_per_step,
     stored_training_rates,
     teacher_cost_s,
 )
-from egosearch.cost.schedule import TRAIN, durations_from_provenance, machine_key, scale_to_rate, simulate
+from egosearch.cost.schedule import (
+    TRAIN,
+    durations_from_provenance,
+    env_steps_of,
+    machine_key,
+    simulate,
+    trainings_at_rate,
+)
 from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
 from egosearch.rl.config import BODY_STEPS, DECISIONS
 from egosearch.workflow.dag import dag_jobs
@@ -107,12 +115,20 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
     benchmark gives ``rate`` (left out when None). Returns the figures and the lines to print."""
     jobs = dag_jobs("all", cores, config={"profile": profile})
     stored = durations_from_provenance(record, jobs)
+    # At a rate, each job on a core of its own (what --cores N gives a one-thread job): its CPU time,
+    # and a training its env steps at the rate plus its imitation phase. The record's wall times keep
+    # the waits of its own runs, which shared the cores with more than the DAG's jobs.
+    own_cores = durations_from_provenance(record, jobs, own_cores=True)
     kind = steps_of_profile(profile)
     all_rates = stored_training_rates(record, results, kind)
     rates = {j.job: all_rates[j.job] for j in jobs if j.record_rule == TRAIN and j.job in all_rates}
+    steps = env_steps_of(results, rates)
+    before_rl = {job: cpu_s_outside_rl(results / "train" / job) for job in rates}
+    before_rl = {job: s for job, s in before_rl.items() if s is not None}
     as_recorded = simulate(jobs, cores, stored)
     slowest_rate = min(rates.values()) if rates else None
-    at_slowest = simulate(jobs, cores, scale_to_rate(stored, rates, slowest_rate)) if rates else None
+    at_slowest_durations = trainings_at_rate(own_cores, steps, before_rl, slowest_rate) if rates else None
+    at_slowest = simulate(jobs, cores, at_slowest_durations) if rates else None
     in_dag = {(j.record_rule, j.job) for j in jobs}
     cpu_over_cores = sum(job_cost_s(r) for r in record.get("jobs", []) if (r["rule"], r["job"]) in in_dag) / cores
     bench_path = Path(bench) if bench else results / "bench" / "learner.json"
@@ -121,7 +137,8 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
     k = ratio[0] if ratio else 1.0
     here = None
     if rate is not None:
-        here = simulate(jobs, cores, scale_to_rate(stored, rates, k * rate)) if rates else as_recorded
+        here = (simulate(jobs, cores, trainings_at_rate(own_cores, steps, before_rl, k * rate)) if rates
+                else as_recorded)
     lines = [
         f"snakemake --cores {cores} all from a fresh clone, {profile} profile ({len(jobs)} jobs, simulated on "
         f"{cores} cores with snakemake's greedy rule):"]
@@ -138,7 +155,9 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
         + (f"; every training at the slowest recorded rate ({slowest_rate:.0f} {kind} per CPU-second): "
            f"{_hours(at_slowest.makespan)}" if at_slowest else ""),
         f"  (the old figure, CPU time / {cores}: {_hours(cpu_over_cores)}, assumes perfect packing and no waiting)",
-        "  " + stored.note() + " Only trainings are scaled to this machine.",
+        "  as recorded: " + stored.note(),
+        *(["  at a rate: " + at_slowest_durations.note() + " Only trainings are scaled to this machine."]
+          if at_slowest_durations else []),
     ]
     return {"cores": cores, "profile": profile, "steps": kind, "hours_here": here.makespan / 3600 if here else None,
             "hours_as_recorded": as_recorded.makespan / 3600,

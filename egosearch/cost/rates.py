@@ -55,7 +55,9 @@ def stored_training_rates(record: dict, results: Path, steps_kind: str = BODY_ST
 def cpu_s_outside_rl(run_dir: Path) -> float | None:
     """CPU seconds a training spent before its RL phase: 0 for one from scratch; for one that learned
     from the classical searcher (its config.json's ``demo_episodes``), its demonstrations' and its
-    imitation's (cloning, DAgger) ``cpu_s`` from its ``done.json``, None when it recorded no imitation."""
+    imitation's (cloning, DAgger) ``cpu_s`` from its ``done.json``. A run that cloned before trainings
+    recorded the cloning's time gets its cloning steps at the median CPU-s per cloning step of the runs
+    stored beside it that recorded theirs (:func:`cloning_cpu_s_per_update`); None when none did."""
     if not learned_from_teacher(run_dir):
         return 0.0
     try:
@@ -63,12 +65,24 @@ def cpu_s_outside_rl(run_dir: Path) -> float | None:
         if "imitation" in done:
             imitation = float(done["imitation"]["cpu_s"])
         elif done["config"].get("bc_updates"):
-            return None  # cloned before trainings recorded the cloning's time
+            per_update = cloning_cpu_s_per_update(run_dir.parents[2])
+            if per_update is None:
+                return None
+            config = done["config"]
+            imitation = per_update * config["bc_updates"] * (1 + config.get("dagger_rounds", 0))
         else:
             imitation = 0.0  # demonstrations in replay, no cloning
         return float(done["demonstrations"]["cpu_s"]) + imitation
-    except (OSError, ValueError, KeyError):
+    except (OSError, ValueError, KeyError, IndexError):
         return None
+
+
+def cloning_cpu_s_per_update(results: Path) -> float | None:
+    """The median CPU seconds per cloning step (DAgger rounds' episodes included) of the stored
+    trainings under ``results`` that recorded their imitation phase; None when none did."""
+    per_update = [d["imitation"]["cpu_s"] / d["imitation"]["bc_updates"] for d in _stored_done(results)
+                  if d.get("imitation", {}).get("bc_updates")]
+    return statistics.median(per_update) if per_update else None
 
 
 def stored_cpu_s_per_step(record: dict, results: Path, steps_kind: str) -> float | None:

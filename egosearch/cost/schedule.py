@@ -20,7 +20,8 @@ Snakemake's job id as the last tie-break. Where it differs:
 - Input sizes are those on disk when the DAG was read (a fresh clone: the stored results, about the
   sizes a new run writes), not those at the moment a job becomes ready.
 - A job takes its recorded wall time whatever runs beside it: no slowdown from sharing memory
-  bandwidth beyond what the record's own runs saw, no start-up latency between jobs.
+  bandwidth beyond what the record's own runs saw, no start-up latency between jobs. With
+  ``own_cores`` it takes its recorded CPU time instead: a core of its own, none of the record's waits.
 """
 
 from __future__ import annotations
@@ -286,6 +287,11 @@ class Durations(Mapping):
     untimed: list[str] = field(default_factory=list)
     scaled: dict[str, float] = field(default_factory=dict)
     unscaled: list[str] = field(default_factory=list)
+    cpu_time: bool = False
+    """Whether the record's jobs are timed by their CPU time (each on a core of its own) rather than
+    their wall time."""
+    at_rate: list[str] = field(default_factory=list)
+    """Trainings timed by their env steps at a rate and their imitation phase (:func:`trainings_at_rate`)."""
 
     def __getitem__(self, key: str) -> float:
         return self.seconds[key]
@@ -298,7 +304,10 @@ class Durations(Mapping):
 
     def note(self) -> str:
         """One sentence on what the durations rest on, for the estimate to say."""
-        parts = [f"{len(self.from_record)} of {len(self.seconds)} jobs timed by the record (wall time)"]
+        parts = [f"{len(self.from_record)} of {len(self.seconds)} jobs timed by the record "
+                 + ("(CPU time: each on a core of its own)" if self.cpu_time else "(wall time)")]
+        if self.at_rate:
+            parts.append(f"{len(self.at_rate)} trainings at the rate (env steps / rate + their imitation phase)")
         if self.missing:
             parts.append(f"{len(self.missing)} not in the record, at their rule's median")
         if self.untimed:
@@ -319,7 +328,7 @@ def _record_seconds(row: Mapping) -> float:
 
 
 def durations_from_provenance(record: Mapping, jobs: Iterable, scale: float | None = None,
-                              other_scale: float = 1.0) -> Durations:
+                              other_scale: float = 1.0, own_cores: bool = False) -> Durations:
     """Each DAG job's duration from a provenance record (``results/<profile>/provenance.json``): the
     wall time of the record's row with the job's (rule, job) key, the whole run's (``run_wall_s``)
     for a resumed training. Wall time, not CPU time: the time a user waits, as the record's runs
@@ -328,10 +337,16 @@ def durations_from_provenance(record: Mapping, jobs: Iterable, scale: float | No
     training than the one that made the record); ``other_scale`` every other timed job. A DAG job
     the record lacks gets the median of its rule's jobs found in the record (of the record's jobs of
     that rule when the DAG has none there), 0 s for report rules; a job without a benchmark 0 s.
-    The result says which (``missing``, ``untimed``; :meth:`Durations.note`)."""
+    The result says which (``missing``, ``untimed``; :meth:`Durations.note`).
+
+    ``own_cores``: each job at its CPU time instead (:func:`job_cost_s`), what it takes on a core of
+    its own, as ``snakemake --cores N`` gives each one-thread job. The record's wall times count the
+    waits of its own runs, which shared two cores with more work than the DAG's (several snakemake
+    runs at once, tests), waits a fresh ``snakemake --cores 2 all`` does not have."""
     sim = as_jobs(jobs)
-    rows = {(r["rule"], r["job"]): _record_seconds(r) for r in record.get("jobs", [])}
-    out = Durations(seconds={})
+    seconds_of = job_cost_s if own_cores else _record_seconds
+    rows = {(r["rule"], r["job"]): seconds_of(r) for r in record.get("jobs", [])}
+    out = Durations(seconds={}, cpu_time=own_cores)
     found: dict[str, list[float]] = {}
     for j in sim:
         if j.record_rule is None:
@@ -408,6 +423,30 @@ def machine_rates(record: Mapping, rates: Mapping[str, float]) -> dict[str, floa
     return {key: statistics.median(values) for key, values in groups.items()}
 
 
+def trainings_at_rate(durations: Durations, steps_by_job: Mapping[str, int],
+                      before_rl_s_by_job: Mapping[str, float], rate: float) -> Durations:
+    """Each training of ``durations`` whose job is in ``steps_by_job`` and ``before_rl_s_by_job`` (job
+    key -> its env steps; the CPU seconds of its imitation phase, demonstrations and cloning) timed as
+    ``steps / rate + before_rl`` on a core of its own; the others go to ``unscaled``. Unlike
+    :func:`scale_to_rate` nothing of the record's wall time stays, waits included."""
+    if rate <= 0:
+        raise ValueError(f"rate must be positive, not {rate}")
+    out = Durations(seconds=dict(durations.seconds), from_record=list(durations.from_record),
+                    missing=list(durations.missing), untimed=list(durations.untimed), scaled=dict(durations.scaled),
+                    unscaled=list(durations.unscaled), cpu_time=durations.cpu_time, at_rate=list(durations.at_rate))
+    prefix = TRAIN + "/"
+    for ident in out.seconds:
+        if not ident.startswith(prefix):
+            continue
+        job = ident[len(prefix):]
+        if job in steps_by_job and job in before_rl_s_by_job:
+            out.seconds[ident] = steps_by_job[job] / rate + before_rl_s_by_job[job]
+            out.at_rate.append(ident)
+        else:
+            out.unscaled.append(ident)
+    return out
+
+
 def scale_to_rate(durations: Durations, rate_by_job: Mapping[str, float], target_rate: float) -> Durations:
     """Each training in ``rate_by_job`` (job key -> env steps per CPU-second it ran at) at
     ``target_rate`` instead: its duration times rate / target (wall time taken to scale with CPU
@@ -416,7 +455,7 @@ def scale_to_rate(durations: Durations, rate_by_job: Mapping[str, float], target
         raise ValueError(f"target_rate must be positive, not {target_rate}")
     out = Durations(seconds=dict(durations.seconds), from_record=list(durations.from_record),
                     missing=list(durations.missing), untimed=list(durations.untimed), scaled=dict(durations.scaled),
-                    unscaled=list(durations.unscaled))
+                    unscaled=list(durations.unscaled), cpu_time=durations.cpu_time, at_rate=list(durations.at_rate))
     prefix = TRAIN + "/"
     for ident in out.seconds:
         if not ident.startswith(prefix):

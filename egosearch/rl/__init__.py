@@ -31,7 +31,11 @@ and the CLI.
 - :mod:`egosearch.rl.replay`: ``ReplayBuffer`` storing each depth frame once, ``MultiReplay``
   (one ring per env, n-step returns), ``replay_gb``;
 - :mod:`egosearch.rl.train`: ``train(env_id, cfg, out_dir, env_kwargs, evaluate_fn)``
-  (resumable; its loop's steps are the methods of ``_Run``);
+  (resumable; its loop's steps are the methods of ``LiveRun``);
+- :mod:`egosearch.rl.stacked`: ``StackedAgents`` (``stack_agents``): N seeds' updates as one stacked,
+  vmapped model, each seed drawing from its own ``SeedStreams``; equal to N separate updates;
+- :mod:`egosearch.rl.train_stacked`: ``train_stacked(env_id, cfgs, out_dirs)``: one ``LiveRun`` per
+  seed (its own envs, replay, streams and files), their updates stacked;
 - :mod:`egosearch.rl.train_env`: the training envs (``make_train_env``, ``train_env_kwargs``: the
   variant's env with the config's training aids);
 - :mod:`egosearch.rl.demos`: the frontier searcher's transitions stored as a replay, the demonstrations

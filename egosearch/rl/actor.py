@@ -15,11 +15,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from egosearch.envs import ALL_ENV_IDS, env_space_dims
 from egosearch.rl.agent import ActorFileNet, Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.registry import actor_loader
 from egosearch.sim.agent import IMAGE_SIZE
-from egosearch.sim.envs import ALL_ENV_IDS, env_space_dims
 
 
 class AgentPolicy:

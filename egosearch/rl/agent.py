@@ -2,7 +2,7 @@
 protocol, :class:`AgentBase` (its optional hooks' default behaviour), and the actor file's contract
 (:class:`ActorFile`, :class:`ActorArch`, :class:`ActorFileNet`).
 
-:mod:`egosearch.rl.train` (``_Run``), :mod:`egosearch.rl.imitation` and
+:mod:`egosearch.rl.train` (``LiveRun``), :mod:`egosearch.rl.imitation` and
 :class:`egosearch.rl.actor.AgentPolicy` call an agent through :class:`Agent` only, and call every
 hook directly: a learner that subclasses :class:`AgentBase` inherits the hooks it does not need. A
 learner is registered by name in :mod:`egosearch.rl.registry` (one ``register`` line), which
@@ -43,7 +43,7 @@ class LearnerSettings(Protocol):
 
 @runtime_checkable
 class Agent(Protocol):
-    """What the training loop (``egosearch.rl.train._Run``), imitation (:mod:`egosearch.rl.imitation`)
+    """What the training loop (``egosearch.rl.train.LiveRun``), imitation (:mod:`egosearch.rl.imitation`)
     and ``AgentPolicy`` may call on a learner: every attribute and method below, and nothing else.
 
     Acting: ``act(obs, deterministic)`` -> one action (A,) in [-1, 1] for ONE env observation (the

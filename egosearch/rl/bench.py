@@ -16,8 +16,9 @@ Keys:
 - ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
   thread count (one);
 - ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
-  the ``cpu`` profile (env, acting and updates all in; ``cpu_profile_run`` has its details), counted in
-  ``cpu_profile_steps`` ("decisions" since the profile is a modular searcher, "body steps" before);
+  the ``cpu`` profile's RL phase (env, acting and updates all in, its imitation phase left out;
+  ``cpu_profile_run`` has its details), counted in ``cpu_profile_steps`` ("body steps"; "decisions"
+  while the profile was a modular searcher);
 - ``*_avx2`` (on a CPU with AVX-512): the cpu profile's rows again in a process whose oneDNN may
   use AVX2 at most (``ONEDNN_MAX_CPU_ISA=AVX2``), for what a CPU without AVX-512 pays;
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
@@ -122,6 +123,56 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         torch.set_num_threads(before)
 
 
+def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds: int = 15,
+                  overrides: dict | None = None) -> dict:
+    """``egosearch bench stacked``: the update of ``seeds`` seeds stacked as one model
+    (:mod:`egosearch.rl.stacked`) against the same seeds' separate updates one after the other, at
+    ``profile``'s learner, batch and sizes and its thread count, each seed sampling its own replay. The
+    two alternate round by round (a round: one update of every seed), so that a shared machine's load
+    falls on both alike; the medians and the fastest rounds are reported. The critic warm-up is off
+    (``critic_warmup_updates`` 0) so that every update is a whole one, actor and temperature included."""
+    from egosearch.rl.stacked import SeedStreams, stack_agents
+
+    cfg = load_config(profile, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
+    before = torch.get_num_threads()
+    torch.set_num_threads(torch_threads(cfg.num_threads))
+    try:
+        device = resolve_device(cfg.device)
+        state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+        streams, separate, members, replays = SeedStreams(device), [], [], []
+        for seed in range(seeds):
+            for agents in (separate, members):
+                torch.manual_seed(seed)
+                agents.append(make_agent(cfg, 5, 30, 4, device, state_dim))
+            streams.capture()
+            replays.append(_filled_replay(5, device, seed=seed, size=separate[-1].replay_image_size,
+                                          state_dim=state_dim))
+        stack = stack_agents(members, streams)
+        sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+        times: dict[str, list[float]] = {"separate": [], "stacked": []}
+        for i in range(warmup + rounds):
+            t0 = time.perf_counter()
+            for agent, replay in zip(separate, replays):
+                agent.update(replay.sample(cfg.batch_size))
+            sync()
+            t1 = time.perf_counter()
+            stack.update([replay.sample(cfg.batch_size) for replay in replays])
+            sync()
+            t2 = time.perf_counter()
+            if i >= warmup:
+                times["separate"].append(t1 - t0)
+                times["stacked"].append(t2 - t1)
+        median = {k: float(np.median(v)) for k, v in times.items()}
+        return {"profile": profile, "algorithm": cfg.algorithm, "seeds": seeds, "batch_size": cfg.batch_size,
+                "torch_threads": torch.get_num_threads(), "device": str(device), "rounds": rounds,
+                "separate_round_s": round(median["separate"], 4), "stacked_round_s": round(median["stacked"], 4),
+                "separate_round_s_best": round(min(times["separate"]), 4),
+                "stacked_round_s_best": round(min(times["stacked"]), 4),
+                "stacked_speedup": round(median["separate"] / median["stacked"], 2)}
+    finally:
+        torch.set_num_threads(before)
+
+
 def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: dict | None = None) -> dict:
     """Env steps per core-second of a short REAL training run of ``profile`` (head-on,
     kitchen_living, everywhere): env stepping, acting and updates all in, its own evaluations
@@ -131,16 +182,28 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
 
 
     overrides = overrides or {}
-    cfg = load_config(profile, {**overrides, "total_env_steps": env_steps,
-                                "init_steps": overrides.get("init_steps", max(1, env_steps // 10)),
-                                "eval_every": env_steps, "checkpoint_every": env_steps, "log_every": env_steps})
+    full = load_config(profile, overrides)
+    short = {"total_env_steps": env_steps, "init_steps": overrides.get("init_steps", max(1, env_steps // 10)),
+             "eval_every": env_steps, "checkpoint_every": env_steps, "log_every": env_steps}
+    if full.demo_episodes:
+        # A profile that learns from the classical searcher first: the stored rates count its RL phase
+        # alone (egosearch.cost.rates), so this run does too. A few demonstrations fill the replay's demo
+        # half (an update costs the same whatever they hold), the cloning is cut to a token, the critic's
+        # warm-up scaled to the run's share of a whole training; their CPU time is taken off below.
+        short.update(demo_episodes=max(2, full.num_envs), bc_updates=min(full.bc_updates, 20), dagger_rounds=0,
+                     critic_warmup_updates=round(full.critic_warmup_updates * env_steps / full.total_env_steps))
+    cfg = load_config(profile, {**overrides, **short})
     with tempfile.TemporaryDirectory() as out:
         cpu0, wall0 = time.process_time(), time.perf_counter()
-        train("EgoSearch-v0", cfg, out, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},
-              evaluate_fn=lambda policy: {}, progress=False, variant="bench")
+        summary = train("EgoSearch-v0", cfg, out, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},
+                        evaluate_fn=lambda policy: {}, progress=False, variant="bench")
         cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
-    return {"env_steps": env_steps, "core_s": round(cpu, 2), "wall_s": round(wall, 2),
-            "env_steps_per_core_s": round(env_steps / cpu, 1), "threads": torch_threads(cfg.num_threads)}
+    outside_rl = (summary.get("demonstrations", {}).get("cpu_s", 0.0)
+                  + summary.get("imitation", {}).get("cpu_s", 0.0))
+    rl_cpu = cpu - outside_rl
+    return {"env_steps": env_steps, "core_s": round(rl_cpu, 2), "wall_s": round(wall, 2),
+            "core_s_before_rl": round(outside_rl, 2),
+            "env_steps_per_core_s": round(env_steps / rl_cpu, 1), "threads": torch_threads(cfg.num_threads)}
 
 
 def cpu_profile_run_steps(quick: bool = False) -> int:

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from egosearch.envs import observed_env_id
 from egosearch.rl.base import pool_depth, pooled_side
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
@@ -34,7 +35,6 @@ from egosearch.rl.run_files import atomic_json
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
-from egosearch.sim.envs import observed_env_id
 from egosearch.sim.scenarios import MAX_STEPS
 
 DEMO_SEED_BASE = 7_000_000

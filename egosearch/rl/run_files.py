@@ -16,15 +16,15 @@ from typing import Any
 import numpy as np
 import torch
 
+from egosearch.envs import ALL_ENV_IDS, env_options
 from egosearch.rl.config import LearnerConfig, field_defaults
-from egosearch.sim.envs import ENV_IDS, MODULAR_ENV_IDS
 
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
 
 CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
 START_ACTOR_NAME = "actor_start.pt"
-"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train._Run.write_start_actor`)."""
+"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train.LiveRun.write_start_actor`)."""
 """The resumable state inside ``out_dir`` (``*.ckpt`` is git-ignored: it holds the replay)."""
 
 
@@ -249,7 +249,8 @@ def saved_config(saved: dict) -> dict:
     theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
     env_id = str(saved.get("env_id"))
     # runs saved before these fields existed named them in their env id only: read them from the id's table
-    theirs.setdefault("modular_searcher", env_id in MODULAR_ENV_IDS)
+    options = env_options(env_id) if env_id in ALL_ENV_IDS else None
+    theirs.setdefault("modular_searcher", bool(options and options.modular))
     if "target_memory" not in saved.get("config", {}):
-        theirs["target_memory"] = bool(ENV_IDS.get(env_id, {}).get("target_memory", False))
+        theirs["target_memory"] = bool(options and options.target_memory)
     return theirs

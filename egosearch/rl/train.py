@@ -55,6 +55,7 @@ import torch
 
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
+from egosearch.envs import observed_env_id
 from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
@@ -81,7 +82,6 @@ from egosearch.rl.run_files import (
     to_tensors,
 )
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
-from egosearch.sim.envs import observed_env_id
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
@@ -204,25 +204,9 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     env_kwargs = dict(env_kwargs or {})
     out_dir = Path(out_dir)
     variant = variant or env_id
-    ckpt_path = out_dir / CHECKPOINT_NAME
-    done_path = out_dir / "done.json"
-
-    # -- a finished run, or a checkpoint to resume: validated before anything is written ----
-    if done_path.exists():
-        try:
-            done = json.loads(done_path.read_text())
-        except (OSError, ValueError) as err:
-            raise CheckpointError(f"cannot read {done_path} ({describe_error(err)})") from None
-        check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
+    done, ckpt = open_run(env_id, cfg, out_dir, env_kwargs, variant)
+    if done is not None:
         return done
-    ours = {CHECKPOINT_NAME.name, "actor.pt", START_ACTOR_NAME, "done.json", "config.json", "curve.csv",
-            "curve_episodes.csv", "train.csv"}
-    for stale in [*out_dir.glob(".tmp*"), *(out_dir / CHECKPOINT_NAME.parent).glob(".tmp*")]:
-        if stale.name.split(".", 2)[-1] in ours:  # temp files of a killed run of ours
-            stale.unlink()
-    ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
-    if ckpt is not None:
-        check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
 
     threads_before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
@@ -237,6 +221,29 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
         for env in envs:
             env.close()
         torch.set_num_threads(threads_before)
+
+
+def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
+             variant: str) -> tuple[dict | None, dict | None]:
+    """A run folder's state, validated before anything is written: (``done.json``'s summary of a
+    finished run, None) or (None, the checkpoint to resume, or None for a fresh start)."""
+    ckpt_path, done_path = out_dir / CHECKPOINT_NAME, out_dir / "done.json"
+    if done_path.exists():
+        try:
+            done = json.loads(done_path.read_text())
+        except (OSError, ValueError) as err:
+            raise CheckpointError(f"cannot read {done_path} ({describe_error(err)})") from None
+        check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
+        return done, None
+    ours = {CHECKPOINT_NAME.name, "actor.pt", START_ACTOR_NAME, "done.json", "config.json", "curve.csv",
+            "curve_episodes.csv", "train.csv"}
+    for stale in [*out_dir.glob(".tmp*"), *(out_dir / CHECKPOINT_NAME.parent).glob(".tmp*")]:
+        if stale.name.split(".", 2)[-1] in ours:  # temp files of a killed run of ours
+            stale.unlink()
+    ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
+    if ckpt is not None:
+        check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
+    return None, ckpt
 
 
 def _act_batch(agent: Agent, observations: list[dict]) -> list[np.ndarray]:
@@ -260,7 +267,7 @@ def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
 def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
            progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None) -> dict:
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
-    run = _Run(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
+    run = LiveRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
     own_eval = evaluate_fn is None
     evaluate_fn = evaluate_fn or default_evaluator(env_id, env_kwargs, cfg.eval_episodes)
     bar = run.open_progress(progress)
@@ -300,7 +307,7 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
     return run.finish(last_row)
 
 
-class _Run:
+class LiveRun:
     """One training run's live state (agent, replay, envs, counters, CSV logs) and the steps of its
     loop, each a method, after DrQ-v2's ``Workspace``.
 
@@ -499,16 +506,24 @@ class _Run:
     def update(self, before: int) -> None:
         """The updates due for the env steps ``before`` -> ``step``: ``updates_per_step`` at every
         ``update_every``-th step from the last warm-up step on."""
+        for _ in range(self.updates_due(before)):
+            self.record(self.agent.update(self.sample()))
+
+    def updates_due(self, before: int) -> int:
+        """How many updates the env steps ``before`` -> ``step`` call for; sets the agent's
+        ``bc_weight_now`` for them."""
         cfg = self.cfg
         if self.step < cfg.init_steps:
-            return
+            return 0
         first_due = max(before, cfg.init_steps - 1)
         if cfg.bc_weight:
             self.agent.bc_weight_now = cfg.bc_weight * max(0.0, 1.0 - self.step / cfg.bc_decay_steps)
-        for _ in range((self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step):
-            metrics = self.agent.update(self.sample())
-            self.means["curve"].add(metrics)
-            self.means["train"].add(metrics)
+        return (self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step
+
+    def record(self, metrics: dict[str, float]) -> None:
+        """An update's metrics, into the means of the next curve.csv and train.csv rows."""
+        self.means["curve"].add(metrics)
+        self.means["train"].add(metrics)
 
     def sample(self) -> dict:
         """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout);

@@ -6,7 +6,7 @@ import os
 
 import gymnasium
 
-import egosearch.sim.envs  # noqa: F401  (registers the ids)
+import egosearch.envs  # noqa: F401  (registers the ids, the decision envs too)
 from egosearch.core.csvio import write_csv_atomic
 from egosearch.runs.metrics import episode_spl, spl
 from egosearch.sim.agent import EVAL_HEIGHTS

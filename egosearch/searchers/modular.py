@@ -35,10 +35,15 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from egosearch.searchers.decision_envs import (
+    MODULAR_MAP_CELL_SIZE,
+    MODULAR_MAP_CELLS,
+    MODULAR_MAP_DIM,
+    modular_decision_dim,
+)
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.policies import RandomPolicy
 from egosearch.sim.env import MASK_FEATURE_DIM, SearchEnv
-from egosearch.sim.envs import MODULAR_MAP_CELL_SIZE, MODULAR_MAP_CELLS, MODULAR_MAP_DIM, modular_decision_dim
 
 
 class GoalFrontierPolicy(FrontierPolicy):
@@ -69,8 +74,8 @@ class GoalFrontierPolicy(FrontierPolicy):
         self._mapped = (-1, False)
 
     def decide(self, decision: np.ndarray) -> None:
-        """Take a decision in [-1, 1] (:func:`egosearch.sim.envs.modular_decision_dim`), read in the body's
-        current frame."""
+        """Take a decision in [-1, 1] (:func:`egosearch.searchers.decision_envs.modular_decision_dim`), read in
+        the body's current frame."""
         a = np.clip(np.asarray(decision, np.float64), -1.0, 1.0)
         s = self.env.state
         forward, left = a[0] * self.GOAL_REACH, a[1] * self.GOAL_REACH

@@ -1,0 +1,85 @@
+"""Every gymnasium id egosearch provides, and the env's options resolved in one place.
+
+``import egosearch.envs`` registers them all; so does ``import egosearch`` when gymnasium is loaded, which
+is how ``gymnasium.make("egosearch:EgoSearch-v0")`` finds them with no other import. Registering loads
+neither the physics nor the sensor.
+
+What a policy observes and what it learns are options (:class:`EnvOptions`): the head, the target memory,
+the floor map (keyword options of the body env, :mod:`egosearch.sim.envs`) and the modular searcher's
+decisions (its own env, :mod:`egosearch.searchers.decision_envs`). A learner config names two of them
+(``target_memory``, ``modular_searcher``) and a variant its env id; :func:`observed_env_id` turns the three
+into the id a run trains and is evaluated in, and :func:`env_options` any id, a stored run's included,
+back into its options."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from egosearch.searchers.decision_envs import MODULAR_ENV_IDS, MODULAR_MAP_DIM, decision_env_id, modular_decision_dim
+from egosearch.sim.envs import ENV_IDS, body_env_id, body_options
+
+ALL_ENV_IDS = (*ENV_IDS, *MODULAR_ENV_IDS)
+"""Every id a policy may be trained and evaluated in."""
+
+
+@dataclass(frozen=True)
+class EnvOptions:
+    """What an env id stands for."""
+
+    head: bool = True
+    """The camera's two joints (paper 4); False: the camera fixed to the body."""
+    target_memory: bool = False
+    """The last-seen target memory in the observation (a change of observation)."""
+    floor_map: bool = False
+    """The egocentric floor map in the observation (a change of observation; comes with the memory)."""
+    modular: bool = False
+    """One step is one decision of where to explore and how to sweep the head, the frontier searcher
+    walking the body (a change of what is learned)."""
+
+    @property
+    def env_id(self) -> str:
+        """The registered id with exactly these options."""
+        if self.modular:
+            if self.target_memory or self.floor_map:
+                raise ValueError("the modular searcher's decision env has no target memory or floor map option")
+            return decision_env_id(self.head)
+        return body_env_id(self.head, self.target_memory, self.floor_map)
+
+
+def env_options(env_id: str) -> EnvOptions:
+    """The options of a registered id; one clear line for any other."""
+    if env_id in MODULAR_ENV_IDS:
+        return EnvOptions(head=MODULAR_ENV_IDS[env_id]["head"], modular=True)
+    if env_id in ENV_IDS:
+        return EnvOptions(**body_options(env_id))
+    raise ValueError(f"env id {env_id!r} is not one of egosearch's; allowed: {', '.join(ALL_ENV_IDS)}")
+
+
+def observed_env_id(env_id: str, target_memory: bool, modular_searcher: bool = False) -> str:
+    """The id a policy trains and is evaluated in: a variant's ``env_id`` with the two learner config fields
+    that change it, ``target_memory`` (added to a body env's observation) and ``modular_searcher`` (the
+    decision env of the same head). A decision env stays as it is, and so does an env of the user's own
+    (registered by them: a test's fake env), which the two fields cannot change."""
+    if env_id not in ALL_ENV_IDS:
+        if target_memory or modular_searcher:
+            raise ValueError(f"env id {env_id!r} is not one of egosearch's ({', '.join(ALL_ENV_IDS)}): the config's "
+                             "target_memory and modular_searcher choose among those only; leave them off")
+        return env_id
+    options = env_options(env_id)
+    if options.modular:
+        return env_id
+    if modular_searcher:
+        return EnvOptions(head=options.head, modular=True).env_id
+    return EnvOptions(**{**asdict(options), "target_memory": options.target_memory or bool(target_memory)}).env_id
+
+
+def env_space_dims(env_id: str) -> dict[str, int]:
+    """``{"action", "mask", "proprio"}`` sizes of a registered id, without building its env."""
+    # local: registering the ids must not load pybullet and the sensor (the Snakefile's checks import this)
+    from egosearch.sim.env import MASK_FEATURE_DIM, space_dims
+
+    options = env_options(env_id)
+    if options.modular:
+        return {**space_dims(options.head), "action": modular_decision_dim(options.head),
+                "mask": MASK_FEATURE_DIM + MODULAR_MAP_DIM}
+    return space_dims(options.head, options.target_memory, options.floor_map)
