@@ -13,14 +13,14 @@ import difflib
 import json
 import math
 import re
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import jsonschema
 import yaml
 
 from egosearch.envs import observed_env_id
-from egosearch.rl.config import LearnerConfig, load_config
+from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
 from egosearch.searchers import registry as searchers
 from egosearch.sim.home_pool import check_home_split
 
@@ -157,9 +157,15 @@ def check_learner_config(variant: Variant, learner_profile: str) -> None:
 
 
 def _learner_overrides(config: dict, path: Path) -> dict:
-    """``config`` checked field by field against ``LearnerConfig``. PyYAML reads ``1e-4`` (no dot)
-    as a string, so a float field also takes a string that reads as a finite number."""
-    kinds = {f.name: f.type for f in fields(LearnerConfig)}
+    """``config`` checked field by field against the fields of every learner's config (and, when the variant
+    names its learner, against that learner's: a field it does not have is one line). PyYAML reads ``1e-4``
+    (no dot) as a string, so a float field also takes a string that reads as a finite number."""
+    kinds = field_types()
+    if isinstance(config.get("algorithm"), str) and config["algorithm"] in ALGORITHMS:
+        try:
+            refuse_foreign_fields(config["algorithm"], config)
+        except ValueError as err:
+            raise VariantError(f"{path}: config: {err}") from None
     out = {}
     for key, value in config.items():
         if key == "seed":
@@ -225,8 +231,8 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
             "env_id": base.env_id, "train_env": base.train_env, "config": base.config}
     path.write_text(
         f"# A variant of {template}: edit what differs. env_id: EgoSearch-v0 (head on) or EgoSearchNoHead-v0;\n"
-        "# train_env: the training home and placement scheme; config: LearnerConfig fields\n"
-        "# (egosearch/rl/config.py) overridden on top of the profile.\n"
+        "# train_env: the training home and placement scheme; config: run settings (egosearch/rl/run_settings.py)\n"
+        "# and the learner's own fields (egosearch/rl/*_settings.py) overridden on top of the profile.\n"
         + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
     try:
         load_variant(path)

@@ -358,7 +358,7 @@ def test_table2_rows_match_the_paper():
 
 
 def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
-    from egosearch.rl.config import HOUSEKEEPING_FIELDS, LearnerConfig, departure_rows, field_docs
+    from egosearch.rl.config import FIELD_ORDER, HOUSEKEEPING_FIELDS, departure_rows, field_defaults, field_docs
 
     assert departure_rows(load_config("paper", {})) == []
     cfg = load_config("paper", {"batch_size": 64, "seed": 7, "algorithm": "sac_drq", "encoder_num_layers": 2})
@@ -367,8 +367,10 @@ def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
     assert rows["batch_size"][:2] == ("64", "32") and rows["batch_size"][2].startswith('Table 2 "Batch-size"')
     assert rows["algorithm"][2].startswith("Paper 4.2")
     docs = field_docs()  # every field documents its source, so every departure can name one
-    assert set(docs) == {f for f in LearnerConfig.__dataclass_fields__} and all(docs.values())
+    assert set(docs) == set(field_defaults()) and all(docs.values())
     assert "seed" in HOUSEKEEPING_FIELDS
+    # the order departures are listed in names every field of every learner once
+    assert sorted(FIELD_ORDER) == sorted(field_defaults())
 
 
 def test_bench_timer_runs():

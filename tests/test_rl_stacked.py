@@ -22,7 +22,7 @@ STREAM_BASE = 500
 """Seed k's random stream for the updates starts at ``torch.manual_seed(STREAM_BASE + k)``."""
 CURL_SMALL = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32, "actor_hidden_dim": 64,
               "critic_hidden_dim": 64, "device": "cpu"}
-DRQ_SMALL = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32, "actor_hidden_dim": 64,
+DRQ_SMALL = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "actor_hidden_dim": 64,
              "critic_hidden_dim": 64, "device": "cpu", "critic_warmup_updates": 2, "num_threads": 1}
 STATE_DIM = 7
 ROUNDING = {"rtol": 1e-4, "atol": 2e-5}

@@ -100,7 +100,7 @@ def test_seeds_that_cannot_be_stacked_are_refused(tmp_path):
     with pytest.raises(StackingError, match="repeated"):
         train_stacked(FAKE_ENV_ID, [cfgs[0], cfgs[0]], [tmp_path / "a", tmp_path / "b"], progress=False)
     with pytest.raises(StackingError, match="algorithm sac_drq_recurrent is not stacked"):
-        train_stacked(FAKE_ENV_ID, configs(algorithm="sac_drq_recurrent", obs_downsample=2, curl_latent=32,
+        train_stacked(FAKE_ENV_ID, configs(algorithm="sac_drq_recurrent", obs_downsample=2,
                                            encoder_stride2_layers=2, num_envs=2),
                       [tmp_path / "a", tmp_path / "b"], progress=False)
     assert not (tmp_path / "a").exists()  # refused before anything is written
@@ -108,7 +108,7 @@ def test_seeds_that_cannot_be_stacked_are_refused(tmp_path):
 
 def test_stacked_sac_drq_training_with_lockstep_envs_and_n_step_returns(tmp_path):
     drq = {"algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2, "encoder_stride2_layers": 2,
-           "aug_pad": 2, "num_envs": 2, "n_step": 3, "update_every": 2, "curl_latent": 32}
+           "aug_pad": 2, "num_envs": 2, "n_step": 3, "update_every": 2}
     cfgs = configs(**drq)
     folders = [tmp_path / f"seed{s}" for s in SEEDS]
     summaries = train_stacked(FAKE_ENV_ID, cfgs, folders, variant="head-on", progress=False)

@@ -96,7 +96,7 @@ def test_train_help_names_the_option(option, capsys):
 def test_bench_stacked_times_both_ways_at_small_sizes():
     from egosearch.rl.bench import bench_stacked
 
-    small = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "curl_latent": 32, "actor_hidden_dim": 64,
+    small = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "actor_hidden_dim": 64,
              "critic_hidden_dim": 64, "batch_size": 16}
     r = bench_stacked(seeds=2, warmup=1, rounds=2, overrides=small)
     assert r["algorithm"] == "sac_drq" and r["seeds"] == 2 and r["batch_size"] == 16 and r["rounds"] == 2

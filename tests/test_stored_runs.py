@@ -44,3 +44,28 @@ def test_a_run_stored_before_a_field_existed_ran_as_its_default():
     theirs = saved_config(saved)
     assert theirs["demo_episodes"] == 0 and theirs["bc_weight"] == 0.0
     assert theirs["target_memory"] is True and theirs["modular_searcher"] is False
+
+
+CONFIGS = sorted((ROOT / "results").glob("*/train/*/seed*/config.json"))
+
+
+def test_there_are_stored_configs():
+    assert len(CONFIGS) >= len(STORED)
+
+
+@pytest.mark.parametrize("path", CONFIGS, ids=lambda p: "/".join(p.parts[-5:-1]))
+def test_a_stored_config_loads_as_its_learners_config_with_the_values_it_recorded(path):
+    """Every stored config.json loads as its learner's config (run settings + its own), each field it has at
+    the recorded value (or, recorded before the field existed, at its default, its "off"). What the file
+    records beyond them are other learners' fields, which this learner never read (runs stored before the
+    config was split into a config per learner recorded every learner's)."""
+    from egosearch.rl.config import LearnerConfig, field_defaults
+
+    saved = json.loads(path.read_text())
+    recorded = saved_config(saved)
+    cfg = LearnerConfig.from_stored(recorded)
+    mine = cfg.to_dict()
+    assert {k: recorded.get(k, field_defaults()[k]) for k in mine} == mine
+    assert set(recorded) - set(mine) <= set(field_defaults()), "a recorded field no settings class has"
+    # and the stored file's own values, read back
+    assert all(mine[k] == v for k, v in saved["config"].items() if k in mine)

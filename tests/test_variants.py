@@ -54,15 +54,14 @@ REPO = __import__("pathlib").Path(__file__).resolve().parent.parent
 def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
     """So a profile that changes pins the old values in the files of the runs stored before it (as
     head_on_25px does): otherwise `compare` would read a stored run as the variant's, trained otherwise."""
-    import dataclasses
     import json
 
-    from egosearch.rl.config import LearnerConfig, load_config
+    from egosearch.rl.config import field_defaults, load_config
 
     _, profile, _, name, _ = run.split("/")
     stored = json.loads((REPO / run / "config.json").read_text())
     want = load_config(profile, load_variant(name).config).to_dict()
-    got = {f.name: f.default for f in dataclasses.fields(LearnerConfig)} | stored["config"]
+    got = field_defaults() | stored["config"]
     # runs from before target_memory was a learner field name the memory in their env id
     got["target_memory"] = got["target_memory"] or any(m in stored["env_id"] for m in ("Memory", "Map"))
     got["modular_searcher"] = got["modular_searcher"] or "Modular" in stored["env_id"]

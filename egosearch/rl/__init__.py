@@ -2,11 +2,18 @@
 Imports core/, scene/, sim/, searchers/ (the teacher) and runs/ (its curve evaluations); imported by variants
 and the CLI.
 
-- :mod:`egosearch.rl.config`: ``LearnerConfig`` (every Table 2 value and every learner's knobs),
-  ``PROFILES`` (smoke / cpu / paper), ``load_config(profile, overrides)``, ``table2_rows(cfg)``;
-- :mod:`egosearch.rl.registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``)
-  and the actor file formats they write (``actor_loader``); adding a learner is one module and
-  one ``register`` line there;
+- :mod:`egosearch.rl.config`: ``LearnerConfig`` (the run settings and the learner's own, composed: one
+  config class per learner), ``load_config(profile, overrides)``, ``table2_rows(cfg)``, ``departure_rows(cfg)``;
+- :mod:`egosearch.rl.run_settings`: ``RunSettings``, what every learner and the training loop share;
+- :mod:`egosearch.rl.network_settings`: the pieces each learner's own settings are made of (``NetworkSettings``,
+  ``SacSettings``, ``PooledSettings``, ``RandomShiftSettings``);
+- :mod:`egosearch.rl.sac_curl_settings`, :mod:`egosearch.rl.sac_drq_settings`,
+  :mod:`egosearch.rl.sac_drq_recurrent_settings`, :mod:`egosearch.rl.ppo_settings`: each learner's own
+  settings, registered with it in the registry;
+- :mod:`egosearch.rl.profiles`: ``PROFILES`` (smoke / cpu / paper) as data, with their sources;
+- :mod:`egosearch.rl.registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``),
+  the settings class of each and the actor file formats they write (``actor_loader``); adding a learner
+  is one module (and its settings') and one ``register`` line there;
 - :mod:`egosearch.rl.agent`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,
   and ``AgentBase``, its optional hooks' defaults; the actor file's contract (``ActorFile``,
   ``ActorArch``, ``ActorFileNet``);

@@ -4,9 +4,10 @@
 :data:`LEARNERS` holds one :class:`Learner` per algorithm name; :data:`ALGORITHMS` (its live names)
 is what ``LearnerConfig.validate`` accepts. Adding a learner is one module with its agent class (an
 :class:`egosearch.rl.agent.Agent`, most simply a subclass of :class:`egosearch.rl.agent.AgentBase`)
-and one :func:`register` line below. Agents and loaders may be named ``"module:attribute"``, imported
-on first use: this module imports neither torch nor a learner, nor the config (:mod:`egosearch.rl.config`
-imports it); it types configs as :class:`egosearch.rl.agent.LearnerSettings`.
+and one :func:`register` line below, which also names the dataclass of its own settings (most simply
+built from :mod:`egosearch.rl.network_settings`'s pieces). Agents, loaders and settings may be named
+``"module:attribute"``, imported on first use: this module imports neither torch nor a learner, nor the
+config (:mod:`egosearch.rl.config` imports it); it types configs as :class:`egosearch.rl.agent.LearnerSettings`.
 """
 
 from __future__ import annotations
@@ -38,13 +39,19 @@ class Learner:
     ``actor_formats``: the ``format`` of each actor file it writes -> the function
     ``(state, device) -> net`` (or ``"module:function"``) that loads that file's network, an
     :class:`egosearch.rl.agent.ActorFileNet`;
-    ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size)."""
+    ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size);
+    ``settings``: the dataclass of its own settings (or ``"module:Class"``), which
+    :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone."""
 
     name: str
     display_name: str
     agent: str | Callable[..., Agent]
     actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] = field(default_factory=dict)
     takes_state_dim: bool = True
+    settings: str | type | None = None
+
+    def settings_class(self) -> type | None:
+        return None if self.settings is None else _resolve(self.settings)
 
     def agent_factory(self) -> Callable[..., Agent]:
         return _resolve(self.agent)
@@ -65,12 +72,12 @@ ALGORITHMS = LEARNERS.keys()
 
 def register(name: str, display_name: str, agent: str | Callable[..., Agent],
              actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] | None = None, *,
-             takes_state_dim: bool = True, replace: bool = False) -> Learner:
+             takes_state_dim: bool = True, settings: str | type | None = None, replace: bool = False) -> Learner:
     """Register a learner under algorithm ``name`` (see :class:`Learner` for the arguments); a name
     already taken needs ``replace``, and an actor format another learner loads differently is refused."""
     if name in LEARNERS and not replace:
         raise ValueError(f"algorithm {name!r} is registered already ({LEARNERS[name].display_name})")
-    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim)
+    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim, settings)
     for other in LEARNERS.values():
         for fmt, loader in learner.actor_formats.items():
             if other.name != name and fmt in other.actor_formats and other.actor_formats[fmt] != loader:
@@ -109,10 +116,14 @@ def actor_loader(fmt: str) -> Callable[..., ActorFileNet] | None:
 # ---- the learners -------------------------------------------------------------------------------
 
 register("sac_curl", "SAC+CURL", "egosearch.rl.sac_curl:SacCurlAgent",
-         {"egosearch-sac-curl-actor-v1": "egosearch.rl.sac_curl:load_actor_net"}, takes_state_dim=False)
+         {"egosearch-sac-curl-actor-v1": "egosearch.rl.sac_curl:load_actor_net"}, takes_state_dim=False,
+         settings="egosearch.rl.sac_curl_settings:SacCurlSettings")
 register("sac_drq", "SAC-DrQ", "egosearch.rl.sac_drq:SacDrqAgent",
-         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"})
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"},
+         settings="egosearch.rl.sac_drq_settings:SacDrqSettings")
 register("sac_drq_recurrent", "recurrent SAC-DrQ", "egosearch.rl.sac_drq_recurrent:SacDrqRecurrentAgent",
-         {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"})
+         {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"},
+         settings="egosearch.rl.sac_drq_recurrent_settings:SacDrqRecurrentSettings")
 register("ppo", "PPO", "egosearch.rl.ppo:PpoAgent",
-         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"})
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"},
+         settings="egosearch.rl.ppo_settings:PpoSettings")

@@ -17,7 +17,7 @@ import numpy as np
 import torch
 
 from egosearch.envs import ALL_ENV_IDS, env_options
-from egosearch.rl.config import LearnerConfig
+from egosearch.rl.config import LearnerConfig, field_defaults
 
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
@@ -219,8 +219,9 @@ def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str
     theirs = saved_config(saved)
     mine = cfg.to_dict()
     # the env id, compared above, is what these two fields select (observed_env_id): a run stored under its
-    # *Memory-v0 id observed the memory whatever its flag said
-    diff = sorted(k for k in set(mine) | set(theirs)
+    # *Memory-v0 id observed the memory whatever its flag said. Only the fields of this config's learner are
+    # compared: a run stored before the config was split also recorded other learners' fields, never read
+    diff = sorted(k for k in mine
                   if k not in RESUMABLE_FIELDS + ENV_ID_FIELDS and mine.get(k) != theirs.get(k))
     if diff:
         shown = ", ".join(f"{k}={theirs.get(k)!r} (now {mine.get(k)!r})" for k in diff[:4])
@@ -228,7 +229,7 @@ def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str
                               f"{' ...' if len(diff) > 4 else ''}; use another out_dir")
 
 
-_DEFAULTS_OF_LATER_FIELDS = {f: LearnerConfig.__dataclass_fields__[f].default
+_DEFAULTS_OF_LATER_FIELDS = {f: field_defaults()[f]
                              for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
                                        "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
                                        "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",

@@ -1,0 +1,349 @@
+"""The run settings: what every learner and the training loop share (paper 4.2 and Table 2).
+
+:class:`RunSettings` holds the settings of a training run that do not depend on which learner it trains:
+the observation and the data (image size, frame history, replay, discount, env steps, batch), the envs and
+their training-only aids, the demonstrations and the imitation phase, the loop's schedule (warm-up,
+updates, evaluations, checkpoints, logs) and where the run is placed on the machine. Each learner's own
+settings (its networks, optimisers and losses) live beside it (:mod:`egosearch.rl.sac_curl_settings`,
+:mod:`egosearch.rl.sac_drq_settings`, :mod:`egosearch.rl.sac_drq_recurrent_settings`,
+:mod:`egosearch.rl.ppo_settings`, built from :mod:`egosearch.rl.network_settings`), and
+:mod:`egosearch.rl.config` composes the two into a learner's config. Each field carries its own docstring
+saying where the value comes from: "Table 2" (the paper, Appendix A), "CURL" (the defaults of the
+reference code of Srinivas et al. 2020) or "ours".
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import ClassVar
+
+from egosearch.sim.agent import IMAGE_SIZE  # the env's frames: one source
+
+Complaint = Callable[[str, str], None]
+"""``bad(field, allowed)``: raises the one-line ``ValueError`` of a value out of range."""
+
+CURRICULUM_START_RADIUS = 1.0
+"""Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
+CURRICULUM_END_RADIUS = 12.0
+"""Radius (m) the curriculum reaches at its end: more than any home's extent."""
+DISTANCE_REWARDS = ("distance", "progress", "geodesic")
+"""Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; ``tests/test_rl_sac.py``'s
+``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
+DEMO_TEACHERS = ("frontier", "frontier_tuned")
+"""The classical searchers demonstrations may come from (see ``RunSettings.demo_teacher``;
+``egosearch.rl.demos.TEACHERS`` maps each to its class)."""
+
+DECISIONS, BODY_STEPS = "decisions", "body steps"
+"""What one env step of a training counts (:attr:`RunSettings.env_step_unit`)."""
+
+
+@dataclass
+class RunSettings:
+    """The settings every learner and the training loop share. A learner's own settings class says, in
+    its class variables, whether it has a privileged critic and whether it learns from demonstrations:
+    the run settings of those two levers are refused, in one line, for a learner without them."""
+
+    privileged_critic: ClassVar[bool] = False
+    """Whether the learner's critic may read the env's hidden state (``critic_privileged_state``)."""
+    learns_from_demonstrations: ClassVar[bool] = False
+    """Whether the learner's update knows demonstrations (``demo_episodes`` and the imitation phase)."""
+
+    # ---- Table 2: observation and data -------------------------------------------------
+    image_size: int = IMAGE_SIZE
+    """Table 2 "Image Size" 100x100: side (px) of the depth frames the env renders and the
+    replay buffer stores. It must be the env's, ``egosearch.sim.agent.IMAGE_SIZE``: a config that
+    differs is one line when it is loaded (``tests/test_rl_sac.py``)."""
+    frame_history: int = 5
+    """Table 2 "Image History Buffer Size" (K of paper 4.1): depth frames stacked as channels."""
+    head_history: int = 1
+    """Table 2 "Head History Buffer Size": past head-joint changes in the proprioception; with
+    1 the env's proprio is (q_p, q_y, last dq_p, last dq_y), i.e. 2 * (1 + head_history) values.
+    Informational for the learner: it is checked against the env's proprio size."""
+    replay_capacity: int = 100_000
+    """Table 2 "Replay buffer": transitions kept (FIFO)."""
+    gamma: float = 0.99
+    """Table 2 "Discount rate gamma"."""
+    total_env_steps: int = 750_000
+    """Table 2 "Number of training steps" 0.75M: environment steps (simulation samples, paper
+    4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` profile trains 200k body
+    steps, the 2-core budget's (see :func:`cpu_profile`); a modular searcher (``modular_searcher``) counts
+    decisions of several body steps instead (``head_on_modular``: 30k)."""
+    batch_size: int = 32
+    """Table 2 "Batch-size": transitions per gradient update (also the CURL negatives + 1)."""
+
+    # ---- the learner, the envs and their training-only aids (the cpu profile's departures) ----
+    algorithm: str = "sac_curl"
+    """Paper 4.2 / Table 2: "sac_curl" = SAC + CURL (:mod:`egosearch.rl.sac_curl`).
+    "sac_drq" = ours, after DrQ-v2 (Yarats et al. 2021): SAC with ONE conv encoder trained by
+    the critic only, random-shift augmentation, no contrastive loss and no target encoder
+    (:mod:`egosearch.rl.sac_drq`); an update costs ~3 conv passes instead of CURL's ~9. This
+    CHANGES THE ALGORITHM: the cpu profile uses it, the paper profile never.
+    "sac_drq_recurrent" = ours, SAC-DrQ with a GRU memory in the actor and a separate one in the
+    critic, trained on replayed sequences with burn-in (:mod:`egosearch.rl.sac_drq_recurrent`;
+    Ni et al. 2022, Kapturowski et al. 2019): a recurrent policy, which CHANGES THE ALGORITHM
+    further (the paper's policy sees only the last ``frame_history`` frames); no profile uses it,
+    a variant sets it. Every "sac_drq" field applies to it as well.
+    "ppo" = ours, PPO (Schulman et al. 2017) on SAC-DrQ's actor, with a separate value network
+    (:mod:`egosearch.rl.ppo`): an on-policy learner, which CHANGES THE ALGORITHM (the paper's is
+    SAC + CURL); no profile uses it, a variant sets it (see the "ppo_*" fields)."""
+    num_envs: int = 1
+    """Ours (CURL: 1): environments stepped in lockstep in one process, their actions computed
+    in one batched forward pass (acting cost per env step falls ~N-fold). Each env has its own
+    replay ring of ``replay_capacity / num_envs`` transitions; ``total_env_steps`` counts the
+    steps of all envs."""
+    n_step: int = 1
+    """CURL: 1 (one-step TD targets). DrQ-v2: 3. Rewards summed over up to ``n_step`` steps of
+    one episode with the target bootstrapped gamma^n later (sampled from the replay)."""
+    target_memory: bool = False
+    """Paper: False (the observation is depth, the target mask and the head's pose). True: the
+    policy trains, and so is evaluated, in the ``*Memory-v0`` env of its variant's id
+    (EgoSearch-v0 -> EgoSearchMemory-v0, EgoSearchNoHead-v0 -> EgoSearchNoHeadMemory-v0), whose
+    observation also carries where the target was last seen, by the searcher's own odometry, and
+    the steps since (``egosearch.sim.env``): the same as naming that id in the variant file. This
+    CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
+    ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
+    profile never."""
+    modular_searcher: bool = False
+    """Paper: False (the policy acts at every body step: its steps, turns and head). True: a modular
+    searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the stored
+    ``head_on_modular`` pair, the ``cpu`` profile's before it learned at every body step, see
+    :func:`cpu_profile`): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
+    its variant's head (EgoSearch-v0 -> EgoSearchModular-v0, EgoSearchNoHead-v0 ->
+    EgoSearchNoHeadModular-v0; ``egosearch.searchers.modular``): it decides only where to explore (a
+    point on its own floor map, walked to as the nearest reachable frontier) and how to sweep the head,
+    at most every 10 body steps, and the frontier searcher maps, plans and walks the body. Its
+    observation adds that map. So the env steps of ``total_env_steps`` and every schedule count
+    decisions. This CHANGES WHAT IS LEARNED AND THE OBSERVATION, at evaluation too (the claims about
+    the body's steps cannot be read on it); the same as naming that id in the variant file. Not with
+    ``target_memory`` (the frontier searcher remembers where it saw the target) nor demonstrations."""
+    train_distance_reward: str = "distance"
+    """Paper eq. 2 text: "distance" = r_d is minus the distance to the target while it is seen.
+    "progress" = the decrease of that distance since the last step while seen (Savva et al.
+    2019's form, which the paper cites; potential-based shaping as in habitat-lab). "geodesic" =
+    the decrease of the geodesic distance to where the target counts as found, at every step,
+    seen or not (habitat-lab's DistanceToGoalReward), with the collision term unclipped (the
+    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``head_on_geodesic``
+    lever, no profile's default. TRAINING ONLY: evaluation always scores the paper's task
+    (success, SPL), whatever the training reward. A variant's ``train_env: distance_reward``
+    takes precedence."""
+    curriculum_steps: int = 0
+    """Paper: 0 (no curriculum). Otherwise a start-distance curriculum after the reverse
+    curriculum of Florensa et al. 2017, simplified: training episodes start within a radius of
+    the target that grows linearly from ``CURRICULUM_START_RADIUS`` (1 m) to
+    ``CURRICULUM_END_RADIUS`` (12 m, the whole home) over the first this many env steps; after
+    that, starts are drawn from the whole home as in the paper. TRAINING ONLY: evaluation always
+    uses the stored scenarios."""
+
+    critic_privileged_state: bool = False
+    """Paper: False (the critic sees what the actor sees). True ("sac_drq", "sac_drq_recurrent"
+    and "ppo" only; for "ppo" the value network reads it): an asymmetric
+    actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
+    and the target's positions, the target in the body's frame, its distance: see
+    ``egosearch.sim.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
+    (history + state, not state alone). The actor, and so every policy and actor file, sees only
+    the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
+    ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""
+
+    train_height_min: float = 1.0
+    """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
+    (plus the per-step noise). Otherwise training heights are drawn from [this, 1.8] m. The
+    paper's Section 5 names randomising the abstract model's height as the way to cover
+    characters of other heights; its learner transfers from [1.0, 1.8] m down to the 0.45 m
+    camera of Table 1, the smaller learner of the cpu profile did not (its searches at 0.45 m
+    collided twice as often as at 1.05 m), so the cpu profile trains at every Table 1 height.
+    TRAINING ONLY: evaluation uses the stored scenarios' fixed heights."""
+
+    # ---- learning from the classical searcher (the paper has no teacher) -------------------------
+    # Learning from demonstrations, the cpu profile's (see cpu_profile): TRAINING ONLY, each a CHANGE OF
+    # ALGORITHM (a teacher the paper's learner does not have). The actor, its file and every evaluation are
+    # as without them.
+    demo_episodes: int = 0
+    """Paper: 0 (no demonstrations). N > 0: a fresh training first runs the classical frontier searcher
+    (``demo_teacher``: by default ``egosearch.searchers.frontier``, untuned; head moving where the body has a
+    head) for N episodes of its own training envs and keeps their transitions (``egosearch.rl.demos``,
+    seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
+    frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
+    kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time. The
+    ``cpu`` profile: 1,500 (see :func:`cpu_profile`)."""
+    demo_teacher: str = "frontier"
+    """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
+    of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
+    classical row (``egosearch.searchers.frontier``). "frontier_tuned": the same searcher tuned on
+    training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row). Either holds its head
+    fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
+    bc_updates: int = 0
+    """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
+    before the first env step, this many behaviour-cloning steps of the encoder and the actor on
+    ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
+    its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
+    act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy. The
+    ``cpu`` profile: 12,000."""
+    dagger_rounds: int = 0
+    """Paper: 0. DAgger (Ross, Gordon & Bagnell 2011), after ``bc_updates``: this many rounds in which the
+    cloned student drives ``dagger_episodes`` training-side episodes (its mean action), the teacher labels
+    every state it reaches (the frontier searcher's map updates from whatever it sees), the labelled states
+    join the demonstrations for cloning only (their actions are the teacher's, not the ones taken, so RL
+    never samples them), and the student is cloned again for ``bc_updates`` steps on all of them, drawn in
+    proportion to their sizes (``egosearch.rl.imitation``)."""
+    dagger_episodes: int = 0
+    """Ours (with ``dagger_rounds``): episodes the student drives in each DAgger round."""
+    critic_warmup_updates: int = 0
+    """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
+    the first policy steps follow a critic fitted to it): the first this many RL updates train only
+    the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned. The
+    ``cpu`` profile: 2,500."""
+    demo_batch_fraction: float = 0.0
+    """RLPD (Ball et al. 2023: 0.5, "symmetric sampling"): this fraction of every update's batch is
+    drawn from the demonstrations, the rest from the online replay. 0: online only (the paper). The ``cpu``
+    profile: 0.5."""
+    bc_weight: float = 0.0
+    """TD3+BC (Fujimoto & Gu 2021: the actor's loss plus a squared error to the data's action, weighted
+    against the critic's scale; their alpha 2.5 is a weight of 1 / 2.5 = 0.4 here), the optional term of
+    RLPD-style training: the actor's SAC loss plus ``bc_weight`` x mean |Q| x the squared error
+    between its mean action and the teacher's on the batch's demonstration rows. It decays linearly to
+    0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none. The ``cpu``
+    profile: 0.4."""
+    bc_decay_steps: int = 0
+    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0. The ``cpu``
+    profile: 100k, half its run."""
+
+    # ---- training loop (CURL defaults or ours) ------------------------------------------
+    init_steps: int = 1000
+    """CURL: environment steps of uniformly random actions before the first update."""
+    update_every: int = 1
+    """Ours (CURL: 1): gradient updates happen after every ``update_every``-th env step."""
+    updates_per_step: int = 1
+    """Ours (CURL: 1): gradient updates done each time updates are due; the update-to-data
+    ratio is ``updates_per_step / update_every``."""
+    eval_every: int = 10_000
+    """Ours: environment steps between evaluations (a row of curve.csv each; the ``cpu`` profile: 20k)."""
+    eval_episodes: int = 10
+    """Ours (CURL: 10): deterministic episodes of the default evaluation."""
+    log_every: int = 1_000
+    """Ours: environment steps between rows of train.csv / progress-bar refreshes."""
+    checkpoint_every: int = 10_000
+    """Ours: environment steps between resumable checkpoints (atomic writes). A checkpoint ends every env's
+    episode, so that a resumed run equals one that was not stopped: the ``cpu`` profile checkpoints every 20k."""
+    seed: int = 1
+    """Ours: seeds torch, numpy, python's random, the env and its action space."""
+
+    # ---- implementation (ours; they do not change the algorithm) ------------------------
+    device: str = "auto"
+    """Ours: "auto" = CUDA when available, else CPU; or any torch device string."""
+    num_threads: int = 0
+    """Ours: torch CPU threads; 0 = every core this process may run on."""
+    channels_last: bool = True
+    """Ours: run the convs in channels-last memory layout (same math, faster oneDNN kernels), in
+    every learner. For SAC-DrQ at 50 px the gain on the 2-core CPU is small and noisy (short real
+    trainings, not a stored benchmark); results differ only by float rounding."""
+    compile: bool = False
+    """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
+    ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
+    kernels near the CPU's peak; see ``egosearch.rl.bench``). May help on a GPU."""
+    cuda_graph: bool = False
+    """Ours: on a GPU, record the SAC+CURL update as CUDA graphs (one per pattern of the update's
+    steps) and replay them, instead of launching its hundreds of small kernels from Python one by
+    one (``egosearch.rl.cuda_graph``). The same math, with capturable Adam; the random numbers
+    come from torch's CUDA generator at other offsets than an eager update's. Used only where it
+    applies: algorithm sac_curl on CUDA without ``compile``; the other learners and the CPU ignore
+    it. The ``paper`` profile turns it on: on an H200 both the update and a paper-profile training
+    ran several times faster with it (docs/gpu.md gives the stored measurement)."""
+    keep_checkpoint: bool = False
+    """Ours: keep the last checkpoint (agent + optimisers + replay) after training finishes;
+    by default it is deleted once actor.pt and done.json are written (replay buffers are large
+    and must never be committed)."""
+
+    # -------------------------------------------------------------------------------------
+    def own_checks(self, bad: Complaint) -> None:
+        """The run settings' ranges and the rules between them (``LearnerConfig.validate`` calls it)."""
+        for name in ("image_size", "frame_history", "replay_capacity", "total_env_steps", "batch_size",
+                     "update_every", "updates_per_step", "eval_every", "eval_episodes", "log_every",
+                     "checkpoint_every", "num_envs", "n_step"):
+            if getattr(self, name) < 1:
+                bad(name, "an integer >= 1")
+        for name in ("head_history", "init_steps", "seed", "num_threads", "curriculum_steps"):
+            if getattr(self, name) < 0:
+                bad(name, "an integer >= 0")
+        if self.image_size != IMAGE_SIZE:
+            bad("image_size", f"{IMAGE_SIZE} (the env renders {IMAGE_SIZE} x {IMAGE_SIZE} frames: "
+                "egosearch.sim.agent.IMAGE_SIZE)")
+        if self.train_distance_reward not in DISTANCE_REWARDS:
+            bad("train_distance_reward", ", ".join(DISTANCE_REWARDS))
+        if self.critic_privileged_state and not self.privileged_critic:
+            # the cpu profile sets it, so a variant of a learner without one there must say so
+            bad("critic_privileged_state", f"False for algorithm {self.algorithm} (only the sac_drq learners have a "
+                "privileged critic; "
+                "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
+        self._check_demonstrations(bad)
+        if self.num_envs > self.replay_capacity:
+            bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
+        # Updates fall on the multiples of update_every from the last warm-up step on (train._Run.update):
+        # a run that ends before the first of them saves the random initial actor as if it were trained.
+        first_update = -(-max(self.init_steps, 1) // self.update_every) * self.update_every
+        if self.total_env_steps < first_update:
+            bad("total_env_steps", f">= {first_update}, the env step of the first update (after init_steps="
+                f"{self.init_steps} random steps, an update every {self.update_every} steps): fewer train no update")
+        if not 0.3 <= self.train_height_min <= 1.8:
+            bad("train_height_min", "[0.3, 1.8] m (training heights are drawn from [this, 1.8] m)")
+        if not 0.0 < self.gamma <= 1.0:
+            bad("gamma", "(0, 1]")
+        if self.batch_size > self.replay_capacity:
+            bad("batch_size", f"1..replay_capacity={self.replay_capacity}")
+        if not (self.device == "auto" or self.device == "cpu" or self.device.startswith("cuda")
+                or self.device == "mps"):
+            bad("device", "auto, cpu, cuda, cuda:N or mps")
+
+    def _check_demonstrations(self, bad: Complaint) -> None:
+        """The imitation levers read demonstrations, and only a learner whose update knows them may have them."""
+        for name in ("demo_episodes", "bc_updates", "critic_warmup_updates", "bc_decay_steps", "dagger_rounds",
+                     "dagger_episodes"):
+            if getattr(self, name) < 0:
+                bad(name, "an integer >= 0")
+        if not 0.0 <= self.demo_batch_fraction < 1.0:
+            bad("demo_batch_fraction", "[0, 1) (the rest of each batch is online)")
+        if self.bc_weight < 0:
+            bad("bc_weight", ">= 0")
+        if self.demo_teacher not in DEMO_TEACHERS:
+            bad("demo_teacher", ", ".join(DEMO_TEACHERS))
+        if self.demo_teacher != "frontier" and self.demo_episodes == 0:
+            bad("demo_teacher", "frontier (the default) unless demo_episodes >= 1 (no demonstrations, no teacher)")
+        uses = {"bc_updates": self.bc_updates > 0, "demo_batch_fraction": self.demo_batch_fraction > 0,
+                "bc_weight": self.bc_weight > 0}
+        for name, used in uses.items():
+            if used and self.demo_episodes == 0:
+                # the cpu profile sets them all: name every one that needs turning off with the teacher
+                on = [n for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
+                                  "bc_decay_steps") if getattr(self, n)]
+                bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations set "
+                    + ", ".join(f"{n}: 0" for n in on))
+        if self.dagger_rounds and not self.bc_updates:
+            bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
+        if bool(self.dagger_rounds) != bool(self.dagger_episodes):
+            bad("dagger_episodes", "1..10000 with dagger_rounds >= 1, else 0")
+        if self.dagger_episodes > 10_000:
+            bad("dagger_episodes", "1..10000 (a round's episodes stay below the next round's seeds)")
+        if self.bc_weight > 0 and self.demo_batch_fraction == 0:
+            bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
+        if self.bc_weight > 0 and self.bc_decay_steps == 0:
+            bad("bc_decay_steps", ">= 1 with bc_weight > 0 (the env steps over which the term decays)")
+        if self.modular_searcher and self.target_memory:
+            bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
+        if self.modular_searcher and self.demo_episodes:
+            bad("demo_episodes", "0 with modular_searcher (the demonstrations are the frontier searcher's body steps)")
+        if (self.demo_episodes or self.critic_warmup_updates) and not self.learns_from_demonstrations:
+            bad("demo_episodes" if self.demo_episodes else "critic_warmup_updates",
+                f"0 for algorithm {self.algorithm} (only sac_drq learns from demonstrations)")
+
+    def start_radius(self, env_steps: int) -> float | None:
+        """The curriculum's start radius (m) at ``env_steps``; None once it is over (or off)."""
+        if env_steps >= self.curriculum_steps:
+            return None
+        frac = env_steps / self.curriculum_steps
+        return CURRICULUM_START_RADIUS + frac * (CURRICULUM_END_RADIUS - CURRICULUM_START_RADIUS)
+
+    @property
+    def env_step_unit(self) -> str:
+        """What one env step of a training with this config is: "decisions" (a modular searcher's; up to
+        10 body steps and the walker's planning each) or "body steps". Rates of the two never mix."""
+        return DECISIONS if self.modular_searcher else BODY_STEPS

@@ -1,0 +1,102 @@
+"""A config per learner (issue 46, item 1): the run settings every learner shares, each learner's own
+settings registered with it, composed into one config class per learner; a field a learner does not
+have is one line, wherever it is set; the profiles are data a learner takes the fields it has of."""
+
+from __future__ import annotations
+
+import dataclasses
+import pickle
+
+import pytest
+
+from egosearch.rl.config import (
+    FIELD_ORDER,
+    LearnerConfig,
+    config_class,
+    field_defaults,
+    load_config,
+    own_settings,
+)
+from egosearch.rl.profiles import CPU, PROFILES
+from egosearch.rl.registry import LEARNERS
+from egosearch.rl.run_settings import RunSettings
+from egosearch.variants import VariantError, load_variant
+
+SHARED = {f.name for f in dataclasses.fields(RunSettings)}
+
+OWN_FIELD_COUNTS = {"sac_curl": 35, "sac_drq": 33, "sac_drq_recurrent": 33, "ppo": 29}
+"""How many fields of its own each learner has, beside the run settings (the closing note's counts)."""
+
+
+def test_the_run_settings_and_each_learners_own_fields_are_counted():
+    assert len(SHARED) == 39
+    assert {name: len(own_settings(name)) for name in OWN_FIELD_COUNTS} == OWN_FIELD_COUNTS
+    # every field belongs to the run settings or to some learner, and none to both
+    assert SHARED | {f for name in LEARNERS for f in own_settings(name)} == set(field_defaults()) == set(FIELD_ORDER)
+    assert not SHARED & {f for name in LEARNERS for f in own_settings(name)}
+
+
+@pytest.mark.parametrize("algorithm", list(OWN_FIELD_COUNTS))
+def test_a_learners_config_is_the_run_settings_and_its_own(algorithm):
+    valid = {"ppo": {"init_steps": 0, "update_every": 8}}  # PPO's rules: no warm-up, a rollout of whole steps
+    cfg = LearnerConfig(algorithm=algorithm, **valid.get(algorithm, {})).validate()
+    assert type(cfg) is config_class(algorithm) and isinstance(cfg, LearnerConfig)
+    assert set(cfg.to_dict()) == SHARED | set(own_settings(algorithm))
+    assert LEARNERS[algorithm].settings_class() is not None
+    assert pickle.loads(pickle.dumps(cfg)) == cfg  # a worker process may be handed one
+    assert LearnerConfig.from_dict(cfg.to_dict()) == cfg
+
+
+def test_the_default_config_is_the_papers_learner():
+    assert type(LearnerConfig()).__name__ == "SacCurlConfig" and LearnerConfig().algorithm == "sac_curl"
+
+
+def test_a_field_another_learner_has_is_one_line_naming_it_the_learner_and_its_fields():
+    with pytest.raises(ValueError) as err:
+        load_config("paper", {"algorithm": "sac_curl", "obs_downsample": 2})
+    line = str(err.value)
+    assert "\n" not in line
+    assert "algorithm sac_curl (SAC+CURL) has no field 'obs_downsample'" in line
+    assert "a setting of sac_drq, sac_drq_recurrent, ppo" in line and "crop_size" in line  # its own fields
+    with pytest.raises(ValueError, match="algorithm ppo .* has no field 'alpha_lr'"):
+        load_config("cpu", {"algorithm": "ppo", "alpha_lr": 1e-3})
+    with pytest.raises(ValueError, match="algorithm sac_drq_recurrent .* has no field 'critic_layer_norm'"):
+        LearnerConfig.from_dict({"algorithm": "sac_drq_recurrent", "critic_layer_norm": True})
+
+
+def test_a_field_no_learner_has_names_the_nearest():
+    with pytest.raises(ValueError, match=r"unknown LearnerConfig field 'obs_downsampel' \(did you mean "
+                                         r"obs_downsample\?\) for algorithm sac_drq"):
+        load_config("cpu", {"obs_downsampel": 2})
+
+
+def test_a_profile_sets_the_fields_a_learner_has_and_leaves_the_others():
+    cfg = load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "n_step": 1, "update_every": 16,
+                              "replay_capacity": 1000, "critic_privileged_state": False, "demo_episodes": 0,
+                              "bc_updates": 0, "critic_warmup_updates": 0, "demo_batch_fraction": 0.0,
+                              "bc_weight": 0.0, "bc_decay_steps": 0})
+    assert cfg.obs_downsample == CPU["obs_downsample"] and not hasattr(cfg, "aug_pad")
+    assert not hasattr(cfg, "alpha_lr")  # the cpu profile's temperature rate: PPO has no temperature
+    for profile in PROFILES:
+        assert set(load_config(profile).to_dict()) <= set(field_defaults())
+
+
+def test_a_variant_naming_its_learner_is_checked_against_it_when_read(tmp_path):
+    (tmp_path / "curl_pooled.yaml").write_text(
+        "name: curl_pooled\nenv_id: EgoSearch-v0\ntrain_env: {layout: kitchen_living, placement: everywhere}\n"
+        "config:\n  algorithm: sac_curl\n  aug_pad: 2\n")
+    with pytest.raises(VariantError, match="curl_pooled.yaml: config: algorithm sac_curl .* has no field 'aug_pad'"):
+        load_variant("curl_pooled", tmp_path)
+
+
+def test_a_learner_registered_without_settings_has_the_run_settings_alone():
+    from egosearch.rl.registry import register
+
+    register("toy_settingless", "toy", "somewhere:Agent")
+    try:
+        cfg = load_config("smoke", {"algorithm": "toy_settingless"})
+        assert set(cfg.to_dict()) == SHARED
+        with pytest.raises(ValueError, match="has no field 'actor_lr'"):
+            load_config("smoke", {"algorithm": "toy_settingless", "actor_lr": 1e-3})
+    finally:
+        del LEARNERS["toy_settingless"]
