@@ -114,16 +114,18 @@ def block_provenance(root: Path, profile: str) -> str:
     if estimate_path.exists():
         e = json.loads(estimate_path.read_text(encoding="utf-8"))
         rates = sorted(e.get("recorded_training_rates", {}).values())
+        steps = e.get("steps", "env steps")
+        slowest = e.get("hours_at_slowest_recorded_rate")
         lines.append(
             f"- `snakemake --cores {e['cores']} all` from a fresh clone, its DAG's schedule simulated on "
-            f"{e['cores']} cores (`egosearch estimate all`): **{e['hours_as_recorded']:.1f} h** as the stored run "
-            "recorded each job"
-            + (f"; {e['hours_at_slowest_recorded_rate']:.1f} h with every training at the slowest recorded rate "
-               f"({e['slowest_recorded_rate']:.0f} {e.get('steps', 'env steps')} per CPU-second; the stored "
-               f"trainings ran at {rates[0]:.0f} to {rates[-1]:.0f})"
-               if e.get("hours_at_slowest_recorded_rate") else "")
+            f"{e['cores']} cores (`egosearch estimate all`), each job on a core of its own (its recorded CPU time) "
+            + (f"and every training at the slowest recorded rate ({e['slowest_recorded_rate']:.0f} {steps} per "
+               f"CPU-second; the stored trainings ran at {rates[0]:.0f} to {rates[-1]:.0f}) plus its imitation "
+               f"phase: **{slowest:.1f} h**" if slowest else "")
             + (f"; {e['hours_here']:.1f} h on a machine whose learner benchmark gives {e['bench_rate']:.0f} "
-               f"{e.get('steps', 'env steps')} per CPU-second ({e['rate_source']})" if e.get("hours_here") else "")
+               f"{steps} per CPU-second ({e['rate_source']})" if e.get("hours_here") else "")
+            + f"; {e['hours_as_recorded']:.1f} h at the wall times the stored run's jobs recorded, which count the "
+            "waits of runs that shared the two cores with more work than the DAG's"
             + f". The jobs' CPU time / {e['cores']}, the lower bound this page used to give: "
             f"{e['hours_cpu_over_cores']:.1f} h. `egosearch estimate all --cores N` calibrates for your machine "
             f"in a minute (from `{estimate_path.relative_to(root)}`).")

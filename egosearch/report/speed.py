@@ -116,7 +116,10 @@ def _learner_lines(root: Path, profile: str) -> list[str]:
                      + (" (a modular searcher: each decision walks several body steps, planned by the frontier "
                         "searcher)" if decisions else "") + " in `kitchen_living` "
                      f"(building the envs and writing its checkpoint, env stepping, acting and updates all in; "
-                     f"core-seconds are the process's own CPU time, {run.get('core_s', '?')} s); {target}.")
+                     f"core-seconds are the process's own CPU time, {run.get('core_s', '?')} s"
+                     + (f", its RL phase's: a token imitation phase first, a few demonstrations and cloning steps, "
+                        f"{run['core_s_before_rl']} s left out, as the stored trainings' rates leave theirs out"
+                        if run.get("core_s_before_rl") else "") + f"); {target}.")
     avx2 = r.get("env_steps_per_core_s_cpu_profile_avx2")
     if avx2 is not None:
         lines.append(f"The same training with oneDNN limited to AVX2 (`ONEDNN_MAX_CPU_ISA=AVX2`, its own process): "
