@@ -55,6 +55,13 @@ def test_every_stored_run_resolves_whatever_id_it_recorded():
     assert {"EgoSearch-v0", "EgoSearchNoHead-v0", "EgoSearchModular-v0"} <= seen
 
 
+def _in_a_fresh_interpreter(code: str) -> str:
+    """What ``code`` prints in a new Python process (nothing of egosearch imported before it)."""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
 def test_gymnasium_finds_the_ids_after_importing_only_gymnasium():
     code = ("import gymnasium\n"
             "env = gymnasium.make('egosearch:EgoSearch-v0', layout='studio', target_memory=True)\n"
@@ -62,9 +69,7 @@ def test_gymnasium_finds_the_ids_after_importing_only_gymnasium():
             "print(obs['mask'].shape)\n"
             "import egosearch.report, sys\n"
             "print('egosearch.envs' in sys.modules)\n")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    shape, registered = r.stdout.split()[-2:]
+    shape, registered = _in_a_fresh_interpreter(code).split()[-2:]
     assert registered == "True"
     assert shape == f"({env_space_dims('EgoSearchMemory-v0')['mask']},)"  # the option took effect
 
@@ -75,5 +80,4 @@ def test_import_egosearch_envs_registers_every_id_without_the_physics():
             "missing = [i for i in egosearch.envs.ALL_ENV_IDS if i not in registry]\n"
             "heavy = [m for m in ('pybullet', 'torch', 'egosearch.sim.env') if m in sys.modules]\n"
             "assert not missing and not heavy, (missing, heavy)\n")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 0, r.stderr
+    _in_a_fresh_interpreter(code)

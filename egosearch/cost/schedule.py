@@ -26,6 +26,7 @@ Snakemake's job id as the last tie-break. Where it differs:
 
 from __future__ import annotations
 
+import copy
 import csv
 import heapq
 import math
@@ -302,6 +303,10 @@ class Durations(Mapping):
     def __len__(self) -> int:
         return len(self.seconds)
 
+    def trainings(self) -> list[str]:
+        """The ids of the training jobs (``train/<variant>/seed<k>``)."""
+        return [ident for ident in self.seconds if ident.startswith(TRAIN + "/")]
+
     def note(self) -> str:
         """One sentence on what the durations rest on, for the estimate to say."""
         parts = [f"{len(self.from_record)} of {len(self.seconds)} jobs timed by the record "
@@ -431,14 +436,9 @@ def trainings_at_rate(durations: Durations, steps_by_job: Mapping[str, int],
     :func:`scale_to_rate` nothing of the record's wall time stays, waits included."""
     if rate <= 0:
         raise ValueError(f"rate must be positive, not {rate}")
-    out = Durations(seconds=dict(durations.seconds), from_record=list(durations.from_record),
-                    missing=list(durations.missing), untimed=list(durations.untimed), scaled=dict(durations.scaled),
-                    unscaled=list(durations.unscaled), cpu_time=durations.cpu_time, at_rate=list(durations.at_rate))
-    prefix = TRAIN + "/"
-    for ident in out.seconds:
-        if not ident.startswith(prefix):
-            continue
-        job = ident[len(prefix):]
+    out = copy.deepcopy(durations)
+    for ident in out.trainings():
+        job = ident[len(TRAIN) + 1:]
         if job in steps_by_job and job in before_rl_s_by_job:
             out.seconds[ident] = steps_by_job[job] / rate + before_rl_s_by_job[job]
             out.at_rate.append(ident)
@@ -453,14 +453,9 @@ def scale_to_rate(durations: Durations, rate_by_job: Mapping[str, float], target
     time). Other jobs as they were; trainings of the durations without a rate go to ``unscaled``."""
     if target_rate <= 0:
         raise ValueError(f"target_rate must be positive, not {target_rate}")
-    out = Durations(seconds=dict(durations.seconds), from_record=list(durations.from_record),
-                    missing=list(durations.missing), untimed=list(durations.untimed), scaled=dict(durations.scaled),
-                    unscaled=list(durations.unscaled), cpu_time=durations.cpu_time, at_rate=list(durations.at_rate))
-    prefix = TRAIN + "/"
-    for ident in out.seconds:
-        if not ident.startswith(prefix):
-            continue
-        rate = rate_by_job.get(ident[len(prefix):])
+    out = copy.deepcopy(durations)
+    for ident in out.trainings():
+        rate = rate_by_job.get(ident[len(TRAIN) + 1:])
         if rate is None or rate <= 0:
             out.unscaled.append(ident)
             continue
