@@ -49,12 +49,26 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(source: str) -> list[tuple[str, str]]:
+def _package_of(path: Path) -> str:
+    """The package a module's relative imports start from: its own for an ``__init__``, else its parent's."""
+    return ".".join(path.relative_to(PACKAGE.parent).parent.parts)
+
+
+def _imports_of(path: Path) -> list[tuple[str, str]]:
+    return _imports(path.read_text(), _package_of(path))
+
+
+def _imports(source: str, package: str = "egosearch") -> list[tuple[str, str]]:
     """(imported egosearch module, imported name or '') of every import in ``source``, those under
-    ``if TYPE_CHECKING:`` and inside functions included: an annotation's import is an arrow too."""
+    ``if TYPE_CHECKING:`` and inside functions included: an annotation's import is an arrow too. A relative
+    import is resolved against ``package``, the package the source's module is in."""
     out = []
     for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("egosearch"):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+            module = ".".join(base + ([node.module] if node.module else []))
+            out += [(module, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("egosearch"):
             out += [(node.module, a.name) for a in node.names]
         elif isinstance(node, ast.Import):
             out += [(a.name, "") for a in node.names if a.name.startswith("egosearch")]
@@ -89,6 +103,9 @@ def test_imports_under_type_checking_and_in_functions_count():
               "if TYPE_CHECKING:\n    from egosearch.variants import ResolvedVariant\n"
               "def f():\n    import egosearch.sim.envs\n")
     assert _imports(source) == [("egosearch.variants", "ResolvedVariant"), ("egosearch.sim.envs", "")]
+    # a relative import is an arrow too, resolved from the module's package
+    assert _imports("from ..variants import load_variant\nfrom . import envs\n", "egosearch.rl") == [
+        ("egosearch.variants", "load_variant"), ("egosearch.rl", "envs")]
 
 
 def test_each_stage_imports_only_the_stages_below_it():
@@ -96,7 +113,7 @@ def test_each_stage_imports_only_the_stages_below_it():
     wrong = []
     for name, path in modules.items():
         stage = _stage(name)
-        for imported, item in _imports(path.read_text()):
+        for imported, item in _imports_of(path):
             target = _target(imported, item, modules)
             other = _stage(target)
             if other not in (stage, "(root)") and other not in LAYERS[stage] and target not in OPEN_MODULES:
@@ -142,7 +159,7 @@ def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 def test_no_import_circles():
     assert find_cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
     modules = _modules()
-    graph = {name: {_target(i, n, modules) for i, n in _imports(path.read_text())} & set(modules) - {name}
+    graph = {name: {_target(i, n, modules) for i, n in _imports_of(path)} & set(modules) - {name}
              for name, path in modules.items()}
     assert not find_cycles(graph)
 
@@ -156,7 +173,7 @@ def test_the_stage_rules_themselves_run_one_way():
 def test_no_module_imports_another_modules_private_names():
     modules = _modules()
     private = [f"{name} imports {imported}.{item}" for name, path in modules.items()
-               for imported, item in _imports(path.read_text())
+               for imported, item in _imports_of(path)
                if item.startswith("_") and not item.startswith("__") and imported != name]
     assert not private, private
 

@@ -17,7 +17,7 @@ this module). What it reads of a config is :class:`LearnerSettings`.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol, TypedDict, runtime_checkable
+from typing import TYPE_CHECKING, Any, ClassVar, NotRequired, Protocol, TypedDict, runtime_checkable
 
 import numpy as np
 
@@ -195,6 +195,10 @@ class ActorArch(TypedDict):
 
     action_dim: int
     extra_dim: int
+    mask_dim: NotRequired[int]
+    proprio_dim: NotRequired[int]
+    crop_size: NotRequired[int]
+    image_size: NotRequired[int]
 
 
 class ActorFile(TypedDict):
