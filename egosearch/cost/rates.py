@@ -36,8 +36,9 @@ def stored_training_rates(record: dict, results: Path, steps_kind: str = BODY_ST
     the learner benchmark's machine), by job key, of the trainings whose env step is ``steps_kind``
     (:data:`DECISIONS`: the modular searchers'). A training that learned from the classical searcher
     counts the CPU time of its RL phase only (its run's, less the teacher's episodes and the cloning that
-    its ``done.json`` records); one that recorded no cloning time is left out: its env steps per
-    CPU-second would mix the teacher's cost into the learner's rate."""
+    its ``done.json`` records, a cloning it did not time priced as :func:`cpu_s_outside_rl` says); one
+    whose cloning cannot be priced is left out: its env steps per CPU-second would mix the teacher's cost
+    into the learner's rate."""
     jobs = [r for r in record.get("jobs", []) if r.get("rule") == TRAIN]
     steps = env_steps_of(results, [r["job"] for r in jobs])
     out = {}

@@ -283,14 +283,8 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
             live = envs[: cfg.total_env_steps - run.step]  # the last round may need fewer envs
             run.step_and_store(live, run.actions(live))
             run.update(before)
-            if run.step // cfg.log_every > before // cfg.log_every:
-                run.log_train(bar)
-            if run.crossed(cfg.eval_every, before):
-                last_row = run.evaluate(evaluate_fn)
-            if run.crossed(cfg.checkpoint_every, before):
-                run.save_checkpoint()
-                if run.step < cfg.total_env_steps:
-                    run.restart_episodes()
+            last_row = run.log_evaluate_checkpoint(before, evaluate_fn, run.crossed(cfg.checkpoint_every, before),
+                                                   bar) or last_row
             if bar is not None:
                 bar.update(run.step - before)
             if on_step is not None:
@@ -573,6 +567,21 @@ class LiveRun:
                               "alpha": self.agent.alpha, "wall_s": self.wall()})
 
     # ---- logging and evaluating -----------------------------------------------------------
+    def log_evaluate_checkpoint(self, before: int, evaluate_fn, checkpoint: bool, bar=None) -> dict | None:
+        """What follows the updates of the env steps ``before`` -> ``step``: a train.csv row at every
+        ``log_every``-th step, an evaluation at every ``eval_every``-th (its curve row is returned, else None),
+        and with ``checkpoint`` the checkpoint, then fresh episodes unless the run is done."""
+        cfg, row = self.cfg, None
+        if self.step // cfg.log_every > before // cfg.log_every:
+            self.log_train(bar)
+        if self.crossed(cfg.eval_every, before):
+            row = self.evaluate(evaluate_fn)
+        if checkpoint:
+            self.save_checkpoint()
+            if self.step < cfg.total_env_steps:
+                self.restart_episodes()
+        return row
+
     def log_train(self, bar=None) -> None:
         """A row of train.csv: update metrics since the last row, the last 20 training episodes."""
         sps, ups = self.rates("train")

@@ -169,14 +169,7 @@ def _loop(runs: list[LiveRun], streams: SeedStreams, cfgs: list[LearnerConfig], 
             stack.sync_members()  # the stacked optimiser states into each seed's agent state
         for k, run in enumerate(runs):
             with streams.stream(k):
-                if run.step // cfg.log_every > before // cfg.log_every:
-                    run.log_train()
-                if run.crossed(cfg.eval_every, before):
-                    last_rows[k] = run.evaluate(evaluators[k])
-                if checkpoint:
-                    run.save_checkpoint()
-                    if run.step < cfg.total_env_steps:
-                        run.restart_episodes()
+                last_rows[k] = run.log_evaluate_checkpoint(before, evaluators[k], checkpoint) or last_rows[k]
         if bar is not None:
             bar.update(first.step - before)
         if on_step is not None:
