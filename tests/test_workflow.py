@@ -210,13 +210,18 @@ def test_a_stored_comparison_gives_no_missing_input_line():
     assert "compare: its outputs are stored" not in result.stderr + result.stdout
 
 
-def test_a_screen_compares_one_seed_against_the_references_same_seed():
-    """`snakemake screen --config variant=NAME`: the lever screen as one command, on screen_seed only."""
-    out = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seed=1"])
+def test_a_screen_trains_screen_seeds_against_the_references_spread_seeds():
+    """`snakemake screen --config variant=NAME`: the lever screen as one command, on screen_seeds seeds from
+    screen_seed, read against every spread seed of the reference (the smoke profile's: 0 and 1)."""
+    out = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seed=1", "screen_seeds=2"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
-    assert "results/smoke/compare/screen_head_off_seed1_vs_head_on_seed1.csv" in text
-    assert "eval/head_off/seed1/" in text and "eval/head_on/seed1/" in text and "/seed0/" not in text
+    assert "results/smoke/compare/screen_head_off_seeds1-2_vs_head_on.csv" in text
+    assert "results/smoke/compare/screen_head_off_seeds1-2_vs_head_on_aggregate.csv" in text
+    assert "eval/head_off/seed1/" in text and "eval/head_off/seed2/" in text and "eval/head_off/seed0/" not in text
+    assert "eval/head_on/seed0/" in text and "eval/head_on/seed1/" in text and "eval/head_on/seed2/" not in text
+    one = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seeds=1"])
+    assert "results/smoke/compare/screen_head_off_seed0_vs_head_on.csv" in one.stdout + one.stderr
     missing = run(["-n", "screen", "--config", "profile=smoke"])
     assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr
 
@@ -229,10 +234,16 @@ def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
     out = run(["-n", "screen", "--config", "variant=head_off"])
     assert out.returncode == 0, out.stderr
     monkeypatch.chdir(REPO)
-    print_variant_cost("cpu", "screen", "head_off", [0], "head_on", 1)
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    seeds = list(range(config["screen_seeds"]))
+    print_variant_cost("cpu", "screen", "head_off", seeds, "head_on", 1,
+                       reference_seeds=config["profiles"]["cpu"]["spread_seeds"])
     line = capsys.readouterr().err.strip()
     assert line.startswith("screen of head_off against head_on: ") and "about" in line
     assert out.stderr.splitlines().count(line) == 1
+    # and the power of that screen, beside its cost
+    assert any(f"a screen of {len(seeds)} seed(s) against head_on" in x or x.startswith("(no power line")
+               for x in out.stderr.splitlines())
 
 
 def test_a_dry_run_without_a_stored_run_says_why_there_is_no_estimate(checkout):

@@ -305,6 +305,10 @@ def add_report(sub) -> None:
                                            "and per shortest-path bin")
     r.add_argument("--reference", nargs="+", required=True, help="the reference variant's evaluation CSVs")
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
+    r.add_argument("--aggregate", help="also write the aggregate over seeds and cells (interquartile mean, "
+                   "probability of improvement) to this CSV")
+    r.add_argument("--spread", nargs="+", help="every stored seed's evaluation CSVs of the reference variant: a side "
+                   "with fewer than 3 seeds (a screen) counts their seed variance (docs/statistics.md)")
     r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
                                  "pooled, to <out stem>_by_length.csv) as well as printing them")
     add_force(r, "; also compares a candidate file with the same content as a reference file (refused without it: "
@@ -373,6 +377,20 @@ def add_report(sub) -> None:
     r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
     r.add_argument("--out", required=True, help="the provenance JSON to write")
     r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
+    add_force(r)
+
+    r = reports.add_parser("null-screen", help="the reference's seeds screened against each other, before and after "
+                                             "the seed spread counts; its summary (docs/statistics.md)")
+    r.add_argument("files", nargs="+", help="every spread seed's evaluation CSVs of one variant")
+    r.add_argument("--out", required=True, help="the null screen's CSV")
+    r.add_argument("--summary", required=True, help="the seed spread, false-positive rates and power, as JSON")
+    r.add_argument("--simulations", type=int, default=400, help="simulated null screens per setting (default 400)")
+    add_force(r)
+
+    r = reports.add_parser("reread-screens", help="every stored one-seed screen read again with the seed spread "
+                                                "counted, beside its old verdict (docs/ablations.md)")
+    r.add_argument("--profile", **profile)
+    r.add_argument("--out", required=True, help="the re-read's CSV")
     add_force(r)
 
     r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a profile (seconds)")

@@ -66,7 +66,8 @@ def report_inputs(args) -> dict[str, list[str]]:
     if args.what == "budget":
         return {"--run": [f for spec in args.run for f in spec.partition("=")[2].split(":") if f]}
     names = {"files": "the input files", "bounds": "--bounds", "levels": "--levels", "reference": "--reference",
-             "candidate": "--candidate", "scenarios": "--scenarios", "stored": "--stored", "fresh": "--fresh"}
+             "candidate": "--candidate", "spread": "--spread", "scenarios": "--scenarios", "stored": "--stored",
+             "fresh": "--fresh"}
     out = {}
     for name, option in names.items():
         value = getattr(args, name, None)
@@ -323,7 +324,7 @@ def _pathlength(args) -> None:
 def _compare(args) -> None:
     if args.out is None:
         report.cmd_compare(args.reference, args.candidate, None, reference_name="reference",
-                           candidate_name="candidate")
+                           candidate_name="candidate", spread_files=args.spread)
         return
     # The comparison writes its CSV before the ℓ split checks that both sides ran the same scenarios:
     # both go to temporary files, moved into place only when every check passed, and what it prints
@@ -335,9 +336,15 @@ def _compare(args) -> None:
     try:
         with contextlib.redirect_stdout(printed):
             report.cmd_compare(args.reference, args.candidate, tmp, reference_name="reference",
-                               candidate_name="candidate")
+                               candidate_name="candidate", spread_files=args.spread)
         os.replace(tmp, out)
         os.replace(tmp_by_length, by_length)
+        if args.aggregate:
+            from egosearch.report.aggregate import aggregate_report, format_aggregate
+            from egosearch.report.data import cells_from_paths
+            print(format_aggregate(aggregate_report(cells_from_paths(args.reference), cells_from_paths(args.candidate),
+                                                    args.aggregate)), file=printed)
+            print(f"wrote {args.aggregate}", file=printed)
     finally:
         for path in (tmp, tmp_by_length):
             path.unlink(missing_ok=True)
@@ -405,10 +412,50 @@ def _readme(args) -> None:
         print(f"rewrote the results blocks of {names} from the {args.profile} results")
 
 
+def _null_screen(args) -> None:
+    import json
+
+    from egosearch.report.data import cells_from_paths
+    from egosearch.report.null_screen import null_screen, seed_spread_summary
+
+    files = cells_from_paths(args.files)
+    variants = _variants(args.files, parse_eval_path)
+    if len(variants) != 1:
+        raise ValueError(f"null-screen: the files are of {len(variants)} variants ({', '.join(variants)}); give one")
+    # results/<profile>/eval/<variant>/seed<N>/<home>/<placement>/h<height>.csv
+    results = Path(args.files[0]).resolve().parents[5]
+    record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
+    summary = seed_spread_summary(files, record, variants[0], n_sims=args.simulations)  # first: it refuses < 2 seeds
+    df = null_screen(files, args.out)
+    called = df[(df["metric"] == "success")]
+    print(f"null screen of {variants[0]} ({summary['n_seeds']} seeds, {df['screen'].nunique()} screens): "
+          f"{int((called['scenarios_verdict'].isin(['lower', 'higher'])).sum())} success cells called different "
+          f"before the seed spread counted, {int(called['verdict'].isin(['lower', 'higher']).sum())} after; "
+          f"seed sd {summary['pooled_seed_sd']:.3f}; wrote {args.out}")
+    Path(args.summary).write_text(json.dumps(summary, indent=1, default=float) + "\n", encoding="utf-8")
+    print(f"recommended screen_seeds: {summary['recommended_screen_seeds']} (detects "
+          f"{summary['detectable_at_recommended']:.3f} at {summary['power_cell'][0]} m with 80% power; "
+          f"{summary['seeds_per_day']} seeds fit in a {summary['day_hours']:g} h day); wrote {args.summary}")
+
+
+def _reread_screens(args) -> None:
+    from egosearch.report.reread import reread_screens
+
+    results = Path("results") / args.profile
+    if not (results / "compare").is_dir():
+        raise FileNotFoundError(f"{results / 'compare'}: no stored comparisons (run it in the project's root)")
+    df = reread_screens(results / "compare", results / "eval", args.out)
+    read = df[df["metric"] == "success"]
+    before, after = (int(read[column].isin(["higher", "lower"]).sum()) for column in ("old_verdict", "verdict"))
+    print(f"{df['screen'].nunique()} stored screens read again: {before} success cells were called different, "
+          f"{after} are now; wrote {args.out}")
+
+
 REPORTS = {"table1": _table1, "table2": _table2, "fig6": _fig6, "fig7": _fig7, "budget": _budget,
            "generalise": _generalise, "fresh": _fresh, "pathlength": _pathlength, "compare": _compare,
            "behaviour": _behaviour, "searches": _searches, "provenance": _provenance, "regenerate": _regenerate,
-           "verify": _verify, "readme": _readme}
+           "verify": _verify, "readme": _readme, "null-screen": _null_screen,
+           "reread-screens": _reread_screens}
 """Each ``egosearch report`` sub-command (its parser: :func:`egosearch.cli.parsers.add_report`)."""
 
 

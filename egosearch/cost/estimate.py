@@ -62,8 +62,14 @@ def print_costs(targets, config: dict, profile: str, seeds: list[int], reference
         print_before_a_run(profile, cores)
     for target in ("compare", "screen"):
         if target in targets and config.get("variant"):
-            chosen = seeds if target == "compare" else [config["screen_seed"]]
-            print_variant_cost(profile, target, config["variant"], chosen, reference, cores)
+            if target == "compare":
+                print_variant_cost(profile, target, config["variant"], seeds, reference, cores)
+                continue
+            chosen = list(range(config["screen_seed"], config["screen_seed"] + config.get("screen_seeds", 1)))
+            spread = config["profiles"][profile].get("spread_seeds", seeds)
+            print_variant_cost(profile, target, config["variant"], chosen, reference, cores,
+                               reference_seeds=spread)
+            print_screen_power(profile, reference, len(chosen))
 
 
 def print_before_a_run(profile: str, cores: int) -> None:
@@ -169,11 +175,34 @@ def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: fl
             "note": stored.note(), "lines": lines}
 
 
+def print_screen_power(profile: str, reference: str, n_seeds: int) -> None:
+    """What ``snakemake -n screen`` prints after its cost: the smallest success difference a screen of
+    ``n_seeds`` seeds detects at 1.05 m (80% power, 5% level before Holm) at the reference's stored seed spread
+    (``results/<profile>/compare/seed_spread_<reference>.json``, from ``snakemake seed_spread``)."""
+    from egosearch.report.null_screen import POWER_CELL, detectable_from_summary
+
+    path = Path("results") / profile / "compare" / f"seed_spread_{reference}.json"
+    if not path.is_file():
+        print(f"(no power line: {path} is not there; `snakemake --cores 2 seed_spread` measures the seed spread)",
+              file=sys.stderr)
+        return
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+        detectable = detectable_from_summary(summary, n_seeds)
+        print(f"a screen of {n_seeds} seed(s) against {reference}'s {summary['n_seeds']} spread seeds detects a "
+              f"success difference of {detectable:.3f} at {POWER_CELL[0]} m with 80% power (seed sd "
+              f"{summary['pooled_seed_sd']:.3f}; the recommended screen_seeds={summary['recommended_screen_seeds']} "
+              f"detects {summary['detectable_at_recommended']:.3f}; {path})", file=sys.stderr)
+    except (OSError, ValueError, KeyError) as err:
+        print(f"(no power line: {path}: {err})", file=sys.stderr)
+
+
 def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int], reference: str,
-                       cores: int) -> None:
+                       cores: int, reference_seeds: list[int] = ()) -> None:
     """What ``snakemake compare``/``screen`` prints before its first job: the trainings and evaluations
-    of ``variant`` it still has to run (their files are missing), each at this machine's rate (its last
-    calibration, else the stored learner benchmark's machine, said which), and the wall time on
+    of ``variant`` it still has to run (their files are missing), and of ``reference`` on
+    ``reference_seeds`` (a screen's spread seeds) where those are missing, each at this machine's rate (its
+    last calibration, else the stored learner benchmark's machine, said which), and the wall time on
     ``cores`` cores (one-thread jobs side by side). Never stops the run."""
     # local: the variants layer loads gymnasium's registry; only a comparison's start reads a variant
     from egosearch.variants import resolve_variant
@@ -198,13 +227,16 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
                     "calibrates this machine)"
         config_of_variant = resolve_variant(variant, profile).config
         steps = config_of_variant.total_env_steps
-        trainings = [s for s in seeds if not (results / "train" / variant / f"seed{s}" / "done.json").exists()]
+        runs = [(variant, s) for s in seeds] + [(reference, s) for s in reference_seeds]
+        trainings = [(v, s) for v, s in runs if not (results / "train" / v / f"seed{s}" / "done.json").exists()]
         evals = [r["wall_s"] for r in record.get("jobs", []) if r.get("rule") == "eval"]
         per_eval = statistics.median(evals) if evals else 0.0
         config = workflow_config()
-        n_evals = sum(not (results / "eval" / variant / f"seed{s}" / home / placement / f"h{height}.csv").exists()
-                      for s in seeds for home in config["homes"] for placement in config["placements"]
+        n_evals = sum(not (results / "eval" / v / f"seed{s}" / home / placement / f"h{height}.csv").exists()
+                      for v, s in runs for home in config["homes"] for placement in config["placements"]
                       for height in workflow_heights(config))
+        of_reference = sum(v == reference for v, _ in trainings)
+        counted = f" ({of_reference} of them the reference's spread seeds)" if of_reference else ""
         per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
         variant_kind = config_of_variant.env_step_unit
         if variant_kind != kind or not rate:
@@ -225,7 +257,8 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
                 teacher = (f", plus the teacher's {config_of_variant.demo_episodes} episodes and the cloning (no "
                            "stored measurement prices them)")
         hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
-        print(f"{target} of {variant} against {reference}: {len(trainings)} training(s) of {steps} env steps, about "
+        print(f"{target} of {variant} against {reference}: {len(trainings)} training(s){counted} of {steps} env "
+              f"steps, about "
               f"{per_training / 3600:.1f} h each on {where}{teacher}, and {n_evals} evaluations of about "
               f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
     except (OSError, ValueError, KeyError, TypeError) as err:

@@ -17,6 +17,8 @@ from egosearch.report.data import cells_from_paths, group_eval_paths, output_bas
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
 from egosearch.report.pathlength import by_length_path, compare_by_length, format_by_length, pathlength_report
 from egosearch.report.provenance import check_stored
+from egosearch.report.spread_sides import comparison_spreads
+from egosearch.report.stats import METRICS
 from egosearch.report.tables import bound_names, compare_report, format_compare, table1, table2
 
 PathLike = str | os.PathLike
@@ -86,13 +88,15 @@ def cmd_fig7(fullbody_files: Iterable[PathLike], out_prefix: PathLike, planner: 
 
 def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: Mapping | Iterable[PathLike],
                 out_csv: PathLike | None = None, reference_name: str = "reference",
-                candidate_name: str = "candidate") -> pd.DataFrame:
+                candidate_name: str = "candidate",
+                spread_files: Mapping | Iterable[PathLike] | None = None) -> pd.DataFrame:
     """Candidate vs reference per (height, placement) cell; each side a ``{cell: [paths]}`` dict or a flat
     list of one variant's evaluation CSVs. Prints the table; writes ``out_csv`` when given.
 
     Refuses (:class:`~egosearch.report.provenance.StoredFileError`) a stored file that differs from
     the sha256 its results folder's provenance recorded; files the record does not list (a new
-    candidate's) are used as they are."""
+    candidate's) are used as they are. ``spread_files``: every stored seed's files of the reference
+    variant, whose seed variance a side with too few seeds borrows (a screen; docs/statistics.md)."""
     reference_list, candidate_list = (_flat(side.values()) if isinstance(side, Mapping) else list(side)
                                       for side in (reference_files, candidate_files))
     # A file on both sides (a variant compared with itself) gives differences of 0 that read as a result.
@@ -102,17 +106,23 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
         more = f" ({len(both) - 1} more file(s) too)" if len(both) > 1 else ""
         raise ValueError(f"{os.fspath(both[0])} is both a reference and a candidate file{more}: compare two "
                          "different variants (is the candidate the reference itself?)")
-    check_stored([*reference_list, *candidate_list], require_record=False)
+    spread_list = [] if spread_files is None else (
+        _flat(spread_files.values()) if isinstance(spread_files, Mapping) else list(spread_files))
+    check_stored([*reference_list, *candidate_list, *spread_list], require_record=False)
     if not isinstance(reference_files, Mapping):
         reference_files = cells_from_paths(reference_files)
     if not isinstance(candidate_files, Mapping):
         candidate_files = cells_from_paths(candidate_files)
-    df = compare_report(reference_files, candidate_files, out_csv)
+    if spread_files is not None and not isinstance(spread_files, Mapping):
+        spread_files = cells_from_paths(spread_files)
+    # the seed spreads first: a screen against a one-seed reference is refused before any table is drawn
+    spreads = {m: comparison_spreads(reference_files, candidate_files, spread_files, m) for m in METRICS}
+    df = compare_report(reference_files, candidate_files, out_csv, spread_files=spread_files)
     print(format_compare(df, reference_name, candidate_name))
     if out_csv is not None:
         print(f"wrote {out_csv}")
     by_csv = None if out_csv is None else by_length_path(out_csv)
-    print(format_by_length(compare_by_length(reference_files, candidate_files, by_csv)))
+    print(format_by_length(compare_by_length(reference_files, candidate_files, by_csv, spreads=spreads)))
     if by_csv is not None:
         print(f"wrote {by_csv}")
     return df

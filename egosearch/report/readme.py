@@ -165,7 +165,7 @@ BY_LENGTH = "_by_length"
 
 
 def _cell_comparisons(folder: Path) -> list[Path]:
-    return sorted(p for p in folder.glob("*_vs_*.csv") if not p.stem.endswith(BY_LENGTH))
+    return sorted(p for p in folder.glob("*_vs_*.csv") if not p.stem.endswith((BY_LENGTH, "_aggregate")))
 
 
 def _by_length_line(path: Path, root: Path) -> str | None:
@@ -232,7 +232,8 @@ def block_power(root: Path, profile: str) -> str:
         lo, hi = int(succ["n_scenarios"].min()), int(succ["n_scenarios"].max())
         homes = ", ".join(sorted(set(succ["homes"])))
         smallest, largest = _fmt(succ["detectable_80"].min()), _fmt(succ["detectable_80"].max())
-        one_seed = (succ["n_seeds_ref"] == 1).all() and (succ["n_seeds_cand"] == 1).all()
+        one_seed = (succ["n_seeds_ref"] == 1).all() and (succ["n_seeds_cand"] == 1).all() and (
+            succ.get("method", pd.Series(["bootstrap"])) != "seed spread").all()
         lines.append(f"- `{path.stem}`: {lo if lo == hi else f'{lo}–{hi}'} scenarios per cell ({homes}); a success "
                      f"difference of {smallest if smallest == largest else f'{smallest}–{largest}'} is "
                      "detected with 80% power"
@@ -450,6 +451,96 @@ def block_reading(root: Path, profile: str) -> str:
             + f"`; the height and cabinet contrasts from `results/{profile}/eval/head_on/` and the scenario sets.\n")
 
 
+def _reference(root: Path) -> str:
+    import yaml
+
+    return yaml.safe_load((root / "egosearch/workflow/config.yaml").read_text(encoding="utf-8"))["reference_variant"]
+
+
+def block_seed_spread(root: Path, profile: str) -> str:
+    """The reference's seed spread, its null screen before and after the spread counts, the simulated
+    false-positive rates and the difference a screen of N seeds detects (``snakemake seed_spread``)."""
+    reference = _reference(root)
+    folder = root / "results" / profile / "compare"
+    summary_path, null_path = folder / f"seed_spread_{reference}.json", folder / f"null_screen_{reference}.csv"
+    if not summary_path.exists() or not null_path.exists():
+        return _missing(root, summary_path if not summary_path.exists() else null_path)
+    sm = json.loads(summary_path.read_text(encoding="utf-8"))
+    null = pd.read_csv(null_path)
+    succ = null[null["metric"] == "success"]
+    called = ("lower", "higher")
+    pairs = succ[~succ["screen"].str.endswith("the_others")]
+    rest = succ[succ["screen"].str.endswith("the_others")]
+    lines = [f"`{reference}`, {sm['n_seeds']} seeds ({', '.join(map(str, sm['seeds']))}), both homes, 400 scenarios "
+             f"per cell. Seed spread per cell (sd between training seeds, the scenarios' part removed; the part the "
+             "scenarios alone explain beside it):", "",
+             "| height | placement | seed sd | scenarios' part of a seed's mean (sd) |", "|---|---|---|---|"]
+    lines += [f"| {c['height']:g} | {c['placement']} | {c['seed_sd']:.3f} | {c['scenario_part_sd']:.3f} |"
+              for c in sm["cells"]]
+    lines += ["", f"Pooled over the cells: **sd {sm['pooled_seed_sd']:.3f}** with {sm['pooled_df']} degrees of "
+              "freedom, what every screen of this reference counts.", "",
+              f"**The null screen** (`{null_path.relative_to(root)}`): each seed screened as a candidate against each "
+              "other seed (the one-seed screen's form) and against the rest, success cells:", "",
+              "| screens | cells | called different, scenarios only (before) | called different, seed spread "
+              "counted (now) |", "|---|---|---|---|",
+              f"| one seed against another seed | {len(pairs)} | {int(pairs['scenarios_verdict'].isin(called).sum())} "
+              f"| {int(pairs['verdict'].isin(called).sum())} |",
+              f"| one seed against the rest | {len(rest)} | {int(rest['scenarios_verdict'].isin(called).sum())} | "
+              f"{int(rest['verdict'].isin(called).sum())} |", "",
+              f"**Simulated false-positive rate** ({sm['simulations']} simulated null screens per row, every cell "
+              f"tested at p < {sm['alpha']} before Holm; seeds drawn from the model fitted to the stored episodes, "
+              "their shift correlated ρ between cells):", "",
+              "| reference seeds | ρ | scenarios only | seed spread counted |", "|---|---|---|---|"]
+    lines += [f"| {f['n_reference']} | {f['rho']:g} | {f['scenarios_only']:.3f} | {f['seed_spread']:.3f} |"
+              for f in sm["false_positive_rate"]]
+    power = pd.DataFrame(sm["detectable_80"])
+    lines += ["", f"**Power**: the success difference a screen of N candidate seeds detects with 80% power (5% level, "
+              f"before Holm) against the {sm['n_seeds']} stored seeds:", "",
+              "| height | placement | " + " | ".join(f"N = {n}" for n in sorted(power["n_candidate"].unique())) + " |",
+              "|---|---|" + "---|" * power["n_candidate"].nunique()]
+    for (h, pl), g in power.groupby(["height", "placement"], sort=False):
+        values = g.sort_values("n_candidate")["detectable_80"]
+        lines.append(f"| {h:g} | {pl} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
+    lines += ["", f"A difference of {sm['power_target']:g} at {sm['power_cell'][0]:g} m ({sm['power_cell'][1]}) "
+              f"needs more seeds than fit in a user's day ({sm['day_hours']:g} h on {sm['day_cores']} cores: "
+              f"{sm['seeds_per_day']} seeds at {sm['hours_per_seed']:.2f} h each, the slowest recorded training "
+              "and its 12 evaluations)" if sm["detectable_at_recommended"] > sm["power_target"] else
+              f"A difference of {sm['power_target']:g} at {sm['power_cell'][0]:g} m ({sm['power_cell'][1]}) is "
+              f"detected with {sm['recommended_screen_seeds']} seeds, within a user's day ({sm['day_hours']:g} h on "
+              f"{sm['day_cores']} cores: {sm['seeds_per_day']} seeds)",
+              f": the recommended `screen_seeds` is **{sm['recommended_screen_seeds']}**, which detects "
+              f"{sm['detectable_at_recommended']:.3f} there.", "", f"From `{summary_path.relative_to(root)}`."]
+    text = "\n".join(lines)
+    return text.replace(")\n: the recommended", "): the recommended") + "\n"
+
+
+def _called_cells(rows: pd.DataFrame, column: str) -> str:
+    picked = [f"{h:g} {'excl.' if p == 'no_low_cabinets' else 'every'} {v}" for h, p, v
+              in zip(rows["height"], rows["placement"], rows[column]) if v in ("higher", "lower")]
+    return ", ".join(picked) or "none"
+
+
+def block_screens_reread(root: Path, profile: str) -> str:
+    """Every stored one-seed screen, its old verdict and the one that counts the seed spread."""
+    path = root / "results" / profile / "compare" / "screens_reread.csv"
+    if not path.exists():
+        return _missing(root, path)
+    df = pd.read_csv(path)
+    lines = ["| screen (candidate vs reference) | spread counted | called different before (success cells) "
+             "| called different now | conclusion |", "|---|---|---|---|---|"]
+    for screen, g in df.groupby("screen", sort=True):
+        if g["metric"].isna().all():
+            lines.append(f"| `{screen}` | | | | {g['verdict'].iloc[0]} |")
+            continue
+        s = g[g["metric"] == "success"]
+        before, now = _called_cells(s, "old_verdict"), _called_cells(s, "verdict")
+        changed = "unchanged" if before == now else (
+            "within the seed spread now" if now == "none" else "fewer cells")
+        spread = f"{s['spread_from'].iloc[0]} ({s['spread_seeds'].iloc[0]})"
+        lines.append(f"| `{screen}` | {spread} | {before} | {now} | {changed} |")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}` (`snakemake seed_spread`).\n"
+
+
 BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "departures": block_departures,
     "budget": block_budget,
@@ -462,6 +553,8 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "provenance": block_provenance,
     "compare": block_compare,
     "power": block_power,
+    "seed_spread": block_seed_spread,
+    "screens_reread": block_screens_reread,
     "reading": block_reading,
     "claims": block_claims,  # the paper's behaviour sentences against the per-step traces
     "speed": block_speed,  # the stored benchmark records and trainings' speed

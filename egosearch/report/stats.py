@@ -24,6 +24,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from egosearch.report.seed_spread import SCENARIOS_ONLY, compare_with_seed_spread
+
 METRICS = ("success", "spl")
 
 
@@ -248,8 +250,23 @@ def _per_scenario(df: pd.DataFrame, metric: str, side: str) -> tuple[pd.Series, 
     return per, int(df["seed"].nunique())
 
 
+def paired_scenarios(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str = "success"):
+    """``((reference's per-scenario seed mean, its seeds), (candidate's, its seeds))``; ValueError (one line)
+    when the two sides were not evaluated on the same scenarios."""
+    ref, n_ref = _per_scenario(reference, metric, "reference")
+    cand, n_cand = _per_scenario(candidate, metric, "candidate")
+    if not ref.index.equals(cand.index):
+        only_ref = ref.index.difference(cand.index)
+        only_cand = cand.index.difference(ref.index)
+        raise ValueError(f"reference and candidate were evaluated on different scenarios "
+                         f"({len(only_ref)} only in reference, {len(only_cand)} only in candidate, "
+                         f"e.g. {list(only_ref[:2]) + list(only_cand[:2])})")
+    return (ref, n_ref), (cand, n_cand)
+
+
 def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str = "success",
-                  confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0) -> dict:
+                  confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
+                  spreads: tuple | None = None) -> dict:
     """Candidate − reference in the mean of ``metric`` (``success`` or ``spl``) on one evaluation cell.
 
     Both frames hold per-episode rows with ``scenario_id``, ``seed`` and the metric (and optionally
@@ -287,22 +304,37 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
        uncorrected, from the draws' standard deviation (:func:`detectable_from_se`; normal
        approximation), so that it counts the seeds' spread as the test does.
 
+    ``spreads``: ``(reference's, candidate's)`` :class:`~egosearch.report.seed_spread.SeedSpread`, given
+    when a side has too few seeds to show its own spread (a screen): then steps 2-5 are
+    :func:`~egosearch.report.seed_spread.compare_with_seed_spread`'s instead, a t interval and p whose
+    variance adds each side's seed variance to the scenarios' (docs/statistics.md, "Seed spread"), and
+    ``method`` says ``seed spread``; otherwise it says ``bootstrap``.
+
     Returns ``{reference, candidate, difference, ci_low, ci_high, p_uncorrected, n_scenarios,
-    n_seeds_ref, n_seeds_cand, detectable_80}``.
+    n_seeds_ref, n_seeds_cand, detectable_80, method}``.
     """
     if metric not in METRICS:
         raise ValueError(f"metric={metric!r}; allowed: {', '.join(METRICS)}")
-    ref, n_ref = _per_scenario(reference, metric, "reference")
-    cand, n_cand = _per_scenario(candidate, metric, "candidate")
-    if not ref.index.equals(cand.index):
-        only_ref = ref.index.difference(cand.index)
-        only_cand = cand.index.difference(ref.index)
-        raise ValueError(f"reference and candidate were evaluated on different scenarios "
-                         f"({len(only_ref)} only in reference, {len(only_cand)} only in candidate, "
-                         f"e.g. {list(only_ref[:2]) + list(only_cand[:2])})")
+    (ref, n_ref), (cand, n_cand) = paired_scenarios(reference, candidate, metric)
     r, c = ref.to_numpy(), cand.to_numpy()
     d = c - r
     diff = float(d.mean())
+    common = {"reference": float(r.mean()), "candidate": float(c.mean()), "n_scenarios": int(d.size),
+              "n_seeds_ref": n_ref, "n_seeds_cand": n_cand}
+    if spreads == SCENARIOS_ONLY:
+        spreads = None
+        method = "scenarios only"
+    else:
+        method = "bootstrap"
+    if spreads is not None and d.size >= 2:
+        try:
+            ref_m, _ = scenario_seed_matrix(reference, metric)
+            cand_m, _ = scenario_seed_matrix(candidate, metric)
+        except ValueError:  # a seed lacks a scenario: the seed-averaged scenarios, one column a side
+            ref_m, cand_m = r[:, None], c[:, None]
+        res = compare_with_seed_spread(ref_m, cand_m, spreads[0], spreads[1], confidence)
+        return {**common, **{k: res[k] for k in ("difference", "ci_low", "ci_high", "p_uncorrected",
+                                                   "detectable_80")}, "method": "seed spread"}
     if d.size < 2:
         lo = hi = detectable = math.nan
         p = 1.0
@@ -322,9 +354,8 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
             lo, hi = quantile_interval(draws, confidence)
             p = percentile_p_value(draws)
             detectable = detectable_from_se(float(draws.std(ddof=1)))
-    return {"reference": float(r.mean()), "candidate": float(c.mean()), "difference": diff,
-            "ci_low": lo, "ci_high": hi, "p_uncorrected": p, "n_scenarios": int(d.size),
-            "n_seeds_ref": n_ref, "n_seeds_cand": n_cand, "detectable_80": detectable}
+    return {**common, "difference": diff, "ci_low": lo, "ci_high": hi, "p_uncorrected": p,
+            "detectable_80": detectable, "method": method}
 
 
 def holm(p_values) -> np.ndarray:

@@ -12,11 +12,13 @@ import numpy as np
 import pandas as pd
 
 from egosearch.report.data import output_base, read_episodes, sorted_cells, suffixed
+from egosearch.report.spread_sides import comparison_spreads
 from egosearch.report.stats import (
     METRICS,
     bootstrap_ci,
     compare_cells,
     holm,
+    paired_scenarios,
     scenario_seed_matrix,
     two_level_ci,
     wilson_ci,
@@ -377,13 +379,33 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
 # --------------------------------------------------------------------------------------------- compare
 COMPARE_COLUMNS = ("height", "placement", "metric", "reference", "candidate", "difference", "ci_low", "ci_high",
                    "p_uncorrected", "p_holm", "significant_holm", "n_scenarios", "n_seeds_ref", "n_seeds_cand",
-                   "detectable_80", "homes")
+                   "detectable_80", "method", "seed_sd", "verdict", "homes")
 """``p_uncorrected`` is one cell's test alone, read from the same two-level bootstrap draws as ``ci_low`` /
 ``ci_high`` (below 0.05 exactly when that interval excludes 0); ``significant_holm`` is ``p_holm < 0.05``,
 Holm's adjustment over every row of the file: the only column that says whether a difference is
 significant (never true while the interval holds 0, since Holm only raises p). ``detectable_80``: the
 true difference the cell's test would detect with 80% power (uncorrected), seeds counted; ``homes``:
-the homes whose scenarios the cell pools."""
+the homes whose scenarios the cell pools. ``method``: ``bootstrap`` (each side shows its own seeds' spread:
+the two-level bootstrap) or ``seed spread`` (a side has too few seeds, so the reference variant's seed
+variance is added: :mod:`egosearch.report.seed_spread`); ``seed_sd``: the standard deviation between
+training seeds counted then (blank for the bootstrap); ``verdict``: ``higher`` or ``lower`` when
+significant after Holm, else ``within the reference's seed spread`` (seed spread) or ``no difference
+detected`` (bootstrap)."""
+
+WITHIN_SEED_SPREAD = "within the reference's seed spread"
+
+
+def verdicts(df: pd.DataFrame) -> pd.Series:
+    """``verdict`` of a comparison frame with ``significant_holm``, ``difference`` and ``method`` (COMPARE_COLUMNS)."""
+    def one(row) -> str:
+        if row["significant_holm"]:
+            side = "higher" if row["difference"] > 0 else "lower"
+            return f"{side} than the scenarios explain (seed spread unknown)" if row["method"] == "scenarios only" \
+                else side
+        if row["method"] == "scenarios only":  # no seed spread to count: the old reading, said so
+            return "no difference the scenarios show (seed spread unknown)"
+        return WITHIN_SEED_SPREAD if row["method"] == "seed spread" else "no difference detected"
+    return df.apply(one, axis=1) if len(df) else pd.Series([], dtype=str)
 
 
 def _cell_name(cell) -> str:
@@ -393,7 +415,8 @@ def _cell_name(cell) -> str:
 
 
 def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: PathLike | None = None,
-                   metrics: Iterable[str] = METRICS, n_resamples: int = 10_000, seed: int = 0) -> pd.DataFrame:
+                   metrics: Iterable[str] = METRICS, n_resamples: int = 10_000, seed: int = 0,
+                   spread_files: Mapping | None = None, count_seed_spread: bool = True) -> pd.DataFrame:
     """Candidate vs reference per cell and metric (:func:`~egosearch.report.stats.compare_cells`), as a frame.
 
     ``reference_files`` / ``candidate_files``: ``{(height, placement): [per-episode CSV paths]}``, the
@@ -401,8 +424,14 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
     path (``.../seed{N}/{layout}/{placement}/h{height}.csv``). Columns :data:`COMPARE_COLUMNS`;
     ``p_holm`` are Holm-adjusted over all rows. Written to ``out_csv`` when given.
 
+    ``spread_files``: every stored seed's files of the reference variant, ``{cell: [paths]}``, whose seed
+    variance a side with too few seeds of its own borrows (:func:`~egosearch.report.seed_spread.comparison_spreads`).
+    ``count_seed_spread=False``: the comparison as it was read before that (each side's own seeds only, a
+    one-seed side's scenarios only): the null screen's "before".
+
     ValueError (one line, naming the cell) if a cell is on one side only or the two sides were
-    evaluated on different scenarios.
+    evaluated on different scenarios; SeedSpreadUnknown (a ValueError) when a side must borrow the seed
+    spread and the reference has one seed.
     """
     ref_cells, cand_cells = set(reference_files), set(candidate_files)
     for cell in sorted(ref_cells ^ cand_cells, key=str):
@@ -410,18 +439,35 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
         raise ValueError(f"compare: cell {_cell_name(cell)} is only in the {side} files")
     if not ref_cells:
         raise ValueError("compare: no cells given")
+    metrics = list(metrics)
+    for cell in sorted_cells(ref_cells):  # the scenarios first: a mismatch is named before any seed is read
+        try:
+            paired_scenarios(read_episodes(reference_files[cell]), read_episodes(candidate_files[cell]))
+        except ValueError as e:
+            raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
+    spreads = {m: comparison_spreads(reference_files, candidate_files, spread_files, m) if count_seed_spread else None
+               for m in metrics}
     rows = []
     for cell in sorted_cells(ref_cells):
         ref = read_episodes(reference_files[cell])
         cand = read_episodes(candidate_files[cell])
         for metric in metrics:
             try:
-                res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed)
+                res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed, spreads=spreads[metric])
             except ValueError as e:
                 raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
             homes = "+".join(sorted({_home_of(x) for x in ref["scenario_set"]}))
-            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res, "homes": homes})
+            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res,
+                         "seed_sd": counted_seed_sd(spreads[metric]), "homes": homes})
     return holm_and_write(pd.DataFrame(rows), COMPARE_COLUMNS, out_csv)
+
+
+def counted_seed_sd(spreads) -> float:
+    """The standard deviation between training seeds that a seed-spread comparison counts: the larger of its
+    two sides' (nan for a bootstrap comparison)."""
+    if not isinstance(spreads, tuple):
+        return math.nan
+    return max(s.sd for s in spreads)
 
 
 def holm_and_write(df: pd.DataFrame, columns: Iterable[str], out_csv: PathLike | None = None) -> pd.DataFrame:
@@ -429,6 +475,8 @@ def holm_and_write(df: pd.DataFrame, columns: Iterable[str], out_csv: PathLike |
     written to ``out_csv`` when given."""
     df["p_holm"] = holm(df["p_uncorrected"].to_numpy())
     df["significant_holm"] = df["p_holm"] < 0.05
+    if "verdict" in columns:
+        df["verdict"] = verdicts(df)
     df = df[list(columns)]
     if out_csv is not None:
         out_csv = Path(out_csv)
@@ -450,6 +498,13 @@ def format_compare(df: pd.DataFrame, reference_name: str = "reference", candidat
                      f"{r.p_holm:>7.4f}{star} "
                      f"{r.n_scenarios:>4d} {r.n_seeds_ref:>2d}/{r.n_seeds_cand:<2d}")
     lines.append("* Holm-adjusted p < 0.05 over all rows (p_unc: one cell's test alone). diff = candidate - "
-                 "reference; CI: paired two-level bootstrap (scenarios, then each side's seeds); p: the same "
-                 "draws read as a two-sided test (p < 0.05 exactly when the 95% CI excludes 0).")
+                 "reference; p < 0.05 exactly when the 95% CI excludes 0.")
+    if (df["method"] == "seed spread").any():
+        sd = float(df.loc[df["method"] == "seed spread", "seed_sd"].max())
+        lines.append(f"A side has too few seeds to show its own spread: CI and p add the reference's seed variance "
+                     f"(sd {sd:.3f} between training seeds) to the scenarios'; a row without * is within the "
+                     "reference's seed spread, not lower or higher (docs/statistics.md).")
+    else:
+        lines.append("CI: paired two-level bootstrap (scenarios, then each side's seeds); p: the same draws read as "
+                     "a two-sided test.")
     return "\n".join(lines)

@@ -156,10 +156,34 @@ def compare_candidate(wildcards):
     return eval_files(config["variant"])
 
 
+SCREEN_SEEDS = list(range(config["screen_seed"], config["screen_seed"] + config["screen_seeds"]))
+# The reference's seeds that measure the seed spread (the profile's spread_seeds; its seeds when it names none).
+SPREAD_SEEDS = PROF.get("spread_seeds", SEEDS)
+
+
 def screen_files(variant):
-    """One seed's evaluation files (config screen_seed) of every Table 1 cell: what a screen compares."""
-    return expand(f"{RESULTS}/eval/{variant}/seed{config['screen_seed']}/{{home}}/{{placement}}/h{{height}}.csv",
-                  home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+    """The screened seeds' evaluation files (config screen_seed, screen_seeds) of every Table 1 cell."""
+    return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
+                  seed=SCREEN_SEEDS, home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def spread_files(variant):
+    """Every spread seed's evaluation files of every Table 1 cell: the seed spread a screen counts."""
+    return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
+                  seed=SPREAD_SEEDS, home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def stored_one_seed_screens():
+    """The stored one-seed screens (screen_NAME_seedN_vs_...csv; their ℓ and aggregate files left out), which
+    `screens_reread` reads again."""
+    return sorted(str(p) for p in Path(RESULTS, "compare").glob("screen_*_seed[0-9]*_vs_*.csv")
+                  if not p.stem.endswith(("_by_length", "_aggregate")))
+
+
+def screen_name():
+    """screen_NAME_seed0_vs_REF (one seed), screen_NAME_seeds0-2_vs_REF (three)."""
+    seeds = f"seed{SCREEN_SEEDS[0]}" if len(SCREEN_SEEDS) == 1 else f"seeds{SCREEN_SEEDS[0]}-{SCREEN_SEEDS[-1]}"
+    return f"screen_{config.get('variant') or 'none'}_{seeds}_vs_{REF}"
 
 
 def screen_candidate(wildcards):

@@ -175,25 +175,66 @@ rule compare:
 
 
 rule screen:
-    """A lever's first test: the variant trained on one seed (screen_seed) against the reference's same
-    seed on the same stored sets, per cell and per shortest-path bin. With one seed on each side its
-    interval and p count the scenarios only, not how seeds differ: a variant that passes gets its
-    three-seed `compare`."""
+    """A lever's first test: the variant trained on screen_seeds seeds against the mean of the reference's
+    spread seeds on the same stored sets, per cell and per shortest-path bin. Its interval and p count how
+    much training seeds differ (the reference's spread, estimated on those seeds), so a row is "lower" or
+    "higher" only beyond that spread; the aggregate over seeds and cells (interquartile mean, probability
+    of improvement) is written beside it."""
     input:
-        reference=ancient(screen_files(REF)),
+        reference=ancient(spread_files(REF)),
         candidate=screen_candidate,
     output:
-        cells=f"{RESULTS}/compare/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}_vs_{REF}"
-              f"_seed{config['screen_seed']}.csv",
-        by_length=f"{RESULTS}/compare/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}_vs_{REF}"
-                  f"_seed{config['screen_seed']}_by_length.csv",
+        cells=f"{RESULTS}/compare/{screen_name()}.csv",
+        by_length=f"{RESULTS}/compare/{screen_name()}_by_length.csv",
+        aggregate=f"{RESULTS}/compare/{screen_name()}_aggregate.csv",
     log:
-        f"{RESULTS}/logs/report/screen_{config.get('variant') or 'none'}_seed{config['screen_seed']}.log",
+        f"{RESULTS}/logs/report/{screen_name()}.log",
     conda:
         CONDA_ENV
     shell:
         "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
-        "--out {output.cells} 2>&1 | tee {log}"
+        "--spread {input.reference} --out {output.cells} --aggregate {output.aggregate} 2>&1 | tee {log}"
+
+
+rule null_screen:
+    """The reference screened against itself (outside `all`: it needs the spread seeds): every spread seed
+    as a candidate against each other seed and against the rest, before and after the seed spread counts;
+    the simulated false-positive rate of both verdicts, the seed spread per cell and the difference a
+    screen of 1, 3 and 5 seeds detects (docs/statistics.md)."""
+    input:
+        ancient(spread_files(REF)),
+    output:
+        screens=f"{RESULTS}/compare/null_screen_{REF}.csv",
+        summary=f"{RESULTS}/compare/seed_spread_{REF}.json",
+    log:
+        f"{RESULTS}/logs/report/null_screen_{REF}.log",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report null-screen --force {input} --out {output.screens} --summary {output.summary} "
+        "2>&1 | tee {log}"
+
+
+rule screens_reread:
+    """Every stored one-seed screen read again with its reference's seed spread counted, beside its old verdict
+    (it reads the stored evaluation files the screens read; docs/ablations.md)."""
+    input:
+        ancient(stored_one_seed_screens()),
+    output:
+        f"{RESULTS}/compare/screens_reread.csv",
+    log:
+        f"{RESULTS}/logs/report/screens_reread.log",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report reread-screens --force --profile {PROFILE} --out {output} 2>&1 | tee {log}"
+
+
+rule seed_spread:
+    """`snakemake --cores 2 seed_spread`: the null screen, its summary, and the stored screens read again."""
+    input:
+        rules.null_screen.output,
+        rules.screens_reread.output,
 
 
 rule provenance:
