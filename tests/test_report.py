@@ -379,7 +379,9 @@ def test_table1(tmp_path):
     df = table1(group_eval_paths(paths), tmp_path / "out" / "table1", n_resamples=N_RES)
     assert list(df.columns) == ["home", "height", "placement", "n_episodes", "n_scenarios", "n_seeds", "success_rate",
                                 "ci_low", "ci_high", "seed_boot_low", "seed_boot_high", "spl", "spl_low", "spl_high",
-                                "paper_success_rate"]
+                                "stuck_share", "paper_success_rate"]
+    # the synthetic episodes have 0-3 collisions: none is stuck
+    assert (df["stuck_share"] == 0).all()
     # each home alone, then both pooled (the rows set beside the paper)
     assert [r.home for r in df.itertuples()] == ["bedroom"] * 6 + ["kitchen"] * 6 + ["both"] * 6
     both = df[df["home"] == "both"]

@@ -379,6 +379,12 @@ def add_report(sub) -> None:
     r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
     add_force(r)
 
+    r = reports.add_parser("failures", help="how each traced searcher fails per cell: stuck, never saw the target, "
+                                          "saw and lost it, timed out near it (egosearch.report.failures)")
+    r.add_argument("files", nargs="+", help="per-step trace files (.npz) of one or more searchers")
+    r.add_argument("--out-prefix", required=True, help="writes PREFIX.csv and PREFIX.md")
+    add_force(r)
+
     r = reports.add_parser("null-screen", help="the reference's seeds screened against each other, before and after "
                                              "the seed spread counts; its summary (docs/statistics.md)")
     r.add_argument("files", nargs="+", help="every spread seed's evaluation CSVs of one variant")

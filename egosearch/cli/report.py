@@ -27,6 +27,7 @@ from egosearch.report.pathlength import by_length_path
 from egosearch.report.provenance import check_stored, verify, write_provenance
 from egosearch.report.readme import pages, update_pages, update_readme
 from egosearch.report.searches import searches_report
+from egosearch.report.tables import stuck_path
 from egosearch.report.workflow_jobs import bound_eval_files, variants_of_all, workflow_config, workflow_heights
 from egosearch.rl.config import departure_rows, load_config, table2_rows
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
@@ -42,7 +43,8 @@ PREFIX_FILES = {"table1": ("table1", (".csv", ".md", ".tex")), "table2": ("table
                 "fig6": ("fig6", (".png", ".pdf", ".csv")), "fig7": ("fig7", (".png", ".pdf", ".csv")),
                 "budget": ("budget", (".csv", ".png", ".pdf")), "pathlength": ("pathlength", (".md", ".png", ".pdf")),
                 "generalise": ("generalise", (".csv", ".md", ".png")), "fresh": ("fresh", (".csv", ".md")),
-                "behaviour": ("behaviour", ("_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md"))}
+                "behaviour": ("behaviour", ("_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md")),
+                "failures": ("failures", (".csv", ".md"))}
 """Per report with ``--out-prefix``: the name it takes in a folder given as the prefix, and what it
 adds to the prefix for each file it writes (as the report modules name them)."""
 
@@ -106,7 +108,7 @@ def check_report_inputs(args) -> None:
             # before the path is parsed: a missing file would be told the pattern of the paths it has
             more = f" ({len(missing) - 1} more missing too)" if len(missing) > 1 else ""
             raise FileNotFoundError(f"{option}: {missing[0]} not found{more}")
-    if args.what in ("behaviour", "searches"):
+    if args.what in ("behaviour", "searches", "failures"):
         check_npz_files("the input files", args.files)
     else:
         for option, paths in report_inputs(args).items():
@@ -329,9 +331,9 @@ def _compare(args) -> None:
     # The comparison writes its CSV before the ℓ split checks that both sides ran the same scenarios:
     # both go to temporary files, moved into place only when every check passed, and what it prints
     # waits with them, so that a refused comparison is one line and leaves no file.
-    out, by_length = Path(args.out), by_length_path(args.out)
+    out, by_length, stuck = Path(args.out), by_length_path(args.out), stuck_path(args.out)
     tmp = out.with_name(f".tmp{os.getpid()}.{out.name}")
-    tmp_by_length = by_length_path(tmp)
+    tmp_by_length, tmp_stuck = by_length_path(tmp), stuck_path(tmp)
     printed = io.StringIO()
     try:
         with contextlib.redirect_stdout(printed):
@@ -339,6 +341,7 @@ def _compare(args) -> None:
                                candidate_name="candidate", spread_files=args.spread)
         os.replace(tmp, out)
         os.replace(tmp_by_length, by_length)
+        os.replace(tmp_stuck, stuck)
         if args.aggregate:
             from egosearch.report.aggregate import aggregate_report, format_aggregate
             from egosearch.report.data import cells_from_paths
@@ -346,9 +349,10 @@ def _compare(args) -> None:
                                                     args.aggregate)), file=printed)
             print(f"wrote {args.aggregate}", file=printed)
     finally:
-        for path in (tmp, tmp_by_length):
+        for path in (tmp, tmp_by_length, tmp_stuck):
             path.unlink(missing_ok=True)
-    print(printed.getvalue().replace(str(tmp_by_length), str(by_length)).replace(str(tmp), str(out)), end="")
+    print(printed.getvalue().replace(str(tmp_by_length), str(by_length)).replace(str(tmp_stuck), str(stuck))
+          .replace(str(tmp), str(out)), end="")
 
 
 def _behaviour(args) -> None:
@@ -412,6 +416,20 @@ def _readme(args) -> None:
         print(f"rewrote the results blocks of {names} from the {args.profile} results")
 
 
+def _failures(args) -> None:
+    from egosearch.report.failures import failure_markdown, failure_table
+
+    by_method: dict[str, list[str]] = {}
+    for path in args.files:
+        if not path.endswith(".npz"):
+            raise ValueError(f"{path}: a per-step trace (.npz) expected")
+        by_method.setdefault(Path(path).parts[-5], []).append(path)
+    csv, md = Path(args.out_prefix + ".csv"), Path(args.out_prefix + ".md")
+    df = failure_table(by_method, csv)
+    md.write_text("# How each searcher fails\n\n" + failure_markdown(df, str(csv)), encoding="utf-8")
+    print(f"wrote {csv} and {md} ({len(by_method)} searchers, {len(df)} cells)")
+
+
 def _null_screen(args) -> None:
     import json
 
@@ -454,7 +472,7 @@ def _reread_screens(args) -> None:
 REPORTS = {"table1": _table1, "table2": _table2, "fig6": _fig6, "fig7": _fig7, "budget": _budget,
            "generalise": _generalise, "fresh": _fresh, "pathlength": _pathlength, "compare": _compare,
            "behaviour": _behaviour, "searches": _searches, "provenance": _provenance, "regenerate": _regenerate,
-           "verify": _verify, "readme": _readme, "null-screen": _null_screen,
+           "verify": _verify, "readme": _readme, "null-screen": _null_screen, "failures": _failures,
            "reread-screens": _reread_screens}
 """Each ``egosearch report`` sub-command (its parser: :func:`egosearch.cli.parsers.add_report`)."""
 

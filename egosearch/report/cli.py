@@ -19,7 +19,15 @@ from egosearch.report.pathlength import by_length_path, compare_by_length, forma
 from egosearch.report.provenance import check_stored
 from egosearch.report.spread_sides import comparison_spreads
 from egosearch.report.stats import METRICS
-from egosearch.report.tables import bound_names, compare_report, format_compare, table1, table2
+from egosearch.report.tables import (
+    bound_names,
+    compare_report,
+    format_compare,
+    format_stuck,
+    stuck_path,
+    table1,
+    table2,
+)
 
 PathLike = str | os.PathLike
 
@@ -125,6 +133,12 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
     print(format_by_length(compare_by_length(reference_files, candidate_files, by_csv, spreads=spreads)))
     if by_csv is not None:
         print(f"wrote {by_csv}")
+    stuck_csv = None if out_csv is None else stuck_path(out_csv)
+    stuck_df = compare_report(reference_files, candidate_files, stuck_csv, metrics=("stuck",),
+                              spread_files=spread_files)
+    print(format_stuck(stuck_df))
+    if stuck_csv is not None:
+        print(f"wrote {stuck_csv}")
     return df
 
 

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from egosearch.report.failures import stuck
 from egosearch.searchers.registry import modular_floors
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
@@ -98,7 +99,8 @@ def _as_paths(value) -> list[Path]:
 
 
 def read_episodes(paths: PathLike | Iterable[PathLike], seed: int | None = None) -> pd.DataFrame:
-    """Per-episode CSVs stacked, with ``seed`` and ``scenario_set`` (see :func:`scenario_set_from_path`) added.
+    """Per-episode CSVs stacked, with ``seed``, ``scenario_set`` (see :func:`scenario_set_from_path`) and
+    ``stuck`` (failed with 50 or more collisions: :func:`egosearch.report.failures.stuck`) added.
 
     ``seed`` given: every file gets that seed and paths need no ``seed{N}`` directory (the scenario set
     is then the path below one, or else the file's path). Otherwise the seed is read from each path.
@@ -127,7 +129,7 @@ def read_episodes(paths: PathLike | Iterable[PathLike], seed: int | None = None)
         seen.add((s, sset))
         if df["scenario_id"].duplicated().any():
             raise ValueError(f"{path}: repeated scenario_id")
-        df = df.assign(seed=s, scenario_set=sset)
+        df = df.assign(seed=s, scenario_set=sset, stuck=stuck(df))
         frames.append(df)
     return pd.concat(frames, ignore_index=True)
 

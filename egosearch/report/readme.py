@@ -165,7 +165,7 @@ BY_LENGTH = "_by_length"
 
 
 def _cell_comparisons(folder: Path) -> list[Path]:
-    return sorted(p for p in folder.glob("*_vs_*.csv") if not p.stem.endswith((BY_LENGTH, "_aggregate")))
+    return sorted(p for p in folder.glob("*_vs_*.csv") if not p.stem.endswith((BY_LENGTH, "_aggregate", "_stuck")))
 
 
 def _by_length_line(path: Path, root: Path) -> str | None:
@@ -514,6 +514,15 @@ def block_seed_spread(root: Path, profile: str) -> str:
     return text.replace(")\n: the recommended", "): the recommended") + "\n"
 
 
+def block_failures(root: Path, profile: str) -> str:
+    """The failure-kind table (``paper_figs/<profile>/failures.md``, rule ``failures``) without its title."""
+    path = root / "paper_figs" / profile / "failures.md"
+    if not path.exists():
+        return _missing(root, path)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    return "\n".join(line for line in lines if not line.startswith("# ")).strip("\n") + "\n"
+
+
 def _called_cells(rows: pd.DataFrame, column: str) -> str:
     picked = [f"{h:g} {'excl.' if p == 'no_low_cabinets' else 'every'} {v}" for h, p, v
               in zip(rows["height"], rows["placement"], rows[column]) if v in ("higher", "lower")]
@@ -554,6 +563,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "compare": block_compare,
     "power": block_power,
     "seed_spread": block_seed_spread,
+    "failures": block_failures,
     "screens_reread": block_screens_reread,
     "reading": block_reading,
     "claims": block_claims,  # the paper's behaviour sentences against the per-step traces

@@ -55,7 +55,7 @@ def reread_screens(compare_dir: Path, eval_dir: Path, out_csv=None, n_resamples:
     reference is a searcher that is not trained."""
     frames = []
     for path in sorted(Path(compare_dir).glob("screen_*.csv")):
-        if path.stem.endswith(("_by_length", "_aggregate")):
+        if path.stem.endswith(("_by_length", "_aggregate", "_stuck")):
             continue
         m = SCREEN_NAME.match(path.stem)
         if m is None or "seeds" in path.stem.split("_vs_")[0].rsplit("_", 1)[-1]:

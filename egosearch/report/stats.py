@@ -313,8 +313,8 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     Returns ``{reference, candidate, difference, ci_low, ci_high, p_uncorrected, n_scenarios,
     n_seeds_ref, n_seeds_cand, detectable_80, method}``.
     """
-    if metric not in METRICS:
-        raise ValueError(f"metric={metric!r}; allowed: {', '.join(METRICS)}")
+    if metric not in (*METRICS, "stuck"):
+        raise ValueError(f"metric={metric!r}; allowed: {', '.join((*METRICS, 'stuck'))}")
     (ref, n_ref), (cand, n_cand) = paired_scenarios(reference, candidate, metric)
     r, c = ref.to_numpy(), cand.to_numpy()
     d = c - r

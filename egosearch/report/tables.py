@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from egosearch.report.data import output_base, read_episodes, sorted_cells, suffixed
+from egosearch.report.failures import STUCK_COLLISIONS, stuck_share
 from egosearch.report.spread_sides import comparison_spreads
 from egosearch.report.stats import (
     METRICS,
@@ -34,13 +35,14 @@ PAPER_TABLE1: dict[tuple[float, str], float] = {
 PLACEMENT_LABELS = {"no_low_cabinets": "Excluding cabinets", "everywhere": "Everywhere"}
 
 TABLE1_COLUMNS = ("home", "height", "placement", "n_episodes", "n_scenarios", "n_seeds", "success_rate", "ci_low",
-                  "ci_high", "seed_boot_low", "seed_boot_high", "spl", "spl_low", "spl_high", "paper_success_rate")
+                  "ci_high", "seed_boot_low", "seed_boot_high", "spl", "spl_low", "spl_high", "stuck_share",
+                  "paper_success_rate")
 """``ci_*``: the two-level bootstrap (scenarios, then seeds) of :func:`~egosearch.report.stats.two_level_ci`."""
 BOTH_HOMES = "both"
 """The ``home`` of Table 1's rows pooled over every home evaluated: the rows set beside the paper's column,
 because the paper tests in both of its homes (Section 6) and gives one number per cell."""
 
-BOUND_STATS = ("n_episodes", "success_rate", "wilson_low", "wilson_high", "spl")
+BOUND_STATS = ("n_episodes", "success_rate", "wilson_low", "wilson_high", "spl", "stuck_share")
 """Table 1's columns of each bound: ``{bound}_{stat}``."""
 
 
@@ -138,11 +140,12 @@ def _sorted_home_cells(cells) -> list[tuple]:
 def _bound_row(df: pd.DataFrame | None, bound: str, confidence: float) -> dict:
     if df is None:
         return {f"{bound}_n_episodes": 0, f"{bound}_success_rate": math.nan, f"{bound}_wilson_low": math.nan,
-                f"{bound}_wilson_high": math.nan, f"{bound}_spl": math.nan}
+                f"{bound}_wilson_high": math.nan, f"{bound}_spl": math.nan, f"{bound}_stuck_share": math.nan}
     n, k = len(df), int(df["success"].astype(int).sum())
     lo, hi = wilson_ci(k, n, confidence)
     return {f"{bound}_n_episodes": n, f"{bound}_success_rate": k / n, f"{bound}_wilson_low": lo,
-            f"{bound}_wilson_high": hi, f"{bound}_spl": float(df["spl"].mean())}
+            f"{bound}_wilson_high": hi, f"{bound}_spl": float(df["spl"].mean()),
+            f"{bound}_stuck_share": stuck_share(df)}
 
 
 def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: int = 10_000,
@@ -186,7 +189,8 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
         rows.append({"home": home, "height": h, "placement": pl, "n_episodes": len(df), "n_scenarios": len(scenarios),
                      "n_seeds": int(df["seed"].nunique()), "success_rate": rate, "ci_low": lo, "ci_high": hi,
                      "seed_boot_low": blo, "seed_boot_high": bhi, "spl": spl_mean, "spl_low": spl_lo,
-                     "spl_high": spl_hi, "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
+                     "spl_high": spl_hi, "stuck_share": stuck_share(df),
+                     "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
         if bounds is not None:
             for bound in all_bounds:
                 rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((home, h, pl)), bound, confidence))
@@ -332,8 +336,10 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
                        f"the scenario is the unit that repeats). {adds}{notes} "
                        + ("The paper's column is set beside both homes pooled: the paper tests its policy in both "
                           "homes (Section 6) and gives one number per cell. " if BOTH_HOMES in homes else "")
-                       + f"SPL and its interval, and the {pct} bootstrap over per-seed success rates, are in "
-                       f"{out_csv.name}. Paper: Table 1 of Sorokin et al. 2021.", ""]
+                       + f"SPL and its interval, the {pct} bootstrap over per-seed success rates and every searcher's "
+                       f"stuck share (episodes failed with {STUCK_COLLISIONS} or more collisions) are in "
+                       f"{out_csv.name}; how each fails is in failures.md (`snakemake failures`). Paper: Table 1 of "
+                       "Sorokin et al. 2021.", ""]
     suffixed(base, ".md").write_text("\n".join(md_all).rstrip("\n") + "\n", encoding="utf-8")
     suffixed(base, ".tex").write_text("\n".join(tex_all), encoding="utf-8")
     return df
@@ -483,6 +489,22 @@ def holm_and_write(df: pd.DataFrame, columns: Iterable[str], out_csv: PathLike |
         out_csv.parent.mkdir(parents=True, exist_ok=True)
         df.to_csv(out_csv, index=False, float_format="%.6g")
     return df
+
+
+def stuck_path(out_csv: PathLike) -> Path:
+    """Where ``egosearch report compare --out X.csv`` writes the stuck shares: ``X_stuck.csv``."""
+    out = Path(out_csv)
+    return out.with_name(out.stem + "_stuck" + (out.suffix or ".csv"))
+
+
+def format_stuck(df: pd.DataFrame) -> str:
+    """One line: the stuck share of each side per cell (episodes failed with 50 or more collisions), the
+    cells where it differs after Holm (over these rows alone)."""
+    cells = "; ".join(f"{r.height:g} m {'excl.' if r.placement == 'no_low_cabinets' else 'every'} "
+                      f"{r.reference * 100:.1f}% -> {r.candidate * 100:.1f}%{' *' if r.significant_holm else ''}"
+                      for r in df.itertuples(index=False))
+    return (f"stuck (failed with {STUCK_COLLISIONS} or more collisions), reference -> candidate: {cells} "
+            "(* different after Holm over these rows)")
 
 
 def format_compare(df: pd.DataFrame, reference_name: str = "reference", candidate_name: str = "candidate") -> str:

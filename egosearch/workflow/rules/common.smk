@@ -177,7 +177,7 @@ def stored_one_seed_screens():
     """The stored one-seed screens (screen_NAME_seedN_vs_...csv; their ℓ and aggregate files left out), which
     `screens_reread` reads again."""
     return sorted(str(p) for p in Path(RESULTS, "compare").glob("screen_*_seed[0-9]*_vs_*.csv")
-                  if not p.stem.endswith(("_by_length", "_aggregate")))
+                  if not p.stem.endswith(("_by_length", "_aggregate", "_stuck")))
 
 
 def screen_name():

@@ -164,12 +164,13 @@ rule compare:
     output:
         cells=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
         by_length=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_by_length.csv",
+        stuck=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_stuck.csv",
     log:
         f"{RESULTS}/logs/report/compare_{config.get('variant') or 'none'}.log",
     conda:
         CONDA_ENV
     shell:
-        # writes {output.by_length} beside {output.cells} (egosearch.report.pathlength.by_length_path)
+        # writes {output.by_length} and {output.stuck} beside {output.cells} (by_length_path, stuck_path)
         "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
         "--out {output.cells} 2>&1 | tee {log}"
 
@@ -187,6 +188,7 @@ rule screen:
         cells=f"{RESULTS}/compare/{screen_name()}.csv",
         by_length=f"{RESULTS}/compare/{screen_name()}_by_length.csv",
         aggregate=f"{RESULTS}/compare/{screen_name()}_aggregate.csv",
+        stuck=f"{RESULTS}/compare/{screen_name()}_stuck.csv",
     log:
         f"{RESULTS}/logs/report/{screen_name()}.log",
     conda:

@@ -92,6 +92,24 @@ rule behaviour:
         "egosearch report behaviour --force {input} --pairs {params.pairs} --out-prefix {params.prefix} > {log} 2>&1"
 
 
+rule failures:
+    """How each traced searcher fails, per Table 1 cell: stuck (failed with 50 or more collisions), never saw
+    the target, saw it and lost it, saw it and was stuck, timed out near it (egosearch.report.failures)."""
+    input:
+        ancient(TRACE_FILES),
+    output:
+        csv=f"{FIGS}/failures.csv",
+        md=f"{FIGS}/failures.md",
+    log:
+        f"{RESULTS}/logs/report/failures.log",
+    params:
+        prefix=lambda wc, output: output.csv.rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report failures --force {input} --out-prefix {params.prefix} > {log} 2>&1"
+
+
 rule searches:
     """Chosen searches of seed 0 on the floor plan, and where the camera looks, per trace cell."""
     input:
