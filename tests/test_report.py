@@ -400,7 +400,7 @@ def test_table1(tmp_path):
     equal = both.iloc[2]
     assert (equal.success_rate, equal.seed_boot_low, equal.seed_boot_high) == (0.6, 0.6, 0.6)
     out = tmp_path / "out"
-    assert pd.read_csv(out / "table1.csv").shape == (18, 15)
+    assert pd.read_csv(out / "table1.csv").shape == (18, 16)
     md = (out / "table1.md").read_text()
     assert md.index("both homes pooled (bedroom and kitchen)") < md.index("Table 1 in bedroom alone")
     assert "| Head height | Searcher | Excluding cabinets | Everywhere |" in md
