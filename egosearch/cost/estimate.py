@@ -49,7 +49,9 @@ def print_costs(targets, config: dict, profile: str, seeds: list[int], reference
     """What ``snakemake`` prints before the first job of ``targets`` (the Snakefile's ``onstart``, and a
     dry run's start): `all`'s whole DAG from scratch, simulated on ``cores`` (:func:`print_before_a_run`),
     and a comparison's trainings and evaluations still to run (:func:`print_variant_cost`: every one of
-    ``seeds`` for compare, ``screen_seed`` for screen). Where no estimate can be made, a line says why:
+    ``seeds`` for compare; for screen ``screen_seeds`` seeds from ``screen_seed`` and the reference's
+    missing spread seeds, then the screen's power, :func:`print_screen_power`). Where no estimate can be
+    made, a line says why:
     ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate.
     First, once, where paper-profile trainings share one GPU (``trainings_per_gpu`` > 1): whether they do
     under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`)."""
