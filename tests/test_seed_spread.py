@@ -199,7 +199,15 @@ def test_detectable_difference_shrinks_with_seeds_and_the_recommendation_respect
     rng = np.random.default_rng(8)
     m = {(1.05, "x"): (rng.random((400, 5)) < rng.uniform(0.5, 0.9, 400)[:, None]).astype(float)}
     assert recommended_screen_seeds(m, (1.05, "x"), target=0.5, max_seeds=9) == 1
-    assert recommended_screen_seeds(m, (1.05, "x"), target=0.0001, max_seeds=9) == 9
+    # out of reach: the fewest seeds within KNEE of the best a day affords, never more than it affords
+    from egosearch.report.null_screen import KNEE, one_seed_scenario_se
+    from egosearch.report.seed_spread import pooled_seed_spread
+
+    knee = recommended_screen_seeds(m, (1.05, "x"), target=0.0001, max_seeds=9)
+    spread, se = pooled_seed_spread(list(m.values())), one_seed_scenario_se(m)[(1.05, "x")]
+    curve = [detectable_difference(spread, se, n, 5, 400) for n in range(1, 10)]
+    assert 1 <= knee <= 9 and curve[knee - 1] <= min(curve) * (1 + KNEE)
+    assert knee == 1 or curve[knee - 2] > min(curve) * (1 + KNEE)
 
 
 def test_iqm_and_probability_of_improvement_by_hand(tmp_path):

@@ -382,7 +382,9 @@ def add_report(sub) -> None:
     r = reports.add_parser("failures", help="how each traced searcher fails per cell: stuck, never saw the target, "
                                           "saw and lost it, timed out near it (egosearch.report.failures)")
     r.add_argument("files", nargs="+", help="per-step trace files (.npz) of one or more searchers")
-    r.add_argument("--out-prefix", required=True, help="writes PREFIX.csv and PREFIX.md")
+    r.add_argument("--out-prefix", required=True, help="writes PREFIX.csv, PREFIX_stuck.csv and PREFIX.md")
+    r.add_argument("--stuck-read", nargs="*", default=[], help="the searchers whose stuck episodes PREFIX.md reads: "
+                   "what they are pressed against, seen before or not, what they did (egosearch.report.stuck_contacts)")
     add_force(r)
 
     r = reports.add_parser("null-screen", help="the reference's seeds screened against each other, before and after "

@@ -44,7 +44,7 @@ PREFIX_FILES = {"table1": ("table1", (".csv", ".md", ".tex")), "table2": ("table
                 "budget": ("budget", (".csv", ".png", ".pdf")), "pathlength": ("pathlength", (".md", ".png", ".pdf")),
                 "generalise": ("generalise", (".csv", ".md", ".png")), "fresh": ("fresh", (".csv", ".md")),
                 "behaviour": ("behaviour", ("_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md")),
-                "failures": ("failures", (".csv", ".md"))}
+                "failures": ("failures", (".csv", "_stuck.csv", ".md"))}
 """Per report with ``--out-prefix``: the name it takes in a folder given as the prefix, and what it
 adds to the prefix for each file it writes (as the report modules name them)."""
 
@@ -418,16 +418,25 @@ def _readme(args) -> None:
 
 def _failures(args) -> None:
     from egosearch.report.failures import failure_markdown, failure_table
+    from egosearch.report.stuck_contacts import stuck_contacts, stuck_markdown
 
     by_method: dict[str, list[str]] = {}
     for path in args.files:
         if not path.endswith(".npz"):
             raise ValueError(f"{path}: a per-step trace (.npz) expected")
         by_method.setdefault(Path(path).parts[-5], []).append(path)
+    unknown = [m for m in args.stuck_read if m not in by_method]
+    if unknown:
+        raise ValueError(f"--stuck-read: {unknown[0]} has no trace among the input files ({', '.join(by_method)})")
     csv, md = Path(args.out_prefix + ".csv"), Path(args.out_prefix + ".md")
+    stuck_csv = Path(args.out_prefix + "_stuck.csv")
     df = failure_table(by_method, csv)
-    md.write_text("# How each searcher fails\n\n" + failure_markdown(df, str(csv)), encoding="utf-8")
-    print(f"wrote {csv} and {md} ({len(by_method)} searchers, {len(df)} cells)")
+    text = "# How each searcher fails\n\n" + failure_markdown(df, str(csv))
+    contacts = stuck_contacts({m: by_method[m] for m in args.stuck_read}, stuck_csv)
+    for method in args.stuck_read:
+        text += f"\n## What `{method}` is stuck against\n\n" + stuck_markdown(contacts, method, str(stuck_csv))
+    md.write_text(text, encoding="utf-8")
+    print(f"wrote {csv}, {stuck_csv} and {md} ({len(by_method)} searchers, {len(df)} cells)")
 
 
 def _null_screen(args) -> None:

@@ -182,16 +182,24 @@ def power_table(matrices: Mapping, seed_counts=(1, 3, 5), n_reference: int | Non
     return pd.DataFrame(rows)
 
 
+KNEE = 0.10
+"""Where a target is out of a day's reach: the seeds whose detectable difference is within this fraction of
+the day's best, past which more seeds barely help."""
+
+
 def recommended_screen_seeds(matrices: Mapping, cell, target: float, max_seeds: int) -> int:
     """The fewest candidate seeds whose screen detects ``target`` in ``cell`` with 80% power against the stored
-    seeds, or ``max_seeds`` (what the budget affords) when none up to it does."""
+    seeds. When no count up to ``max_seeds`` (what a day affords) does, the fewest whose detectable difference
+    is within :data:`KNEE` of the best affordable one: past it, more seeds barely help."""
     spread = pooled_seed_spread(list(matrices.values()))
     se = one_seed_scenario_se(matrices)[cell]
-    k = matrices[cell].shape[1]
-    for n in range(1, max_seeds + 1):
-        if detectable_difference(spread, se, n, k, matrices[cell].shape[0]) <= target:
-            return n
-    return max_seeds
+    k, n = matrices[cell].shape[1], matrices[cell].shape[0]
+    detectable = [detectable_difference(spread, se, seeds, k, n) for seeds in range(1, max_seeds + 1)]
+    for seeds, d in enumerate(detectable, start=1):
+        if d <= target:
+            return seeds
+    best = min(detectable)
+    return next(seeds for seeds, d in enumerate(detectable, start=1) if d <= best * (1 + KNEE))
 
 
 def cell_spreads(matrices: Mapping) -> pd.DataFrame:
@@ -243,7 +251,8 @@ def seed_spread_summary(files: Mapping, record: dict, reference: str, n_sims: in
     spread; the simulated false-positive rates (:func:`false_positive_rate`, at each of :data:`RHOS`, for a
     screen against the other seeds of the null screen and against all of them); the detectable difference
     for 1, 3 and 5 candidate seeds; and the recommended ``screen_seeds`` (:func:`recommended_screen_seeds`
-    for :data:`POWER_TARGET` at :data:`POWER_CELL`, within :func:`seeds_per_day`)."""
+    for :data:`POWER_TARGET` at :data:`POWER_CELL`, within :func:`seeds_per_day`), with the difference the
+    day's most seeds would detect."""
     matrices = cell_matrices(files)
     k = next(iter(matrices.values())).shape[1]
     pooled = pooled_seed_spread(list(matrices.values()))
@@ -262,6 +271,9 @@ def seed_spread_summary(files: Mapping, record: dict, reference: str, n_sims: in
         "power_cell": list(POWER_CELL), "power_target": POWER_TARGET,
         "seeds_per_day": per_day, "hours_per_seed": per_seed_h, "day_hours": USER_DAY_HOURS, "day_cores": 2,
         "recommended_screen_seeds": recommended_screen_seeds(matrices, POWER_CELL, POWER_TARGET, per_day),
+        "detectable_at_a_days_seeds": detectable_difference(
+            pooled, one_seed_scenario_se(matrices)[POWER_CELL], per_day, k, matrices[POWER_CELL].shape[0]),
+        "knee": KNEE,
         "detectable_at_recommended": detectable_difference(
             pooled, one_seed_scenario_se(matrices)[POWER_CELL],
             recommended_screen_seeds(matrices, POWER_CELL, POWER_TARGET, per_day), k,

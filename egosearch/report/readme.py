@@ -50,6 +50,47 @@ def block_table1(root: Path, profile: str) -> str:
     return path.read_text(encoding="utf-8").rstrip("\n") + "\n"
 
 
+def block_table1_pooled(root: Path, profile: str) -> str:
+    """Table 1 with both homes pooled, its notes, and where each home alone is (the README's block)."""
+    path = root / "paper_figs" / profile / "table1.md"
+    if not path.exists():
+        return _missing(root, path)
+    text = path.read_text(encoding="utf-8")
+    pooled = text.split("\nTable 1 in ", 1)[0].rstrip("\n")
+    return pooled + ("\n\nEach home alone: [Results](docs/results.md#table-1-success-rate-by-head-height-and-"
+                     f"placement-head-on-policy) (`{path.relative_to(root)}`).\n")
+
+
+def block_standing(root: Path, profile: str) -> str:
+    """Per Table 1 cell (both homes pooled): the reference against the paper (is the paper's value inside its
+    interval?) and against the classical searcher it learned from (the stored ``<reference>_vs_frontier.csv``),
+    and the stuck shares of both."""
+    from egosearch.report.tables import BOTH_HOMES
+
+    reference = _reference(root)
+    table = root / "paper_figs" / profile / "table1.csv"
+    versus = root / "results" / profile / "compare" / f"{reference}_vs_frontier.csv"
+    if not table.exists() or not versus.exists():
+        return _missing(root, table if not table.exists() else versus)
+    t = pd.read_csv(table)
+    t = t[t["home"] == BOTH_HOMES]
+    v = pd.read_csv(versus)
+    v = v[v["metric"] == "success"]
+    lines = [f"| cell | `{reference}` [95% CI] | paper | the paper's value | against the frontier searcher "
+             "(difference [95% CI], Holm) | stuck: ours / frontier |", "|---|---|---|---|---|---|"]
+    for r in t.itertuples(index=False):
+        cell = f"{r.height:g} m {'excl. low cabinets' if r.placement == 'no_low_cabinets' else 'everywhere'}"
+        inside = ("inside" if r.ci_low <= r.paper_success_rate <= r.ci_high else
+                  "above" if r.paper_success_rate > r.ci_high else "below")
+        c = v[(v["height"] == r.height) & (v["placement"] == r.placement)].iloc[0]
+        verdict = c["verdict"] if "verdict" in v.columns else ("different" if c["significant_holm"] else "same")
+        lines.append(f"| {cell} | {r.success_rate:.2f} [{r.ci_low:.2f}, {r.ci_high:.2f}] | {r.paper_success_rate:.2f} "
+                     f"| {inside} the interval | {c['difference']:+.3f} [{c['ci_low']:+.3f}, {c['ci_high']:+.3f}], "
+                     f"{verdict} | {r.stuck_share * 100:.1f} % / {r.frontier_stuck_share * 100:.1f} % |")
+    return ("\n".join(lines) + f"\n\nFrom `{table.relative_to(root)}` and `{versus.relative_to(root)}` "
+            "(`snakemake versus_teacher`; stuck: failed with 50 or more collisions).\n")
+
+
 def block_fig6(root: Path, profile: str) -> str:
     """Per variant: success at the first and the last evaluation, the rise between them (what the curve
     says learning adds to its start), and the best mean along the way."""
@@ -501,17 +542,20 @@ def block_seed_spread(root: Path, profile: str) -> str:
     for (h, pl), g in power.groupby(["height", "placement"], sort=False):
         values = g.sort_values("n_candidate")["detectable_80"]
         lines.append(f"| {h:g} | {pl} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
-    lines += ["", f"A difference of {sm['power_target']:g} at {sm['power_cell'][0]:g} m ({sm['power_cell'][1]}) "
-              f"needs more seeds than fit in a user's day ({sm['day_hours']:g} h on {sm['day_cores']} cores: "
-              f"{sm['seeds_per_day']} seeds at {sm['hours_per_seed']:.2f} h each, the slowest recorded training "
-              "and its 12 evaluations)" if sm["detectable_at_recommended"] > sm["power_target"] else
-              f"A difference of {sm['power_target']:g} at {sm['power_cell'][0]:g} m ({sm['power_cell'][1]}) is "
-              f"detected with {sm['recommended_screen_seeds']} seeds, within a user's day ({sm['day_hours']:g} h on "
-              f"{sm['day_cores']} cores: {sm['seeds_per_day']} seeds)",
-              f": the recommended `screen_seeds` is **{sm['recommended_screen_seeds']}**, which detects "
+    day = (f"a user's day ({sm['day_hours']:g} h on {sm['day_cores']} cores) holds {sm['seeds_per_day']} seeds at "
+           f"{sm['hours_per_seed']:.2f} h each (the slowest recorded training of the reference and 12 evaluations)")
+    target = f"a difference of {sm['power_target']:g} at {sm['power_cell'][0]:g} m ({sm['power_cell'][1]})"
+    if sm["detectable_at_recommended"] <= sm["power_target"]:
+        verdict = (f"{target.capitalize()} is detected with {sm['recommended_screen_seeds']} seeds, within reach: "
+                   f"{day}.")
+    else:
+        verdict = (f"{target.capitalize()} is out of reach: {day}, and those detect "
+                   f"{sm['detectable_at_a_days_seeds']:.3f} (the reference's own {sm['n_seeds']} seeds bound it). "
+                   f"The recommendation is then the fewest seeds within {sm['knee'] * 100:.0f} % of that, past which "
+                   "more seeds barely help.")
+    lines += ["", verdict + f" The recommended `screen_seeds` is **{sm['recommended_screen_seeds']}**, which detects "
               f"{sm['detectable_at_recommended']:.3f} there.", "", f"From `{summary_path.relative_to(root)}`."]
-    text = "\n".join(lines)
-    return text.replace(")\n: the recommended", "): the recommended") + "\n"
+    return "\n".join(lines) + "\n"
 
 
 def block_failures(root: Path, profile: str) -> str:
@@ -556,6 +600,8 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "generalise": block_generalise,
     "fresh": block_fresh,
     "table1": block_table1,
+    "table1_pooled": block_table1_pooled,
+    "standing": block_standing,
     "fig6": block_fig6,
     "fig7": block_fig7,
     "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),

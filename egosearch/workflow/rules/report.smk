@@ -302,6 +302,36 @@ rule decisions_floor:
         [f"{RESULTS}/compare/{variant}_vs_{floor}.csv" for variant, floor in DECISIONS_FLOORS],
 
 
+rule teacher_compare:
+    """Figure 6's pair against the classical searcher each learned from (its teacher at the cpu profile):
+    head_on against frontier, head_off against frontier_head_off, every seed against the teacher's one, on the
+    same stored sets; per cell, per shortest-path bin and the stuck share."""
+    input:
+        reference=ancient(lambda wc: bound_files([wc.teacher])),
+        candidate=ancient(lambda wc: eval_files(wc.variant)),
+    output:
+        cells=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}.csv",
+        by_length=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_by_length.csv",
+        stuck=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_stuck.csv",
+    log:
+        f"{RESULTS}/logs/report/teacher_compare_{{variant}}_vs_{{teacher}}.log",
+    wildcard_constraints:
+        teacher="frontier|frontier_head_off",
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
+        "--out {output.cells} > {log} 2>&1"
+
+
+rule versus_teacher:
+    """`snakemake --cores 2 versus_teacher`: head_on against frontier, head_off against frontier_head_off."""
+    input:
+        # Figure 6's pair: the first of claims_pairs
+        expand(f"{RESULTS}/compare/{{pair}}.csv", pair=[f"{claims_pairs(config)[0][0]}_vs_frontier",
+                                                       f"{claims_pairs(config)[0][1]}_vs_frontier_head_off"]),
+
+
 rule decisions_floor_compare:
     """One variant of the pair against its floor (all its seeds against the floor's one)."""
     input:

@@ -94,20 +94,24 @@ rule behaviour:
 
 rule failures:
     """How each traced searcher fails, per Table 1 cell: stuck (failed with 50 or more collisions), never saw
-    the target, saw it and lost it, saw it and was stuck, timed out near it (egosearch.report.failures)."""
+    the target, saw it and lost it, saw it and was stuck, timed out near it (egosearch.report.failures); and
+    what Figure 6's pair is stuck against (egosearch.report.stuck_contacts)."""
     input:
         ancient(TRACE_FILES),
     output:
         csv=f"{FIGS}/failures.csv",
+        stuck=f"{FIGS}/failures_stuck.csv",
         md=f"{FIGS}/failures.md",
     log:
         f"{RESULTS}/logs/report/failures.log",
     params:
         prefix=lambda wc, output: output.csv.rsplit(".", 1)[0],
+        # what Figure 6's pair is stuck against (the stuck episodes' furniture, seen or not, their actions)
+        read=" ".join(TRACE_VARIANTS),
     conda:
         CONDA_ENV
     shell:
-        "egosearch report failures --force {input} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report failures --force {input} --out-prefix {params.prefix} --stuck-read {params.read} > {log} 2>&1"
 
 
 rule searches:
