@@ -79,7 +79,23 @@ def _env_lines(root: Path, profile: str) -> list[str]:
             f"**{r['env_steps_per_s']:,.0f} env steps/s** ({r['env_ms_per_step']} ms a step, "
             f"{r['env_resets_included']} resets included; target 700: "
             f"{_met(r['env_steps_per_s'], ENV_TARGETS['env_steps_per_s'])}). Measured by "
-            + _measured_on(record) + f"; from `{path.relative_to(root)}`."]
+            + _measured_on(record) + f"; from `{path.relative_to(root)}`."] + _reward_lines(root, profile)
+
+
+def _reward_lines(root: Path, profile: str) -> list[str]:
+    """What the geodesic progress reward (a training lever) costs per env step against the profile's progress
+    reward, timed side by side on the same actions in one run (``results/<profile>/bench/env_rewards.json``)."""
+    path = root / "results" / profile / "bench" / "env_rewards.json"
+    if not path.exists():
+        return []
+    record = json.loads(path.read_text(encoding="utf-8"))
+    r = record["result"]
+    by = r["env_ms_per_step_by_reward"]
+    ratio = r["geodesic_over_progress"]
+    return ["", f"The geodesic progress reward (`train_distance_reward: geodesic`) costs **{ratio:.2f}x** "
+            f"the progress reward per env step ({by['geodesic']} against {by['progress']} ms, the same actions timed "
+            "side by side in one run, so the ratio holds on a busy machine), measured by " + _measured_on(record)
+            + f"; from `{path.relative_to(root)}`."]
 
 
 def _learner_lines(root: Path, profile: str) -> list[str]:

@@ -38,6 +38,11 @@ def one_core():
         os.sched_setaffinity(0, before)
 
 
+REWARDS_TIMED = ("progress", "geodesic")
+"""The training r_d forms ``bench env`` times side by side: the cpu profile's and the geodesic lever's."""
+REWARD_ROUNDS = 6
+
+
 def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3000, seed: int = 0) -> dict:
     import gymnasium
 
@@ -57,6 +62,23 @@ def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3
                 done_episodes += 1
         elapsed = time.perf_counter() - start
         env.close()
+        # The training rewards side by side on the same actions, interleaved rounds, in this one run: a ratio
+        # the machine's load cancels from (the geodesic reward reads the navigation grid at every step).
+        reward_s = {name: 0.0 for name in REWARDS_TIMED}
+        envs = {name: gymnasium.make("EgoSearch-v0", layout=layout, distance_reward=name) for name in REWARDS_TIMED}
+        for e in envs.values():
+            e.reset(seed=seed)
+        for chunk in np.array_split(actions, REWARD_ROUNDS):
+            for name, e in envs.items():
+                t0 = time.perf_counter()
+                for a in chunk:
+                    _, _, terminated, truncated, _ = e.step(a)
+                    if terminated or truncated:
+                        e.reset()
+                reward_s[name] += time.perf_counter() - t0
+        for e in envs.values():
+            e.close()
+    per_step_ms = {name: 1000 * t / steps for name, t in reward_s.items()}
     return {
         "layout": layout,
         "triangles": triangle_count(scene),
@@ -65,6 +87,8 @@ def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3
         "env_steps_per_s": round(steps / elapsed, 1),
         "env_ms_per_step": round(1000 * elapsed / steps, 3),
         "env_resets_included": done_episodes,
+        "env_ms_per_step_by_reward": {name: round(v, 3) for name, v in per_step_ms.items()},
+        "geodesic_over_progress": round(per_step_ms["geodesic"] / per_step_ms["progress"], 3),
         "pinned_core": core,
         "cpu": platform.processor() or platform.machine(),
     }
