@@ -250,3 +250,23 @@ def test_the_stored_reference_does_not_differ_from_itself():
     assert not df["verdict"].isin(["lower", "higher"]).any()
     assert (df["p_holm"] >= 0.05).all()
     assert df["candidate_seed"].nunique() >= 5
+
+
+STORED_SUMMARY = REPO / "results/cpu/compare/seed_spread_head_on.json"
+
+
+@pytest.mark.skipif(not STORED_SUMMARY.exists(), reason="needs the stored seed spread (snakemake seed_spread)")
+def test_the_default_screen_seeds_is_the_power_analysis_recommendation():
+    import json
+
+    import yaml
+
+    summary = json.loads(STORED_SUMMARY.read_text())
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    assert config["screen_seeds"] == summary["recommended_screen_seeds"]
+    assert summary["recommended_screen_seeds"] <= summary["seeds_per_day"]
+    # the simulated false-positive rate of the verdict that counts the spread stays near its level, and the
+    # scenario-only verdict's does not
+    rates = summary["false_positive_rate"]
+    assert max(r["seed_spread"] for r in rates) < 2 * summary["alpha"]
+    assert min(r["scenarios_only"] for r in rates) > 2 * summary["alpha"]
