@@ -462,7 +462,7 @@ def _null_screen(args) -> None:
     Path(args.summary).write_text(json.dumps(summary, indent=1, default=float) + "\n", encoding="utf-8")
     print(f"recommended screen_seeds: {summary['recommended_screen_seeds']} (detects "
           f"{summary['detectable_at_recommended']:.3f} at {summary['power_cell'][0]} m with 80% power; "
-          f"{summary['seeds_per_day']} seeds fit in a {summary['day_hours']:g} h day); wrote {args.summary}")
+          f"{summary['seeds_per_day']} seeds fit in a day of {summary['day_hours']:g} h); wrote {args.summary}")
 
 
 def _reread_screens(args) -> None:
