@@ -1242,15 +1242,16 @@ def test_a_compare_that_fails_a_check_leaves_no_file(bad, capsys):
     assert not out.parent.exists() or not list(out.parent.iterdir())
 
 
-def test_a_compare_that_passes_writes_both_files_under_their_names(bad, capsys):
+def test_a_compare_that_passes_writes_its_files_under_their_names(bad, capsys):
     out = bad / "cmp_ok" / "c.csv"
     assert main(["report", "compare", "--reference", str(bad / "cmp/ref/seed0/kitchen_living/everywhere/h1.05.csv"),
                  "--candidate", str(bad / "eval/head_off/seed0/kitchen_living/everywhere/h1.05.csv"), "--out",
                  str(out)]) == 0
     printed = capsys.readouterr().out
     assert f"wrote {out}\n" in printed and f"wrote {out.parent / 'c_by_length.csv'}\n" in printed
+    assert f"wrote {out.parent / 'c_stuck.csv'}\n" in printed
     assert ".tmp" not in printed
-    assert sorted(p.name for p in out.parent.iterdir()) == ["c.csv", "c_by_length.csv"]
+    assert sorted(p.name for p in out.parent.iterdir()) == ["c.csv", "c_by_length.csv", "c_stuck.csv"]
 
 
 def test_a_smoke_actor_gets_a_note_naming_its_profile(capsys):

@@ -5,7 +5,6 @@ searcher that is not trained none."""
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Mapping
 
 import numpy as np
@@ -54,7 +53,7 @@ def comparison_spreads(reference_files: Mapping, candidate_files: Mapping, sprea
     ``spread_files`` (``{cell: [every stored seed's paths]}``; the reference's files when None). SeedSpreadUnknown,
     one line, when a side must borrow and there is no trained reference to borrow from, or ``spread_files``
     holds one seed. Without ``spread_files`` and with a one-seed reference, the comparison cannot count a
-    seed spread: :data:`~egosearch.report.stats.SCENARIOS_ONLY`, and one line on stderr says so."""
+    seed spread: :data:`~egosearch.report.seed_spread.SCENARIOS_ONLY` (its table's footnote says so)."""
     sides = []
     for files in (reference_files, candidate_files):
         sides.append((is_trained(_variants_of(files)), _seed_count(files), files))
@@ -66,8 +65,6 @@ def comparison_spreads(reference_files: Mapping, candidate_files: Mapping, sprea
             raise SeedSpreadUnknown("the candidate has fewer than 3 seeds and the reference is not trained: give the "
                                     "stored seeds of a trained variant whose seed spread it borrows (--spread)")
         if _seed_count(reference_files) < 2:
-            print(f"note: {', '.join(sorted(_variants_of(reference_files)))} has 1 seed here: the variance between "
-                  "training seeds cannot be estimated; the intervals count the scenarios only", file=sys.stderr)
             return SCENARIOS_ONLY
         spread_files = reference_files  # the reference's seeds given are all it has
     missing = [c for c in cells if c not in spread_files]

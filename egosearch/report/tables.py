@@ -526,6 +526,10 @@ def format_compare(df: pd.DataFrame, reference_name: str = "reference", candidat
         lines.append(f"A side has too few seeds to show its own spread: CI and p add the reference's seed variance "
                      f"(sd {sd:.3f} between training seeds) to the scenarios'; a row without * is within the "
                      "reference's seed spread, not lower or higher (docs/statistics.md).")
+    elif (df["method"] == "scenarios only").any():
+        lines.append("A side has one seed and the reference has no other to show how much training seeds differ: "
+                     "CI and p count the scenarios only, so a difference may be a seed's luck (give the reference's "
+                     "seeds with --spread; docs/statistics.md).")
     else:
         lines.append("CI: paired two-level bootstrap (scenarios, then each side's seeds); p: the same draws read as "
                      "a two-sided test.")
