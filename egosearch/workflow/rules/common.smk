@@ -121,7 +121,17 @@ if PROFILE == "paper":
         print(f"egosearch: error: {err}", file=sys.stderr)
         sys.exit(1)
     if LOCAL_RUN and "gpu_slots" in workflow.global_resources:
-        TRAININGS_PER_GPU = max(1, int(workflow.global_resources["gpu_slots"].value))
+        SLOTS = int(workflow.global_resources["gpu_slots"].value)
+        if SLOTS < 1:
+            # each training asks for one slot: with none, the plan lists trainings that could never start
+            import sys
+
+            print(f"egosearch: error: --resources gpu_slots={SLOTS}: every paper-profile training asks for one "
+                  "gpu_slots (its share of the GPU), so none could start; give gpu_slots=1 or more (the trainings "
+                  "side by side on one GPU), or leave it out (config trainings_per_gpu sets it: "
+                  f"{TRAININGS_PER_GPU} here)", file=sys.stderr)
+            sys.exit(1)
+        TRAININGS_PER_GPU = SLOTS
     elif LOCAL_RUN:
         workflow.register_resource("gpu_slots", TRAININGS_PER_GPU)
 else:
