@@ -1328,18 +1328,58 @@ ISSUE57_SNAKEMAKE = [
      "the GPU), so none could start; give gpu_slots=1 or more (the trainings side by side on one GPU), or leave it "
      "out (config trainings_per_gpu sets it: 6 here)"),
 ]
+# (id, before, the gymnasium id, its keyword options, the one line of the ValueError gymnasium.make raises)
+ISSUE57_ENV_OPTIONS = [
+    ("nohead_id_with_the_head", "silent", "egosearch:EgoSearchNoHead-v0", {"head": True},
+     "head=True contradicts EgoSearchNoHead-v0, which fixes head=False (the camera's two joints off); allowed: "
+     "head=False, or leave head out (EgoSearch-v0 is the id with head=True)"),
+    ("modular_id_with_target_memory", "silent", "egosearch:EgoSearchModular-v0", {"target_memory": True},
+     "target_memory=True: EgoSearchModular-v0 does not read target_memory (its observation is the decision's: the "
+     "mask's features and the searcher's map); allowed: leave target_memory out (a body env reads it, e.g. "
+     "EgoSearchMemory-v0)"),
+    ("floor_map_without_target_memory", "silent", "egosearch:EgoSearch-v0", {"floor_map": True},
+     "floor_map=True in EgoSearch-v0 needs target_memory=True (the floor map comes with the target memory: "
+     "EgoSearchMap-v0 and EgoSearchNoHeadMap-v0); allowed: floor_map with target_memory=True, or floor_map=False"),
+    ("height_a_string", "cryptic", "egosearch:EgoSearch-v0", {"height": "1.05"},
+     "height='1.05' is a str, not a number; allowed: a number of metres in [0.3, 2.0]"),
+    ("max_steps_zero", "silent", "egosearch:EgoSearch-v0", {"max_steps": 0},
+     "max_steps=0: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
+     "before an episode is truncated)"),
+    # beyond the issue's rows: the same kinds on the other ids
+    ("head_id_without_the_head", "silent", "egosearch:EgoSearch-v0", {"head": False},
+     "head=False contradicts EgoSearch-v0, which fixes head=True (the camera's two joints on); allowed: head=True, "
+     "or leave head out (EgoSearchNoHead-v0 is the id with head=False)"),
+    ("memory_id_without_the_memory", "silent", "egosearch:EgoSearchMemory-v0", {"target_memory": False},
+     "target_memory=False contradicts EgoSearchMemory-v0, which fixes target_memory=True (the last-seen target "
+     "memory on); allowed: target_memory=True, or leave target_memory out (EgoSearch-v0 is the id with "
+     "target_memory=False)"),
+    ("modular_id_with_the_floor_map", "silent", "egosearch:EgoSearchNoHeadModular-v0", {"floor_map": True},
+     "floor_map=True: EgoSearchNoHeadModular-v0 does not read floor_map (its observation is the decision's: the "
+     "mask's features and the searcher's map); allowed: leave floor_map out (a body env reads it, e.g. "
+     "EgoSearchMap-v0)"),
+    ("nohead_modular_id_with_the_head", "silent", "egosearch:EgoSearchNoHeadModular-v0", {"head": True},
+     "head=True contradicts EgoSearchNoHeadModular-v0, which fixes head=False (the camera's two joints off); "
+     "allowed: head=False, or leave head out (EgoSearchModular-v0 is the id with head=True)"),
+    ("head_a_word", "silent", "egosearch:EgoSearchNoHead-v0", {"head": "no"},
+     "head='no' is a str; allowed: True or False"),
+    ("max_steps_a_fraction", "silent", "egosearch:EgoSearch-v0", {"max_steps": 2.5},
+     "max_steps=2.5 is a float; allowed: an integer >= 1 (T_max: the steps before an episode is truncated)"),
+    ("max_steps_negative_in_a_decision_env", "silent", "egosearch:EgoSearchModular-v0", {"max_steps": -5},
+     "max_steps=-5: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
+     "before an episode is truncated)"),
+]
 # (id, before, the input): accepted now, as what it means
 ISSUE57_ACCEPTED = [
     ("variant_file_bare_config", "cryptic", HEAD + "config:\n"),
 ]
-COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 8, "traceback": 0, "silent": 1, "damage": 0}
+COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 9, "traceback": 0, "silent": 12, "damage": 0}
 """What the rows above did before the fix; after it each is one clear line before any work."""
 
 
 def issue57_rows():
     return ([c[:2] for c in ISSUE57_CASES] + [c[:2] for c in ISSUE57_CONFIGS]
             + [c[:2] for c in ISSUE57_VARIANT_FILES] + [c[:2] for c in ISSUE57_SNAKEMAKE]
-            + [c[:2] for c in ISSUE57_ACCEPTED])
+            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS])
 
 
 def test_issue_57s_counts_before():
@@ -1381,3 +1421,39 @@ def test_issue_57s_snakemake_rows_are_one_line(case, suite):
     _, _, args, message = case
     rc, lines = snakemake_lines(suite, *args)
     assert rc == 1 and lines == [message]
+
+
+@pytest.mark.parametrize("case", ISSUE57_ENV_OPTIONS, ids=[c[0] for c in ISSUE57_ENV_OPTIONS])
+def test_env_options_that_contradict_their_id_are_one_line(case, monkeypatch):
+    """gymnasium's convention: an exception whose message names the option and what is allowed, raised before
+    the env (its physics, its sensor) is built."""
+    import gymnasium
+
+    import egosearch.searchers.modular
+    import egosearch.sim.env
+
+    _, _, env_id, options, message = case
+
+    def built(*args, **kwargs):
+        raise AssertionError("the env was built before the bad option was refused")
+
+    monkeypatch.setattr(egosearch.sim.env, "World", built)
+    monkeypatch.setattr(egosearch.searchers.modular, "GoalFrontierPolicy", built)
+    with pytest.raises(ValueError) as err:
+        gymnasium.make(env_id, **options)
+    assert str(err.value) == message and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("env_id, options, mask", [
+    ("EgoSearch-v0", {"target_memory": True}, "EgoSearchMemory-v0"),
+    ("EgoSearchMemory-v0", {"floor_map": True}, "EgoSearchMap-v0"),
+    ("EgoSearchNoHead-v0", {"head": False, "target_memory": True, "floor_map": True}, "EgoSearchNoHeadMap-v0"),
+])
+def test_env_options_that_name_a_registered_observation_are_taken(env_id, options, mask):
+    import gymnasium
+
+    from egosearch.envs import env_space_dims
+
+    env = gymnasium.make(f"egosearch:{env_id}", **options)
+    assert env.observation_space["mask"].shape == (env_space_dims(mask)["mask"],)
+    env.close()
