@@ -1457,3 +1457,12 @@ def test_env_options_that_name_a_registered_observation_are_taken(env_id, option
     env = gymnasium.make(f"egosearch:{env_id}", **options)
     assert env.observation_space["mask"].shape == (env_space_dims(mask)["mask"],)
     env.close()
+
+
+@pytest.mark.skipif(shutil.which("git") is None or not (REPO / ".git").exists(), reason="not a git checkout")
+def test_a_smoke_runs_outputs_are_git_ignored():
+    """Issue 57: a smoke screen left results/smoke/ untracked; its outputs are plumbing, never stored."""
+    paths = ["results/smoke/train/my_lr/seed0/curve.csv", "paper_figs/smoke/table1.md"]
+    out = subprocess.run(["git", "check-ignore", *paths], cwd=REPO, capture_output=True, text=True)
+    assert out.stdout.split() == paths
+    assert subprocess.run(["git", "check-ignore", "-q", "results/cpu/provenance.json"], cwd=REPO).returncode == 1
