@@ -52,13 +52,14 @@ def print_costs(targets, config: dict, profile: str, seeds: list[int], reference
     ``seeds`` for compare; for screen ``screen_seeds`` seeds from ``screen_seed`` and the reference's
     missing spread seeds, then the screen's power, :func:`print_screen_power`). Where no estimate can be
     made, a line says why:
-    ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate.
+    ``cores`` None (a cluster executor's run, which lays its jobs out itself) has no schedule to simulate.
     First, once, where paper-profile trainings share one GPU (``trainings_per_gpu`` > 1): whether they do
     under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`)."""
     warn_gpu_sharing(profile, trainings_per_gpu)
     if cores is None:
         if "all" in targets or ({"compare", "screen"} & set(targets) and config.get("variant")):
-            print("(no estimate of the cost: the run names no --cores to lay its jobs out on)", file=sys.stderr)
+            print("(no estimate of the cost: a cluster executor's run lays its jobs out itself, on no cores of this "
+                  "machine to simulate)", file=sys.stderr)
         return
     if "all" in targets:
         print_before_a_run(profile, cores)
