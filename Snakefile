@@ -1,8 +1,10 @@
 # egosearch: the paper's experiments as one DAG.
-#   snakemake --cores 2 all                     # everything at the default `cpu` profile (hours: `egosearch estimate all` says how many here)
-#   snakemake --cores 2 table1                  # Table 1 only (trains what it needs)
-#   snakemake --cores 2 compare --config variant=my_variant
+#   snakemake all                               # everything at the default `cpu` profile (hours: `egosearch estimate all` says how many here)
+#   snakemake table1                            # Table 1 only (trains what it needs)
+#   snakemake compare --config variant=my_variant
+# On 2 cores of this machine (profiles/default/config.yaml); `--cores N` chooses others.
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
+import os
 import sys
 
 from snakemake.settings.types import Quietness
@@ -64,8 +66,14 @@ if (workflow.is_main_process and workflow.output_settings.dryrun
         and Quietness.ALL not in (workflow.output_settings.quiet or ())):
     from egosearch.cost.estimate import print_costs
 
-    named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}]
-    print_costs(named or ["all"], config, PROFILE, SEEDS, REF, cores_given(), trainings_per_gpu=TRAININGS_PER_GPU)
+    named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}] or ["all"]
+    # `all` on a complete tree (its inputs stored, nothing forced) runs nothing: Snakemake says "Nothing to be
+    # done", and a fresh clone's estimate above it would read as this run's cost
+    forced = {"-F", "--forceall", "-R", "--forcerun", "-f", "--force"} & set(sys.argv[1:])
+    if "all" in named and not forced and all(os.path.exists(path) for path in rules.all.input):
+        named.remove("all")
+    if named:
+        print_costs(named, config, PROFILE, SEEDS, REF, cores_given(), trainings_per_gpu=TRAININGS_PER_GPU)
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

@@ -19,6 +19,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
+from egosearch.core.schema_errors import schema_error
 from egosearch.envs import observed_env_id
 from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
 from egosearch.searchers import registry as searchers
@@ -97,12 +98,14 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
         raise VariantError(f"{path}: not a text file; a variant is a YAML file with name, env_id, train_env") from None
     if data is None:
         raise VariantError(f"{path}: empty file; a variant needs name, env_id, train_env")
+    if isinstance(data, dict) and "config" in data and data["config"] is None:
+        data["config"] = {}  # a bare `config:` (YAML's null) reads as `config: {}`: no override
     schema = json.loads(SCHEMA_PATH.read_text())
     try:
         jsonschema.validate(data, schema)
     except jsonschema.ValidationError as err:
-        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
-        raise VariantError(f"{path}: {where}: {err.message}") from None
+        where, what = schema_error(err)
+        raise VariantError(f"{path}: {where}: {what}") from None
     if data["name"] != path.stem:
         raise VariantError(f"{path}: name={data['name']!r} must equal the file name {path.stem!r}")
     if data["name"] in searchers.SEARCHERS:

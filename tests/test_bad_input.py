@@ -67,7 +67,8 @@ BAD_VARIANT_FILES = [
     ("no_placement", HEAD.replace(", placement: everywhere", ""),
      "ablations/no_placement.yaml: train_env: 'placement' is a required property"),
     ("key_typo", HEAD + "confgi: {}\n",
-     "ablations/key_typo.yaml: (top level): Additional properties are not allowed ('confgi' was unexpected)"),
+     "ablations/key_typo.yaml: (top level): 'confgi' (did you mean 'config'?) is not a key here; allowed: name, "
+     "description, env_id, train_env, config"),
     ("env_typo", HEAD.replace("EgoSearch-v0", "EgoSearch-v1"),
      "ablations/env_typo.yaml: env_id: 'EgoSearch-v1' is not one of ['EgoSearch-v0', 'EgoSearchNoHead-v0', "
      "'EgoSearchMemory-v0', 'EgoSearchNoHeadMemory-v0', 'EgoSearchMap-v0', 'EgoSearchNoHeadMap-v0', "
@@ -117,7 +118,7 @@ def suite(tmp_path_factory):
     shutil.copytree(REPO / "ablations", dest / "ablations")
     if (REPO / "profiles").is_dir():
         shutil.copytree(REPO / "profiles", dest / "profiles")
-    for stem, text, _ in BAD_VARIANT_FILES:
+    for stem, text, _ in BAD_VARIANT_FILES + [(stem, text, line) for stem, _, text, line in ISSUE57_VARIANT_FILES]:
         (dest / "ablations" / f"{stem}.yaml").write_text(text.replace("NAME", stem))
     return dest
 
@@ -1286,3 +1287,183 @@ def test_help_names_every_layout_the_commands_take(capsys):
             main(argv)
         out = " ".join(capsys.readouterr().out.split())
         assert "SAC-DrQ at cpu" in out, argv
+
+
+# --------------------------------------------------------------------------- issue 57: a newcomer's third round
+# The same form as issue 48's tables: (id, what it did before the fix, the input, the one line now). The
+# rows of the issue's items 4, 6 and 7 that were cryptic or silent.
+ISSUE57_CASES = [
+    ("table1_bounds_a_searchers_name", "cryptic",
+     ["report", "table1", ev("head_on"), "--bounds", "frontier", "--out-prefix", "{t}/t"],
+     "egosearch report: error: --bounds: frontier not found; --bounds takes evaluation CSV paths, not a searcher's "
+     "name: frontier's are results/<profile>/eval/frontier/seed<N>/<home>/<placement>/h<height>.csv"),
+    ("table1_bounds_a_missing_csv", "cryptic",
+     ["report", "table1", ev("head_on"), "--bounds", "{t}/missing.csv", "--out-prefix", "{t}/t"],
+     "egosearch report: error: --bounds: {t}/missing.csv not found; --bounds takes the evaluation CSV paths of the "
+     "searchers (random, frontier, frontier_head_off, frontier_tuned, frontier_tuned_head_off, oracle): "
+     "results/<profile>/eval/<searcher>/seed<N>/<home>/<placement>/h<height>.csv"),
+]
+TPG = "allowed: 'auto' or an integer from 1 to 64"
+ISSUE57_CONFIGS = [
+    ("trainings_per_gpu_a_word", "cryptic", {"trainings_per_gpu": "many"}, "all",
+     f"config trainings_per_gpu: 'many' is not allowed; {TPG}"),
+    ("trainings_per_gpu_a_fraction", "cryptic", {"trainings_per_gpu": 2.5}, "all",
+     f"config trainings_per_gpu: 2.5 is not allowed; {TPG}"),
+    ("trainings_per_gpu_capitalised", "cryptic", {"trainings_per_gpu": "Auto"}, "all",
+     f"config trainings_per_gpu: 'Auto' is not allowed (did you mean 'auto'?); {TPG}"),
+    ("trainings_per_gpu_zero", "clear", {"trainings_per_gpu": 0}, "all",
+     f"config trainings_per_gpu: 0 is not allowed; {TPG}"),
+]
+ISSUE57_VARIANT_FILES = [
+    ("top_level_profile", "cryptic", HEAD + "profile: turbo\n",
+     "ablations/top_level_profile.yaml: (top level): 'profile' is not a key here; allowed: name, description, "
+     "env_id, train_env, config"),
+    ("train_env_key_typo", "cryptic", HEAD.replace("everywhere}", "everywhere, objets: [mug]}"),
+     "ablations/train_env_key_typo.yaml: train_env: 'objets' (did you mean 'objects'?) is not a key here; allowed: "
+     "layout, placement, objects, distance_reward, coverage_bonus, home_seeds"),
+]
+# (id, before, the snakemake arguments after -n, the one line)
+ISSUE57_SNAKEMAKE = [
+    ("paper_gpu_slots_zero", "silent", ["all", "--config", "profile=paper", "--resources", "gpu_slots=0"],
+     "egosearch: error: --resources gpu_slots=0: every paper-profile training asks for one gpu_slots (its share of "
+     "the GPU), so none could start; give gpu_slots=1 or more (the trainings side by side on one GPU), or leave it "
+     "out (config trainings_per_gpu sets it: 6 here)"),
+]
+# (id, before, the gymnasium id, its keyword options, the one line of the ValueError gymnasium.make raises)
+ISSUE57_ENV_OPTIONS = [
+    ("nohead_id_with_the_head", "silent", "egosearch:EgoSearchNoHead-v0", {"head": True},
+     "head=True contradicts EgoSearchNoHead-v0, which fixes head=False (the camera's two joints off); allowed: "
+     "head=False, or leave head out (EgoSearch-v0 is the id with head=True)"),
+    ("modular_id_with_target_memory", "silent", "egosearch:EgoSearchModular-v0", {"target_memory": True},
+     "target_memory=True: EgoSearchModular-v0 does not read target_memory (its observation is the decision's: the "
+     "mask's features and the searcher's map); allowed: leave target_memory out (a body env reads it, e.g. "
+     "EgoSearchMemory-v0)"),
+    ("floor_map_without_target_memory", "silent", "egosearch:EgoSearch-v0", {"floor_map": True},
+     "floor_map=True in EgoSearch-v0 needs target_memory=True (the floor map comes with the target memory: "
+     "EgoSearchMap-v0 and EgoSearchNoHeadMap-v0); allowed: floor_map with target_memory=True, or floor_map=False"),
+    ("height_a_string", "cryptic", "egosearch:EgoSearch-v0", {"height": "1.05"},
+     "height='1.05' is a str, not a number; allowed: a number of metres in [0.3, 2.0]"),
+    ("max_steps_zero", "silent", "egosearch:EgoSearch-v0", {"max_steps": 0},
+     "max_steps=0: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
+     "before an episode is truncated)"),
+    # beyond the issue's rows: the same kinds on the other ids
+    ("head_id_without_the_head", "silent", "egosearch:EgoSearch-v0", {"head": False},
+     "head=False contradicts EgoSearch-v0, which fixes head=True (the camera's two joints on); allowed: head=True, "
+     "or leave head out (EgoSearchNoHead-v0 is the id with head=False)"),
+    ("memory_id_without_the_memory", "silent", "egosearch:EgoSearchMemory-v0", {"target_memory": False},
+     "target_memory=False contradicts EgoSearchMemory-v0, which fixes target_memory=True (the last-seen target "
+     "memory on); allowed: target_memory=True, or leave target_memory out (EgoSearch-v0 is the id with "
+     "target_memory=False)"),
+    ("modular_id_with_the_floor_map", "silent", "egosearch:EgoSearchNoHeadModular-v0", {"floor_map": True},
+     "floor_map=True: EgoSearchNoHeadModular-v0 does not read floor_map (its observation is the decision's: the "
+     "mask's features and the searcher's map); allowed: leave floor_map out (a body env reads it, e.g. "
+     "EgoSearchMap-v0)"),
+    ("nohead_modular_id_with_the_head", "silent", "egosearch:EgoSearchNoHeadModular-v0", {"head": True},
+     "head=True contradicts EgoSearchNoHeadModular-v0, which fixes head=False (the camera's two joints off); "
+     "allowed: head=False, or leave head out (EgoSearchModular-v0 is the id with head=True)"),
+    ("head_a_word", "silent", "egosearch:EgoSearchNoHead-v0", {"head": "no"},
+     "head='no' is a str; allowed: True or False"),
+    ("max_steps_a_fraction", "silent", "egosearch:EgoSearch-v0", {"max_steps": 2.5},
+     "max_steps=2.5 is a float; allowed: an integer >= 1 (T_max: the steps before an episode is truncated)"),
+    ("max_steps_negative_in_a_decision_env", "silent", "egosearch:EgoSearchModular-v0", {"max_steps": -5},
+     "max_steps=-5: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
+     "before an episode is truncated)"),
+]
+# (id, before, the input): accepted now, as what it means
+ISSUE57_ACCEPTED = [
+    ("variant_file_bare_config", "cryptic", HEAD + "config:\n"),
+]
+COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 9, "traceback": 0, "silent": 12, "damage": 0}
+"""What the rows above did before the fix; after it each is one clear line before any work."""
+
+
+def issue57_rows():
+    return ([c[:2] for c in ISSUE57_CASES] + [c[:2] for c in ISSUE57_CONFIGS]
+            + [c[:2] for c in ISSUE57_VARIANT_FILES] + [c[:2] for c in ISSUE57_SNAKEMAKE]
+            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS])
+
+
+def test_issue_57s_counts_before():
+    before = dict.fromkeys(BEFORE_KINDS_48, 0)
+    for _, kind in issue57_rows():
+        before[kind] += 1
+    assert before == COUNTS_BEFORE_57
+    names = [name for name, _ in issue57_rows()] + [c[0] for c in CLI_CASES]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("case", ISSUE57_CASES, ids=[c[0] for c in ISSUE57_CASES])
+def test_issue_57s_commands_are_one_clear_line(case, bad, capsys, monkeypatch, nothing_runs):
+    test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
+
+
+@pytest.mark.parametrize("case", ISSUE57_CONFIGS, ids=[c[0] for c in ISSUE57_CONFIGS])
+def test_issue_57s_configs_name_what_is_allowed(case, suite, monkeypatch, capsys):
+    test_a_config_naming_no_variant_names_its_key(case, suite, monkeypatch, capsys)
+
+
+@pytest.mark.parametrize("case", ISSUE57_VARIANT_FILES, ids=[c[0] for c in ISSUE57_VARIANT_FILES])
+def test_issue_57s_variant_files_list_the_allowed_keys(case, suite, monkeypatch, capsys):
+    stem, _, _, message = case
+    monkeypatch.chdir(suite)
+    with pytest.raises(SystemExit) as stop:
+        checked_variants(config(variant=stem), argv=["compare"], directory=suite / "ablations")
+    assert stop.value.code == 1 and capsys.readouterr().err == f"egosearch: error: {message}\n"
+
+
+def test_a_bare_config_in_a_variant_file_is_an_empty_mapping(tmp_path):
+    """`config:` with nothing under it is YAML's null: read as `config: {}`, no override."""
+    (tmp_path / "bare.yaml").write_text(ISSUE57_ACCEPTED[0][2].replace("NAME", "bare"))
+    assert load_variant("bare", tmp_path).config == {}
+
+
+@pytest.mark.parametrize("case", ISSUE57_SNAKEMAKE, ids=[c[0] for c in ISSUE57_SNAKEMAKE])
+def test_issue_57s_snakemake_rows_are_one_line(case, suite):
+    _, _, args, message = case
+    rc, lines = snakemake_lines(suite, *args)
+    assert rc == 1 and lines == [message]
+
+
+@pytest.mark.parametrize("case", ISSUE57_ENV_OPTIONS, ids=[c[0] for c in ISSUE57_ENV_OPTIONS])
+def test_env_options_that_contradict_their_id_are_one_line(case, monkeypatch):
+    """gymnasium's convention: an exception whose message names the option and what is allowed, raised before
+    the env (its physics, its sensor) is built."""
+    import gymnasium
+
+    import egosearch.searchers.modular
+    import egosearch.sim.env
+
+    _, _, env_id, options, message = case
+
+    def built(*args, **kwargs):
+        raise AssertionError("the env was built before the bad option was refused")
+
+    monkeypatch.setattr(egosearch.sim.env, "World", built)
+    monkeypatch.setattr(egosearch.searchers.modular, "GoalFrontierPolicy", built)
+    with pytest.raises(ValueError) as err:
+        gymnasium.make(env_id, **options)
+    assert str(err.value) == message and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("env_id, options, mask", [
+    ("EgoSearch-v0", {"target_memory": True}, "EgoSearchMemory-v0"),
+    ("EgoSearchMemory-v0", {"floor_map": True}, "EgoSearchMap-v0"),
+    ("EgoSearchNoHead-v0", {"head": False, "target_memory": True, "floor_map": True}, "EgoSearchNoHeadMap-v0"),
+])
+def test_env_options_that_name_a_registered_observation_are_taken(env_id, options, mask):
+    import gymnasium
+
+    from egosearch.envs import env_space_dims
+
+    env = gymnasium.make(f"egosearch:{env_id}", **options)
+    assert env.observation_space["mask"].shape == (env_space_dims(mask)["mask"],)
+    env.close()
+
+
+@pytest.mark.skipif(shutil.which("git") is None or not (REPO / ".git").exists(), reason="not a git checkout")
+def test_a_smoke_runs_outputs_are_git_ignored():
+    """Issue 57: a smoke screen left results/smoke/ untracked; its outputs are plumbing, never stored."""
+    paths = ["results/smoke/train/my_lr/seed0/curve.csv", "paper_figs/smoke/table1.md"]
+    out = subprocess.run(["git", "check-ignore", *paths], cwd=REPO, capture_output=True, text=True)
+    assert out.stdout.split() == paths
+    assert subprocess.run(["git", "check-ignore", "-q", "results/cpu/provenance.json"], cwd=REPO).returncode == 1

@@ -225,3 +225,31 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
         each = (rl_phase + (teacher_s or 0.0)) / 3600
         assert f"1 training(s) of {config.total_env_steps} env steps, about {each:.1f} h each" in line, line
         assert said.format(config.demo_episodes) in line
+
+
+def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatch, capsys):
+    """Issue 57: the cached calibration is shared by every checkout on the machine; one made while other
+    processes kept cores busy is said wherever it is reused (a training's start, a comparison's cost line,
+    `snakemake all`'s estimate), not only by the `estimate all` that made it."""
+    import egosearch.cost.estimate as estimate
+    from egosearch.cost import calibration
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    here = estimate.machine_key(calibration.this_machine())
+    busy = ("this machine's last calibration was made while it was busy: other processes used 1.3 cores meanwhile, "
+            "so its rate may be low and the estimate long (`egosearch estimate all` calibrates again: run it when "
+            "the machine is idle)")
+    results = tmp_path / "results" / "cpu"
+    (results / "bench").mkdir(parents=True)
+    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+        {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0}]}))
+    for other, said in ((1.3, True), (0.1, False), (None, False)):
+        (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "body steps",
+                                                        "other_load_cores": other}))
+        assert (calibration.cached_busy_line() == busy) is said
+        line = estimate.training_time_line(180_000, "cpu")
+        assert line.startswith("estimate: about 0.5 h of CPU time") and line.endswith(f"; {busy}") is said
+        estimate.print_variant_cost("cpu", "screen", "head_off", [0], "head_on", 1)
+        err = capsys.readouterr().err
+        assert "this machine (its last calibration)" in err and (f"  {busy}\n" in err) is said, err

@@ -11,6 +11,9 @@ import yaml
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+PROFILE_CORES = yaml.safe_load((REPO / "profiles/default/config.yaml").read_text())["jobs"]
+"""The cores a run on this machine that names none runs on (the workflow profile's jobs, which Snakemake reads
+as cores there), dry runs' cost lines included."""
 
 
 def run(args, cwd=REPO, timeout=600):
@@ -38,6 +41,40 @@ def test_dry_run_of_all_lists_every_stage():
     for rule in ("scenarios", "train", "evaluate", "fullbody", "fullbody_oracle", "table1", "table2", "fig6", "fig7",
                  "fig7_oracle", "pathlength", "provenance"):
         assert rule in out.stdout, rule
+
+
+def test_snakemake_all_as_the_user_types_it():
+    """Issue 57: `snakemake -n all`, verbatim (no --cores), plans on this machine; on a complete tree (the
+    stored results) it has nothing to do, and prints no fresh clone's estimate above "Nothing to be done"."""
+    out = run(["-n", "all"])
+    text = out.stdout + out.stderr
+    assert out.returncode == 0, text[-3000:]
+    assert "cores have to be specified" not in text
+    if "Nothing to be done" in text:
+        assert "from a fresh clone" not in text and "simulated on" not in text, text[:3000]
+
+
+def test_a_run_as_the_user_types_it_runs_on_this_machine(checkout):
+    """`snakemake table2` with no --cores runs (it used to stop: "cores have to be specified for local
+    execution"), on the profile's 2 cores; --jobs is still read as the cores on one machine."""
+    out = run(["table2", "--config", "profile=smoke"], cwd=checkout)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert f"Provided cores: {PROFILE_CORES}" in out.stdout + out.stderr
+    assert (checkout / "paper_figs/smoke/table2.md").is_file()
+    planned = run(["-n", "screen", "-j", "6", "--config", "variant=head_off"])
+    assert planned.returncode == 0 and "on 6 core(s)" in planned.stderr, planned.stderr[-3000:]
+
+
+def test_a_cluster_executors_dry_run_names_no_cores_of_this_machine():
+    """The profile's jobs are cores on this machine only: under a cluster executor they are the jobs it
+    submits at once, and the cost line says it has no cores here to lay the jobs out on."""
+    assert PROFILE_CORES == 2
+    out = run(["-n", "screen", "--config", "variant=head_off", "--executor", "cluster-generic",
+               "--cluster-generic-submit-cmd", "true", "--jobs", "50"])
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert "(no estimate of the cost: a cluster executor's run lays its jobs out itself, on no cores of this " \
+           "machine to simulate)" in out.stderr.splitlines()
+    assert "core(s)" not in out.stderr
 
 
 def test_dry_run_of_generalise_reads_four_groups_of_homes():
@@ -113,7 +150,7 @@ def test_smoke_table1_end_to_end(checkout):
     # the reference's success by path length reads the same evaluations: one more job. The timeout
     # only stops a hang: the run is 75 one-process jobs, and it took over 15 minutes beside three
     # training jobs.
-    out = run(["--cores", "2", "table1", "paper_figs/smoke/pathlength_head_on.md", "--config", "profile=smoke"],
+    out = run(["table1", "paper_figs/smoke/pathlength_head_on.md", "--config", "profile=smoke"],
               cwd=checkout, timeout=2400)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     by_length = pd.read_csv(checkout / "results/smoke/pathlength/head_on.csv")
@@ -228,7 +265,7 @@ def test_a_screen_trains_screen_seeds_against_the_references_spread_seeds():
 
 def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
     """`snakemake -n screen` is where a user plans: the line onstart prints before a real run's first job,
-    once (a dry run has 1 core unless --cores says otherwise)."""
+    once (on the workflow profile's cores unless --cores says otherwise)."""
     from egosearch.cost.estimate import print_variant_cost
 
     out = run(["-n", "screen", "--config", "variant=head_off"])
@@ -236,7 +273,7 @@ def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
     monkeypatch.chdir(REPO)
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
     seeds = list(range(config["screen_seeds"]))
-    print_variant_cost("cpu", "screen", "head_off", seeds, "head_on", 1,
+    print_variant_cost("cpu", "screen", "head_off", seeds, "head_on", PROFILE_CORES,
                        reference_seeds=config["profiles"]["cpu"]["spread_seeds"])
     line = capsys.readouterr().err.strip()
     assert line.startswith("screen of head_off against head_on: ") and "about" in line

@@ -16,7 +16,7 @@ from pathlib import Path
 from egosearch.cli.checks import read_json_object
 from egosearch.core.machine import measured_on, with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
-from egosearch.cost.calibration import calibrate, this_machine
+from egosearch.cost.calibration import BUSY_CORES, calibrate, this_machine
 from egosearch.cost.estimate import estimate_all
 from egosearch.cost.rates import steps_of_bench, steps_of_profile
 from egosearch.cost.run_log import RunLog, read_run_log
@@ -34,9 +34,6 @@ jobs; a larger figure is a typo, and the estimate would be the DAG's longest cha
 RECORD_FILE = ("a provenance record is the JSON file `egosearch report provenance` writes "
                "(results/<profile>/provenance.json)")
 BENCH_FILE = "a learner benchmark record is the JSON file `egosearch bench learner --out` writes"
-BUSY_CORES = 0.25
-"""Other processes' CPU use during a calibration (cores) above which the estimate says it was measured on
-a busy machine: the calibration counts this process's CPU time, but shared caches and memory slow it."""
 
 
 def run(args) -> None:

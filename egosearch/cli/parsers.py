@@ -265,9 +265,9 @@ def add_report(sub) -> None:
                                             "{placement}/h{height}.csv")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md, .csv and .tex"))
     r.add_argument("--variant", help="the variant of the files (default: read from their paths)")
-    r.add_argument("--bounds", nargs="*", help="evaluation CSVs of the searchers Table 1 sets beside the policy "
-                                               f"({', '.join(searchers.bounds())}: .../eval/SEARCHER/...): rows that "
-                                               "bound the policy")
+    r.add_argument("--bounds", nargs="*", metavar="CSV", help="evaluation CSV paths of the searchers Table 1 sets "
+                                                             f"beside the policy ({', '.join(searchers.bounds())}: "
+                                                             ".../eval/SEARCHER/...): rows that bound the policy")
     r.add_argument("--learning-adds", metavar="CSV", help="the policy against its own start on the same scenarios "
                                                          "(compare/{variant}_vs_its_start.csv, rule learning_adds): "
                                                          "what its learning adds, said in the notes")

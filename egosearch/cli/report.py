@@ -31,6 +31,7 @@ from egosearch.report.tables import stuck_path
 from egosearch.report.workflow_jobs import bound_eval_files, variants_of_all, workflow_config, workflow_heights
 from egosearch.rl.config import departure_rows, load_config, table2_rows
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
+from egosearch.searchers import registry as searchers
 
 
 def run(args) -> None:
@@ -99,6 +100,18 @@ def check_report_outputs(args) -> None:
                      force=args.force)
 
 
+def _bounds_hint(option: str, path: str) -> str:
+    """What ``--bounds`` takes, said where one of its paths is missing: a searcher's name is its most
+    likely typo (``--bounds frontier``)."""
+    if option != "--bounds":
+        return ""
+    pattern = "results/<profile>/eval/{}/seed<N>/<home>/<placement>/h<height>.csv"
+    if path in searchers.SEARCHERS:
+        return f"; --bounds takes evaluation CSV paths, not a searcher's name: {path}'s are {pattern.format(path)}"
+    return (f"; --bounds takes the evaluation CSV paths of the searchers ({', '.join(searchers.bounds())}): "
+            f"{pattern.format('<searcher>')}")
+
+
 def check_report_inputs(args) -> None:
     """The input files are files of their kind, and every option names something they hold: a report
     otherwise fails half-way with pandas' or numpy's words, or draws an empty row without a word."""
@@ -107,7 +120,7 @@ def check_report_inputs(args) -> None:
         if missing:
             # before the path is parsed: a missing file would be told the pattern of the paths it has
             more = f" ({len(missing) - 1} more missing too)" if len(missing) > 1 else ""
-            raise FileNotFoundError(f"{option}: {missing[0]} not found{more}")
+            raise FileNotFoundError(f"{option}: {missing[0]} not found{more}{_bounds_hint(option, missing[0])}")
     if args.what in ("behaviour", "searches", "failures"):
         check_npz_files("the input files", args.files)
     else:

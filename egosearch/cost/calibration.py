@@ -49,13 +49,39 @@ def calibrate() -> tuple[float, float | None]:
     return rate, other
 
 
-def cached_rate() -> float | None:
-    """This machine's last calibration (None when it has none, it was another machine's, or it timed
-    another kind of env step than the cpu profile's today)."""
+BUSY_CORES = 0.25
+"""Other processes' CPU use during a calibration (cores) above which an estimate says it was measured on
+a busy machine: the calibration counts this process's CPU time, but shared caches and memory slow it."""
+
+
+def cached_calibration() -> dict | None:
+    """This machine's last calibration as stored (its ``rate`` and the ``other_load_cores`` meanwhile);
+    None when it has none, it was another machine's, or it timed another kind of env step than the cpu
+    profile's today."""
     try:
         cached = json.loads(CALIBRATION_CACHE.read_text())
     except (OSError, ValueError):
         return None
+    if not isinstance(cached, dict):
+        return None
     here = machine_key(this_machine())
     same = cached.get("machine") == here and cached.get("steps", BODY_STEPS) == steps_of_profile("cpu")
-    return float(cached["rate"]) if same and cached.get("rate") else None
+    return cached if same and cached.get("rate") else None
+
+
+def cached_rate() -> float | None:
+    """This machine's last calibration's rate (None as :func:`cached_calibration`)."""
+    cached = cached_calibration()
+    return float(cached["rate"]) if cached else None
+
+
+def cached_busy_line() -> str | None:
+    """One line where this machine's last calibration (which every checkout on it shares) was made while
+    other processes kept more than :data:`BUSY_CORES` cores busy; None otherwise."""
+    cached = cached_calibration()
+    other = cached.get("other_load_cores") if cached else None
+    if not isinstance(other, (int, float)) or other <= BUSY_CORES:
+        return None
+    return (f"this machine's last calibration was made while it was busy: other processes used {other:.1f} cores "
+            "meanwhile, so its rate may be low and the estimate long (`egosearch estimate all` calibrates again: "
+            "run it when the machine is idle)")

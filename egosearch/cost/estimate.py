@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 
 from egosearch.core.gpu_share import warn_gpu_sharing
-from egosearch.cost.calibration import cached_rate, this_machine
+from egosearch.cost.calibration import cached_busy_line, cached_rate, this_machine
 from egosearch.cost.rates import (
     benchmark_ratio,
     cpu_s_outside_rl,
@@ -52,13 +52,14 @@ def print_costs(targets, config: dict, profile: str, seeds: list[int], reference
     ``seeds`` for compare; for screen ``screen_seeds`` seeds from ``screen_seed`` and the reference's
     missing spread seeds, then the screen's power, :func:`print_screen_power`). Where no estimate can be
     made, a line says why:
-    ``cores`` None (a run that names no --cores, as a cluster executor's may) has no schedule to simulate.
+    ``cores`` None (a cluster executor's run, which lays its jobs out itself) has no schedule to simulate.
     First, once, where paper-profile trainings share one GPU (``trainings_per_gpu`` > 1): whether they do
     under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`)."""
     warn_gpu_sharing(profile, trainings_per_gpu)
     if cores is None:
         if "all" in targets or ({"compare", "screen"} & set(targets) and config.get("variant")):
-            print("(no estimate of the cost: the run names no --cores to lay its jobs out on)", file=sys.stderr)
+            print("(no estimate of the cost: a cluster executor's run lays its jobs out itself, on no cores of this "
+                  "machine to simulate)", file=sys.stderr)
         return
     if "all" in targets:
         print_before_a_run(profile, cores)
@@ -90,6 +91,8 @@ def print_before_a_run(profile: str, cores: int) -> None:
                              where=f"on this machine ({machine_key(this_machine())})")["lines"][:-2]
         if rate is None:
             lines.append(f"  for this machine: egosearch estimate all --cores {cores} --profile {profile} (a minute)")
+        elif cached_busy_line():
+            lines.append(f"  {cached_busy_line()}")
     except (OSError, ValueError, RuntimeError, KeyError) as err:
         lines = [f"(no estimate of the run's time: {err})"]
     for line in lines:
@@ -263,6 +266,8 @@ def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int]
               f"steps, about "
               f"{per_training / 3600:.1f} h each on {where}{teacher}, and {n_evals} evaluations of about "
               f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
+        if where.startswith("this machine") and cached_busy_line():
+            print(f"  {cached_busy_line()}", file=sys.stderr)
     except (OSError, ValueError, KeyError, TypeError) as err:
         print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)
 
@@ -305,4 +310,6 @@ def training_time_line(steps: int, profile: str, config=None) -> str | None:
         line += (f", plus about {_hours(extra)} for the teacher's {config.demo_episodes} episodes and the cloning"
                  if extra is not None else
                  f", plus the teacher's {config.demo_episodes} episodes and the cloning (no stored measurement)")
+    if cached_busy_line():
+        line += f"; {cached_busy_line()}"
     return line

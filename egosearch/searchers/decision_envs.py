@@ -35,6 +35,47 @@ def decision_env_id(head: bool) -> str:
     return "EgoSearchModular-v0" if head else "EgoSearchNoHeadModular-v0"
 
 
+UNREAD_OPTIONS = {"target_memory": "EgoSearchMemory-v0", "floor_map": "EgoSearchMap-v0"}
+"""Body-env options a decision env does not read (its observation is the decision's: the mask's features and
+the searcher's map), with the body id that does."""
+
+
+def check_decision_options(env_id: str | None, kwargs: dict) -> None:
+    """``kwargs`` of a decision env (``env_id``'s registered ones with the caller's on top; None: the class
+    built directly) name no option it does not read, and keep the head its id fixes."""
+    from egosearch.sim.envs import check_flag
+
+    where = env_id or "the modular searcher's decision env"
+    for name, reader in UNREAD_OPTIONS.items():
+        if name in kwargs:
+            raise ValueError(f"{name}={kwargs[name]!r}: {where} does not read {name} (its observation is the "
+                             f"decision's: the mask's features and the searcher's map); allowed: leave {name} out "
+                             f"(a body env reads it, e.g. {reader})")
+    if "head" in kwargs:
+        check_flag("head", kwargs["head"])
+    if env_id is not None and bool(kwargs.get("head", True)) != MODULAR_ENV_IDS[env_id]["head"]:
+        fixed = MODULAR_ENV_IDS[env_id]["head"]
+        other = decision_env_id(not fixed)
+        raise ValueError(f"head={kwargs['head']!r} contradicts {env_id}, which fixes head={fixed} (the camera's two "
+                         f"joints {'on' if fixed else 'off'}); allowed: head={fixed}, or leave head out ({other} is "
+                         f"the id with head={not fixed})")
+
+
+def _entry_point(env_id: str):
+    def make(**kwargs):
+        check_decision_options(env_id, kwargs)
+        from egosearch.searchers.modular import ModularSearchEnv  # here: registering must not load the physics
+
+        return ModularSearchEnv(**kwargs)
+
+    make.__name__ = make.__qualname__ = env_id.replace("-", "_")
+    make.__doc__ = f"{env_id}: :class:`egosearch.searchers.modular.ModularSearchEnv` with {MODULAR_ENV_IDS[env_id]}."
+    make.metadata = {"render_modes": []}
+    return make
+
+
 for _env_id, _kwargs in MODULAR_ENV_IDS.items():
+    globals()[_env_id.replace("-", "_")] = _entry_point(_env_id)
     if _env_id not in registry:
-        register(id=_env_id, entry_point="egosearch.searchers.modular:ModularSearchEnv", kwargs=dict(_kwargs))
+        register(id=_env_id, entry_point=f"egosearch.searchers.decision_envs:{_env_id.replace('-', '_')}",
+                 kwargs=dict(_kwargs))

@@ -39,6 +39,7 @@ from egosearch.searchers.decision_envs import (
     MODULAR_MAP_CELL_SIZE,
     MODULAR_MAP_CELLS,
     MODULAR_MAP_DIM,
+    check_decision_options,
     modular_decision_dim,
 )
 from egosearch.searchers.frontier import FrontierPolicy
@@ -151,6 +152,7 @@ class ModularSearchEnv(gymnasium.Env):
     metadata = {"render_modes": []}
 
     def __init__(self, head: bool = True, **env_kwargs):
+        check_decision_options(None, {"head": head, **env_kwargs})
         self.body_env = SearchEnv(head=head, **env_kwargs)
         self.searcher = GoalFrontierPolicy(self.body_env)
         inner = self.body_env.observation_space

@@ -9,6 +9,7 @@ human motion (paper 6.1). The per-step bounds below are human limits at that rat
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,6 +112,9 @@ def wrap_angle(angle: float) -> float:
 def check_height(height: float) -> float:
     """A camera height in :data:`HEIGHT_RANGE`, or a one-line error naming the field."""
     lo, hi = HEIGHT_RANGE
-    if not (isinstance(height, (int, float)) and lo <= float(height) <= hi):
+    if isinstance(height, bool) or not isinstance(height, numbers.Real):
+        raise ValueError(f"height={height!r} is a {type(height).__name__}, not a number; allowed: a number of "
+                         f"metres in [{lo}, {hi}]")
+    if not lo <= float(height) <= hi:
         raise ValueError(f"height={height!r} is outside the sensible range [{lo}, {hi}] m")
     return float(height)

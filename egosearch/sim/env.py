@@ -42,6 +42,7 @@ Two ways to start an episode:
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import replace
 
 import gymnasium
@@ -53,6 +54,7 @@ from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
 from egosearch.scene.placement import sample_target
 from egosearch.sim.agent import IMAGE_SIZE, AgentSpec, AgentState, check_height
+from egosearch.sim.envs import BODY_METADATA, check_flag
 from egosearch.sim.floormap import FloorMap
 from egosearch.sim.scenarios import (
     MAX_STEPS,
@@ -148,7 +150,7 @@ def privileged_state(state: AgentState, target: Part, distance: float, visible: 
 
 
 class SearchEnv(gymnasium.Env):
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 1.0 / 0.15}
+    metadata = BODY_METADATA
 
     def __init__(self, layout: str = "kitchen_living", placement: str = "everywhere",
                  head: bool = True, height: float | None = None, height_noise: bool | None = None,
@@ -178,6 +180,8 @@ class SearchEnv(gymnasium.Env):
                 episode (0: the paper's reward).
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
         """
+        for name, value in (("head", head), ("target_memory", target_memory), ("floor_map", floor_map)):
+            check_flag(name, value)
         self.scene = layouts_mod.get_scene(layout)
         self.layout = layout
         self.placement = check_placement(placement)
@@ -186,6 +190,12 @@ class SearchEnv(gymnasium.Env):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode={render_mode!r}; allowed: None, rgb_array")
         self.render_mode = render_mode
+        if isinstance(max_steps, bool) or not isinstance(max_steps, numbers.Integral):
+            raise ValueError(f"max_steps={max_steps!r} is a {type(max_steps).__name__}; allowed: an integer >= 1 "
+                             "(T_max: the steps before an episode is truncated)")
+        if max_steps <= 0:
+            raise ValueError(f"max_steps={max_steps}: every episode would end before its first step; allowed: an "
+                             "integer >= 1 (T_max: the steps before an episode is truncated)")
         self.max_steps = int(max_steps)
         if distance_reward not in DISTANCE_REWARDS:
             raise ValueError(f"distance_reward={distance_reward!r}; allowed: {', '.join(DISTANCE_REWARDS)}")

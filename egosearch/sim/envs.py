@@ -1,11 +1,17 @@
 """The body env's gymnasium ids (``import egosearch.sim.envs`` registers them; ``import egosearch.envs``
 registers every id, the modular searcher's too, and resolves the env options).
 
-One env, :class:`egosearch.sim.env.SearchEnv`; its observation is chosen by keyword options, not by id:
-``gymnasium.make("EgoSearch-v0", head=False, target_memory=True)``. The ids below name the combinations
-the stored runs recorded, so that every stored run keeps loading under the id it trained in."""
+One env, :class:`egosearch.sim.env.SearchEnv`; its observation is chosen by keyword options:
+``gymnasium.make("EgoSearchNoHead-v0", target_memory=True)``. The ids below name the combinations the
+stored runs recorded, so that every stored run keeps loading under the id it trained in. An option that
+contradicts its id (``head=True`` on a NoHead id, ``target_memory=False`` on a Memory id) or a combination
+no id names (``floor_map`` without ``target_memory``) is refused with a ``ValueError`` naming the option and
+what is allowed (:func:`check_body_options`), before the env is built."""
 
 from gymnasium.envs.registration import register, registry
+
+BODY_METADATA = {"render_modes": ["rgb_array"], "render_fps": 1.0 / 0.15}
+"""SearchEnv's gymnasium metadata (its ``metadata``; the entry points carry it too, for ``gymnasium.make``)."""
 
 BODY_OPTIONS = ("head", "target_memory", "floor_map")
 """The body env's keyword options that change what it observes (and so what an actor must fit):
@@ -24,10 +30,59 @@ ENV_IDS = {
     "EgoSearchNoHeadMap-v0": {"head": False, "target_memory": True, "floor_map": True},
 }
 
+OPTION_WORDS = {"head": "the camera's two joints", "target_memory": "the last-seen target memory",
+                "floor_map": "the egocentric floor map"}
+
+
+def check_flag(name: str, value) -> None:
+    """An on/off option is a bool (numpy's too): ``head="no"`` would otherwise read as on."""
+    if type(value).__name__ not in ("bool", "bool_"):
+        raise ValueError(f"{name}={value!r} is a {type(value).__name__}; allowed: True or False")
+
+
+def check_body_options(env_id: str, kwargs: dict) -> None:
+    """``kwargs`` (the id's registered ones with the caller's on top, as ``gymnasium.make`` merges them) do
+    not contradict ``env_id``: an option the id fixes keeps its value, and the options together are a
+    combination an id names (a floor map comes with the target memory)."""
+    fixed = ENV_IDS[env_id]
+    for name in BODY_OPTIONS:
+        if name in kwargs:
+            check_flag(name, kwargs[name])
+    options = {"head": True, "target_memory": False, "floor_map": False, **fixed,
+               **{k: bool(v) for k, v in kwargs.items() if k in BODY_OPTIONS}}
+    for name, value in fixed.items():
+        if options[name] != value:
+            wanted = {**options, "target_memory": options["target_memory"] or options["floor_map"]}
+            other = next((i for i, o in ENV_IDS.items() if body_options(i) == wanted), None)
+            instead = f" ({other} is the id with {name}={options[name]})" if other else ""
+            raise ValueError(f"{name}={options[name]!r} contradicts {env_id}, which fixes {name}={value} "
+                             f"({OPTION_WORDS[name]} {'on' if value else 'off'}); allowed: {name}={value}, or leave "
+                             f"{name} out{instead}")
+    if options["floor_map"] and not options["target_memory"]:
+        maps = [i for i, o in ENV_IDS.items() if o.get("floor_map")]
+        raise ValueError(f"floor_map=True in {env_id} needs target_memory=True (the floor map comes with the "
+                         f"target memory: {' and '.join(maps)}); allowed: floor_map with target_memory=True, or "
+                         "floor_map=False")
+
+
+def _entry_point(env_id: str):
+    def make(**kwargs):
+        check_body_options(env_id, kwargs)
+        from egosearch.sim.env import SearchEnv  # here: registering must not load the physics
+
+        return SearchEnv(**kwargs)
+
+    make.__name__ = make.__qualname__ = env_id.replace("-", "_")
+    make.__doc__ = f"{env_id}: :class:`egosearch.sim.env.SearchEnv` with {ENV_IDS[env_id]}, its options checked."
+    make.metadata = BODY_METADATA
+    return make
+
+
 for _env_id, _kwargs in ENV_IDS.items():
+    globals()[_env_id.replace("-", "_")] = _entry_point(_env_id)
     if _env_id not in registry:
         # SearchEnv enforces T_max itself (truncated=True at step 100), so no TimeLimit wrapper.
-        register(id=_env_id, entry_point="egosearch.sim.env:SearchEnv", kwargs=dict(_kwargs))
+        register(id=_env_id, entry_point=f"egosearch.sim.envs:{_env_id.replace('-', '_')}", kwargs=dict(_kwargs))
 
 
 def body_options(env_id: str) -> dict[str, bool]:

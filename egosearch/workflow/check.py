@@ -14,6 +14,7 @@ import re
 import sys
 from pathlib import Path
 
+from egosearch.core.schema_errors import schema_error
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
 from egosearch.searchers import registry as searchers
 from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
@@ -77,8 +78,8 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     try:
         jsonschema.validate(config, schema)
     except jsonschema.ValidationError as err:
-        where = "/".join(str(p) for p in err.absolute_path) or "(top level)"
-        raise ConfigError(f"config {where}: {err.message}") from None
+        where, what = schema_error(err)
+        raise ConfigError(f"config {where}: {what}") from None
     for where, pairs in every_claims_pairs(config):
         for pair in pairs:
             if pair[0] == pair[1]:

@@ -59,7 +59,19 @@ def pathlength_files(variants=None):
 
 
 def cores_given():
-    """--cores, or None where a run names none (a cluster executor's: there workflow.cores raises)."""
+    """The cores a run on this machine lays its jobs out on: --cores, else --jobs (Snakemake's alias for it
+    on one machine; profiles/default gives 2, so `snakemake all` runs as typed), a dry run's too (Snakemake
+    gives a dry run 1 core unless --cores says otherwise, not the cores its real run would have). None under
+    a cluster executor, which lays its jobs out itself (its --jobs are jobs submitted at once)."""
+    import sys
+
+    argv = sys.argv[1:]
+    if not workflow.local_exec or any(a in ("-e", "--executor") or a.startswith("--executor=") for a in argv):
+        return None
+    named = any(a == "--cores" or a.startswith("--cores=") or (a.startswith("-c") and not a.startswith("--"))
+                for a in argv)
+    if workflow.output_settings.dryrun and not named and workflow.nodes:
+        return int(workflow.nodes)
     try:
         return workflow.cores
     except WorkflowError:
@@ -121,7 +133,17 @@ if PROFILE == "paper":
         print(f"egosearch: error: {err}", file=sys.stderr)
         sys.exit(1)
     if LOCAL_RUN and "gpu_slots" in workflow.global_resources:
-        TRAININGS_PER_GPU = max(1, int(workflow.global_resources["gpu_slots"].value))
+        SLOTS = int(workflow.global_resources["gpu_slots"].value)
+        if SLOTS < 1:
+            # each training asks for one slot: with none, the plan lists trainings that could never start
+            import sys
+
+            print(f"egosearch: error: --resources gpu_slots={SLOTS}: every paper-profile training asks for one "
+                  "gpu_slots (its share of the GPU), so none could start; give gpu_slots=1 or more (the trainings "
+                  "side by side on one GPU), or leave it out (config trainings_per_gpu sets it: "
+                  f"{TRAININGS_PER_GPU} here)", file=sys.stderr)
+            sys.exit(1)
+        TRAININGS_PER_GPU = SLOTS
     elif LOCAL_RUN:
         workflow.register_resource("gpu_slots", TRAININGS_PER_GPU)
 else:
