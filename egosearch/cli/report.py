@@ -526,9 +526,12 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     check_outputs(dirs={"the figures folder": figs, "the path-length folder": results / "pathlength"})
     # Table 1's homes only, as the DAG's rules: eval/ also holds the generalisation groups
     homes = set(config["homes"])
+    # the profile's seeds only: the reference's spread seeds beyond them (snakemake seed_spread) are no
+    # part of Table 1, Figure 6 or the path-length tables, as in the DAG
+    seeds = {f"seed{s}" for s in config["profiles"][profile]["seeds"]}
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv")
-                   if Path(p).parts[-3] in homes)
-    curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv"))
+                   if Path(p).parts[-3] in homes and Path(p).parts[-4] in seeds)
+    curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv") if p.parts[-2] in seeds)
               for v in variants_of_all(config)}
     curves = {v: paths for v, paths in curves.items() if paths}
     fullbody = sorted(str(p) for p in (results / "fullbody").glob("*/seed*.csv"))
@@ -560,7 +563,7 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     scenarios = sorted(str(p) for home in homes for p in (results / "scenarios" / home).glob("*/h*.csv"))
     for variant in variants_of_all(config):
         variant_evals = sorted(str(p) for p in (results / "eval" / variant).glob("seed*/*/*/h*.csv")
-                               if Path(p).parts[-3] in homes)
+                               if Path(p).parts[-3] in homes and Path(p).parts[-4] in seeds)
         if variant_evals and scenarios:
             report.cmd_pathlength(variant_evals, scenarios, success_radius(), figs / f"pathlength_{variant}",
                                   out_csv=results / "pathlength" / f"{variant}.csv", bounds=bounds)

@@ -61,21 +61,8 @@ def check_decision_options(env_id: str | None, kwargs: dict) -> None:
                          f"the id with head={not fixed})")
 
 
-def _entry_point(env_id: str):
-    def make(**kwargs):
-        check_decision_options(env_id, kwargs)
-        from egosearch.searchers.modular import ModularSearchEnv  # here: registering must not load the physics
-
-        return ModularSearchEnv(**kwargs)
-
-    make.__name__ = make.__qualname__ = env_id.replace("-", "_")
-    make.__doc__ = f"{env_id}: :class:`egosearch.searchers.modular.ModularSearchEnv` with {MODULAR_ENV_IDS[env_id]}."
-    make.metadata = {"render_modes": []}
-    return make
-
-
 for _env_id, _kwargs in MODULAR_ENV_IDS.items():
-    globals()[_env_id.replace("-", "_")] = _entry_point(_env_id)
     if _env_id not in registry:
-        register(id=_env_id, entry_point=f"egosearch.searchers.decision_envs:{_env_id.replace('-', '_')}",
+        # named, not imported: registering must not load the physics (egosearch.searchers.decision_entry)
+        register(id=_env_id, entry_point=f"egosearch.searchers.decision_entry:{_env_id.replace('-', '_')}",
                  kwargs=dict(_kwargs))

@@ -65,24 +65,12 @@ def check_body_options(env_id: str, kwargs: dict) -> None:
                          "floor_map=False")
 
 
-def _entry_point(env_id: str):
-    def make(**kwargs):
-        check_body_options(env_id, kwargs)
-        from egosearch.sim.env import SearchEnv  # here: registering must not load the physics
-
-        return SearchEnv(**kwargs)
-
-    make.__name__ = make.__qualname__ = env_id.replace("-", "_")
-    make.__doc__ = f"{env_id}: :class:`egosearch.sim.env.SearchEnv` with {ENV_IDS[env_id]}, its options checked."
-    make.metadata = BODY_METADATA
-    return make
-
-
 for _env_id, _kwargs in ENV_IDS.items():
-    globals()[_env_id.replace("-", "_")] = _entry_point(_env_id)
     if _env_id not in registry:
-        # SearchEnv enforces T_max itself (truncated=True at step 100), so no TimeLimit wrapper.
-        register(id=_env_id, entry_point=f"egosearch.sim.envs:{_env_id.replace('-', '_')}", kwargs=dict(_kwargs))
+        # SearchEnv enforces T_max itself (truncated=True at step 100), so no TimeLimit wrapper. The entry
+        # point is named, not imported: registering must not load the physics (egosearch.sim.env_entry).
+        register(id=_env_id, entry_point=f"egosearch.sim.env_entry:{_env_id.replace('-', '_')}",
+                 kwargs=dict(_kwargs))
 
 
 def body_options(env_id: str) -> dict[str, bool]:

@@ -226,10 +226,12 @@ rule screens_reread:
         f"{RESULTS}/compare/screens_reread.csv",
     log:
         f"{RESULTS}/logs/report/screens_reread.log",
+    params:
+        profile=PROFILE,
     conda:
         CONDA_ENV
     shell:
-        "egosearch report reread-screens --force --profile {PROFILE} --out {output} 2>&1 | tee {log}"
+        "egosearch report reread-screens --force --profile {params.profile} --out {output} 2>&1 | tee {log}"
 
 
 rule seed_spread:
