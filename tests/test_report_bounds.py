@@ -89,6 +89,22 @@ def test_table1_puts_the_policy_between_the_random_searcher_and_the_oracle(tmp_p
         cmd_table1(ours, tmp_path / "out2", variant="head_on", bounds=stray)
 
 
+CURVE_SCENARIOS = [("kitchen_living", 0.45, 0, 4.5), ("kitchen_living", 1.05, 0, 6.0),
+                   ("bedroom_bath", 0.45, 0, 3.0), ("bedroom_bath", 1.65, 1, 5.5)]
+"""A curve's held-out scenarios: (home, height, scenario_id, shortest path); ids restart in each group."""
+
+
+def _curve_level_csv(root: Path, searcher: str, successes: list[int], scenarios=CURVE_SCENARIOS) -> Path:
+    from egosearch.report.data import CURVE_LEVEL_COLUMNS
+
+    rows = [dict(zip(CURVE_LEVEL_COLUMNS, (home, h, i, ok, 50, 6.0, ell, 0.5 * ok, 0, -10.0)))
+            for (home, h, i, ell), ok in zip(scenarios, successes, strict=True)]
+    path = root / "eval_curve" / searcher / "head_on.csv"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(rows, columns=list(CURVE_LEVEL_COLUMNS)).to_csv(path, index=False)
+    return path
+
+
 def test_figure6_draws_the_random_and_classical_searchers_and_each_start_as_levels(tmp_path):
     from matplotlib.figure import Figure
 
@@ -98,11 +114,17 @@ def test_figure6_draws_the_random_and_classical_searchers_and_each_start_as_leve
     curve = tmp_path / "train" / "head_on" / "seed0" / "curve.csv"
     curve.parent.mkdir(parents=True)
     pd.DataFrame({"env_steps": [0, 100, 200], "success_rate": [0.25, 0.5, 0.75]}).to_csv(curve, index=False)
-    rand = [_eval_csv(tmp_path, "random", "everywhere", h, s) for h, s in ((0.45, [1, 0, 0, 0]), (1.65, [0, 0, 0, 0]))]
-    classical = [_eval_csv(tmp_path, "frontier", "everywhere", 1.05, [1, 1, 1, 0])]
+    # the episodes behind the curve: the same four scenarios at every step
+    pd.DataFrame([{"env_steps": step, "home": home, "height": h, "scenario_id": i, "success": int(k <= step // 100),
+                   "shortest_path": ell, "path_length": 7.0}
+                  for step in (0, 100, 200) for k, (home, h, i, ell) in enumerate(CURVE_SCENARIOS)]
+                 ).to_csv(curve.with_name("curve_episodes.csv"), index=False)
+    rand = [_curve_level_csv(tmp_path, "random", [1, 0, 0, 0])]
+    classical = [_curve_level_csv(tmp_path, "frontier", [1, 1, 1, 0])]
     df = figure6_frame({"head_on": [curve]}, level_files=rand + classical, n_resamples=50)
     level = df[df["variant"] == RANDOM]
-    assert list(level["env_steps"]) == [0, 100, 200] and (level["success_rate"] == 1 / 8).all()
+    assert list(level["env_steps"]) == [0, 100, 200] and (level["success_rate"] == 1 / 4).all()
+    assert (level["n_scenarios"] == 4).all()
     assert (df[df["variant"] == "frontier"]["success_rate"] == 3 / 4).all()
     assert set(df[df["variant"] == "frontier"]["label"]) == {"classical searcher, head moving"}
 
@@ -120,12 +142,17 @@ def test_figure6_draws_the_random_and_classical_searchers_and_each_start_as_leve
         png, _pdf, _csv = figure6({"head_on": [curve]}, tmp_path / "fig6", level_files=rand + classical,
                                   n_resamples=50)
     assert png.stat().st_size > 10_000
-    assert sorted(drawn) == sorted([("random searcher", 1 / 8), ("classical searcher, head moving", 3 / 4),
+    assert sorted(drawn) == sorted([("random searcher", 1 / 4), ("classical searcher, head moving", 3 / 4),
                                     (START_LABEL, 0.25)])
     with pytest.raises(ValueError, match="may not be called 'random'"):
         figure6_frame({"random": [curve]}, level_files=rand)
-    with pytest.raises(ValueError, match="no level's evaluation file"):
-        figure6_frame({"head_on": [curve]}, level_files=[_eval_csv(tmp_path, "oracle", "everywhere", 1.05, [1])])
+    # a level read on other episodes than the curve's (Table 1's sets, or another curve's scenarios) is refused
+    with pytest.raises(ValueError, match="no level's episodes on a curve's scenarios"):
+        figure6_frame({"head_on": [curve]}, level_files=[_eval_csv(tmp_path, "frontier", "everywhere", 1.05, [1])])
+    moved = [(home, h, i, ell + 1.0) for home, h, i, ell in CURVE_SCENARIOS]
+    other = _curve_level_csv(tmp_path / "other", "frontier", [1, 1, 1, 0], scenarios=moved)
+    with pytest.raises(ValueError, match="ran other scenarios than head_on's curve"):
+        figure6_frame({"head_on": [curve]}, level_files=[other])
 
 
 # --------------------------------------------------------------------------------------------- provenance

@@ -71,11 +71,18 @@ def env_id_help() -> str:
 
 def add_evaluate(sub) -> None:
     p = sub.add_parser("evaluate", help="run a policy over a scenario CSV -> per-episode CSV")
-    p.add_argument("--scenarios", required=True, help="a scenario CSV written by `egosearch scenarios`")
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument("--scenarios", help="a scenario CSV written by `egosearch scenarios`")
+    which.add_argument("--curve-of", metavar="VARIANT",
+                       help="instead of --scenarios: the held-out scenarios VARIANT's training curve is evaluated on "
+                            "at --profile, each episode seeded as the curve's (Figure 6's levels; the CSV gains the "
+                            "home and height, as scenario ids restart in each)")
+    p.add_argument("--profile", default="cpu", help="with --curve-of: the learner profile (default: cpu)")
     p.add_argument("--policy", default="actor", help=policy_help())
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help=env_id_help())
-    p.add_argument("--seed", type=int, default=0, help=POLICY_SEED)
+    p.add_argument("--seed", type=int, help=POLICY_SEED + " (not with --curve-of, whose episodes are seeded as the "
+                                            "curve's)")
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")
     p.add_argument("--traces", metavar="FILE.npz", help="also write every step of every episode (pose, head, action, "
                                                         "what the camera's centre looks at, distances) to this "
@@ -116,6 +123,19 @@ def add_demos(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes (default 0)")
     p.add_argument("--out", required=True, metavar="FILE.replay.npz",
                    help="the transitions (git-ignored); a summary goes beside it as FILE.json")
+    add_force(p)
+
+
+def add_tune(sub) -> None:
+    about = ("redo the tuned frontier searcher's tuning (frontier_tuned): candidates on a training-side fit split, "
+             "the chosen one checked on a held-out split, never on a stored set; resumable")
+    p = sub.add_parser("tune", help=about, description=about)
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="the episodes of every candidate (DIR/SPLIT/HEAD_MODE/CANDIDATE.csv) and DIR/record.json; "
+                        "rerun with the same DIR to resume")
+    p.add_argument("--limit", type=int, default=0,
+                   help="a quick run: the first N scenarios of each cell only, N >= 1 (0: the full splits, 540 "
+                        "scenarios each, 90 a cell; about 13,000 episodes in all)")
     add_force(p)
 
 

@@ -20,7 +20,7 @@ from egosearch.report import cli as report
 from egosearch.report.behaviour import behaviour_report, check_pairs, parse_pair, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
 from egosearch.report.data import parse_eval_path
-from egosearch.report.figures import fig6_levels
+from egosearch.report.figures import CURVE_LEVELS_DIR, fig6_levels
 from egosearch.report.fresh import fresh_report
 from egosearch.report.generalise import generalise_report
 from egosearch.report.pathlength import by_length_path
@@ -514,10 +514,6 @@ def regenerate(profile: str, reference: str | None) -> None:
 
 
 def _regenerate_files(profile: str, reference: str | None) -> None:
-    # local: only regenerate reads a variant, and the variants layer loads gymnasium's registry
-    from egosearch.sim.home_pool import curve_homes
-    from egosearch.variants import load_variant
-
     config = workflow_config()
     if profile not in config["profiles"]:
         raise ValueError(f"--profile={profile!r}; allowed: {', '.join(config['profiles'])}")
@@ -538,16 +534,14 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     fullbody_oracle = sorted(str(p) for p in (results / "fullbody_oracle").glob("*/seed*.csv"))
     bounds = [p for p in bound_eval_files(results, config["homes"], config["placements"], workflow_heights(config))
               if Path(p).exists()]
-    # Figure 6's levels: the cells the reference is evaluated in while training (as in the DAG).
-    train_env = load_variant(reference).train_env
-    levels = fig6_levels()
-    level_files = [p for p in bounds if Path(p).parts[-5] in levels and Path(p).parts[-2] == train_env["placement"]
-                   and Path(p).parts[-3] in curve_homes(train_env)]
+    # Figure 6's levels: the searchers on the scenarios of the reference's curve (as in the DAG).
+    level_files = [str(p) for p in (results / CURVE_LEVELS_DIR / name / f"{reference}.csv" for name in fig6_levels())
+                   if p.exists()]
     adds = results / "compare" / f"{reference}_vs_its_start.csv"
     if not (evals or curves or fullbody or fullbody_oracle):
         raise FileNotFoundError(f"no stored results under {results}/ (eval, train or fullbody)")
-    read = [*evals, *bounds, *(p for paths in curves.values() for p in paths), *fullbody, *fullbody_oracle,
-            *([str(adds)] if adds.exists() else [])]
+    read = [*evals, *bounds, *level_files, *(p for paths in curves.values() for p in paths), *fullbody,
+            *fullbody_oracle, *([str(adds)] if adds.exists() else [])]
     if check_stored(read, require_record=True):
         print(f"note: {results}/provenance.json has no sha256 list: the stored files are used unverified")
     figs.mkdir(parents=True, exist_ok=True)

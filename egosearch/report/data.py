@@ -28,6 +28,8 @@ from egosearch.searchers.registry import modular_floors
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
                    "episode_return")
+CURVE_LEVEL_COLUMNS = ("home", "height", *EPISODE_COLUMNS)
+"""A searcher's episodes on a training curve's scenarios (egosearch.runs.evaluate writes them): Figure 6's levels."""
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss", "curl_loss",
                  "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
 FULLBODY_COLUMNS = ("scenario_id", "method", "mg", "M", "T", "success", "steps", "path_length", "shortest_path",

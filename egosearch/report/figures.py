@@ -22,10 +22,11 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
 from egosearch.report.data import (
+    CURVE_LEVEL_COLUMNS,
     counts_decisions,
     output_base,
+    read_checked_csv,
     read_curves,
-    read_episodes,
     read_fullbody,
     seed_from_path,
     suffixed,
@@ -72,7 +73,7 @@ def fig6_levels() -> dict[str, tuple]:
     """Figure 6's levels, searchers that do not train (a horizontal line each: label, line style, colour): the
     registered searchers with a ``fig6_level`` (:mod:`egosearch.searchers.registry`), the floor a policy must
     rise above and the classical searcher its learning is read against. The row name is the searcher's, read
-    from its evaluation files' path (``eval/{searcher}/seed{N}/...``)."""
+    from its episodes' path (:func:`level_searcher`)."""
     return {s.name: s.fig6_level for s in searchers.SEARCHERS.values() if s.fig6_level}
 
 
@@ -128,16 +129,38 @@ def _curve_episodes(curve_paths: list) -> pd.DataFrame | None:
     return pd.concat(frames, ignore_index=True) if frames else None
 
 
+CURVE_LEVELS_DIR = "eval_curve"
+"""Where the levels' episodes lie: ``{results}/eval_curve/{searcher}/{variant}.csv``, written by
+``egosearch evaluate --curve-of VARIANT --policy SEARCHER`` on the scenarios of the variant's curve."""
+
+
 def level_searcher(path: PathLike) -> str:
-    """The searcher whose evaluation file ``path`` is (``.../eval/{searcher}/seed{N}/{home}/{placement}/h*.csv``),
+    """The searcher whose episodes on a curve's scenarios ``path`` holds (``.../eval_curve/{searcher}/{variant}.csv``),
     one of :func:`fig6_levels`; ValueError otherwise."""
     parts = Path(path).parts
-    name = parts[-5] if len(parts) >= 5 else ""
+    name = parts[-2] if len(parts) >= 3 and parts[-3] == CURVE_LEVELS_DIR else ""
     levels = fig6_levels()
     if name not in levels:
-        raise ValueError(f"figure6: {path} is no level's evaluation file (.../eval/SEARCHER/seedN/HOME/PLACEMENT/"
-                         f"hH.csv, SEARCHER one of {', '.join(levels)})")
+        raise ValueError(f"figure6: {path} is no level's episodes on a curve's scenarios (.../{CURVE_LEVELS_DIR}/"
+                         f"SEARCHER/VARIANT.csv from `egosearch evaluate --curve-of VARIANT --policy SEARCHER`, "
+                         f"SEARCHER one of {', '.join(levels)})")
     return name
+
+
+def read_curve_levels(paths: list) -> pd.DataFrame:
+    """A level's episodes on a curve's scenarios (:data:`egosearch.runs.evaluate.CURVE_LEVEL_COLUMNS`), stacked."""
+    frames = []
+    for path in paths:
+        df = read_checked_csv(path, CURVE_LEVEL_COLUMNS, "level's episodes on a curve's scenarios")
+        if df.empty:
+            raise ValueError(f"{path}: no episodes")
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def _scenario_keys(df: pd.DataFrame) -> set:
+    return {(h, round(float(z), 3), int(i), round(float(ell), 3))
+            for h, z, i, ell in zip(df["home"], df["height"], df["scenario_id"], df["shortest_path"])}
 
 
 def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str, str] | None = None,
@@ -150,15 +173,17 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     than 2 seeds were evaluated at that step).
 
     Seeds are aligned on ``env_steps``; at each step only the seeds that have it count.
-    ``level_files``: per-episode CSVs of searchers that do not train (:func:`fig6_levels`: the random
-    searcher, the classical searchers; which one a file is comes from its path, :func:`level_searcher`);
-    each searcher's pooled success rate and Wilson interval become rows named after it, one at every
-    step of the curves (the same level throughout).
+    ``level_files``: the episodes of searchers that do not train (:func:`fig6_levels`: the random
+    searcher, the classical searchers; which one a file is comes from its path, :func:`level_searcher`)
+    on the curves' own scenarios, seeded as the curves' episodes are (``egosearch evaluate --curve-of``):
+    each searcher's success rate and Wilson interval become rows named after it, one at every step of
+    the curves (the same level throughout). ValueError when a level ran other scenarios than a curve's
+    episodes: a level must be read on the episodes its curves are.
     """
     labels = {**FIG6_LABELS, **(labels or {})}
     if not curves:
         raise ValueError("figure6: no training curves given")
-    rows = []
+    rows, curve_episode_sets = [], {}
     for variant, paths in curves.items():
         paths = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
         if not paths:
@@ -167,6 +192,8 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
         if df.empty:
             raise ValueError(f"figure6: the curves of {variant!r} have no evaluated rows")
         episodes = _curve_episodes(paths)
+        if episodes is not None:
+            curve_episode_sets[variant] = episodes[episodes["env_steps"] == episodes["env_steps"].min()]
         for step, g in df.groupby("env_steps", sort=True):
             v = g["success_rate"].to_numpy(dtype=float)
             at = None if episodes is None else episodes[episodes["env_steps"] == step]
@@ -185,15 +212,21 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
     for path in level_files or []:
         by_level.setdefault(level_searcher(path), []).append(path)
     levels = fig6_levels()
+    curve_keys = {variant: _scenario_keys(eps) for variant, eps in curve_episode_sets.items()}
     for name in sorted(by_level, key=list(levels).index):
         if name in curves:
             raise ValueError(f"figure6: a variant may not be called {name!r}, the {levels[name][0]}'s row")
-        eps = read_episodes(by_level[name])
+        eps = read_curve_levels(by_level[name])
+        for variant, keys in curve_keys.items():
+            if _scenario_keys(eps) != keys:
+                raise ValueError(f"figure6: {name}'s episodes ({', '.join(map(str, by_level[name]))}) ran other "
+                                 f"scenarios than {variant}'s curve: a level is read on the curve's own "
+                                 "(`egosearch evaluate --curve-of VARIANT --policy SEARCHER`)")
         k, n = int(eps["success"].astype(int).sum()), len(eps)
         lo, hi = wilson_ci(k, n, confidence)
         for step in sorted({r["env_steps"] for r in rows}):
             rows.append({"variant": name, "label": levels[name][0], "env_steps": step,
-                         "n_seeds": int(eps["seed"].nunique()), "n_scenarios": n, "success_rate": k / n,
+                         "n_seeds": 1, "n_scenarios": n, "success_rate": k / n,
                          "low": lo, "high": hi, "ci_unit": CI_WILSON})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
 

@@ -80,17 +80,40 @@ def write_episodes(path: str | os.PathLike, rows: list[dict]) -> None:
     write_csv_atomic(path, EPISODE_COLUMNS, rows)
 
 
-def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = 7):
+CURVE_SEED = 7
+"""The training curve's scenarios are drawn with this seed, and episode i of them is seeded ``CURVE_SEED +
+scenario_id``: the same episodes at every evaluation step of every training seed."""
+CURVE_LEVEL_COLUMNS = ("home", "height", *EPISODE_COLUMNS)
+"""A searcher's episodes on a training curve's scenarios (``egosearch evaluate --curve-of``): Figure 6's levels.
+Scenario ids restart in each home and height, so the home and height say which scenario a row is."""
+
+
+def curve_scenarios(layout: str | list[str], placement: str, n: int, seed: int = CURVE_SEED) -> list[Scenario]:
+    """The ``n`` held-out scenarios a training curve is evaluated on: ``layout`` (a home, or a list of homes),
+    the three evaluation heights, each (home, height) group drawn with ``seed`` and taken in turn."""
+    layouts = [layout] if isinstance(layout, str) else list(layout)
+    groups = [(home, h) for home in layouts for h in EVAL_HEIGHTS]
+    per_group = [generate_scenarios(home, placement, h, n=-(-n // len(groups)), seed=seed) for home, h in groups]
+    return [sc for i in range(max(map(len, per_group))) for group in per_group for sc in group[i:i + 1]][:n]
+
+
+def curve_episodes(env_id: str, make_policy, scenarios: list[Scenario], progress: bool = False,
+                   desc: str = "evaluate", recorder=None) -> list[dict]:
+    """``make_policy(env)`` on a training curve's scenarios (:func:`curve_scenarios`), each episode seeded as
+    the curve's are: rows of :data:`CURVE_LEVEL_COLUMNS`."""
+    # by home and height, so that each env is built once (the curve interleaves them)
+    grouped = sorted(scenarios, key=lambda sc: (sc.layout, sc.height, sc.scenario_id))
+    rows = evaluate(env_id, make_policy, grouped, seed=CURVE_SEED, progress=progress, desc=desc, recorder=recorder)
+    return [{"home": sc.layout, "height": sc.height, **row} for sc, row in zip(grouped, rows, strict=True)]
+
+
+def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = CURVE_SEED):
     """``evaluate(policy) -> {success_rate, spl, episode_return, episodes}`` on ``n`` fixed held-out
     scenarios of ``layout`` (a home, or a list of homes taken in turn), the three evaluation heights
     in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
     ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
     variant trains with, so that the curves of variants are on one scale."""
-    layouts = [layout] if isinstance(layout, str) else list(layout)
-    groups = [(home, h) for home in layouts for h in EVAL_HEIGHTS]
-    per_group = [generate_scenarios(home, placement, h, n=-(-n // len(groups)), seed=seed) for home, h in groups]
-    scenarios = [sc for i in range(max(map(len, per_group))) for group in per_group
-                 for sc in group[i:i + 1]][:n]
+    scenarios = curve_scenarios(layout, placement, n, seed)
     envs: dict = {}
 
     def evaluate_policy(policy) -> dict:

@@ -235,14 +235,9 @@ def bound_files(bounds=BOUNDS, placements=None, homes=None):
 
 
 def fig6_level_files():
-    """The random and classical searchers (head moving and head fixed) on the Table 1 cells the reference
-    is evaluated in during training (Figure 6's curves): their levels in that figure."""
-    from egosearch.sim.home_pool import curve_homes
-
-    train_env = VARIANTS[REF].train_env
-    homes = [h for h in curve_homes(train_env) if h in HOMES]
-    levels = [b for b in BOUNDS if searchers.get(b).fig6_level]
-    return bound_files(levels, [train_env["placement"]], homes) if train_env["placement"] in PLACEMENTS and homes else []
+    """The random and classical searchers (head moving and head fixed) on the scenarios the reference's training
+    curve is evaluated on, each episode seeded as the curve's: their levels in Figure 6 (rule curve_level)."""
+    return [f"{RESULTS}/eval_curve/{s}/{REF}.csv" for s in BOUNDS if searchers.get(s).fig6_level]
 
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top

@@ -52,6 +52,51 @@ rule evaluate_start:
 ruleorder: bound > evaluate
 
 
+rule curve_level:
+    """A searcher without training (the random and classical searchers) on the held-out scenarios a
+    variant's training curve is evaluated on, each episode seeded as the curve's: its level in Figure 6,
+    read on the curve's own episodes."""
+    output:
+        "results/{profile}/eval_curve/{bound}/{variant}.csv",
+    log:
+        "results/{profile}/logs/eval_curve/{bound}/{variant}.log",
+    benchmark:
+        "results/{profile}/benchmarks/eval_curve/{bound}/{variant}.tsv"
+    wildcard_constraints:
+        bound="|".join(REFERENCE_SEARCHERS),
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=15,
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch evaluate --force --policy {wildcards.bound} --curve-of {wildcards.variant} "
+        "--profile {wildcards.profile} --out {output} > {log} 2>&1"
+
+
+rule tune_teacher:
+    """The tuned frontier searcher's tuning run again (not part of `all`): every candidate on a training-side
+    fit split, the one chosen and the untuned searcher on a held-out split, never a stored set; the record
+    says whether the shipped parameters still win and what they do held out. About 13,000 episodes."""
+    output:
+        "results/{profile}/teacher_tuning/record.json",
+    log:
+        "results/{profile}/logs/teacher_tuning.log",
+    benchmark:
+        "results/{profile}/benchmarks/teacher_tuning.tsv"
+    threads: 1
+    resources:
+        mem_mb=1500,
+        runtime=300,
+    params:
+        out=lambda wc, output: os.path.dirname(output[0]),
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch tune --force --out {params.out} > {log} 2>&1"
+
+
 rule bound:
     """A reference searcher on one Table 1 cell: the random searcher, the classical frontier searcher
     (head moving or held fixed), the privileged oracle (it knows the target) or the modular searcher's

@@ -334,6 +334,12 @@ rule versus_teacher:
                                                        f"{claims_pairs(config)[0][1]}_vs_frontier_head_off"]),
 
 
+rule teacher_tuning:
+    """`snakemake --cores 1 teacher_tuning`: the tuned teacher's tuning run again (egosearch.runs.teacher_tuning)."""
+    input:
+        f"{RESULTS}/teacher_tuning/record.json",
+
+
 rule decisions_floor_compare:
     """One variant of the pair against its floor (all its seeds against the floor's one)."""
     input:
