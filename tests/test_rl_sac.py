@@ -297,6 +297,26 @@ def test_the_configs_forms_of_r_d_are_the_envs():
     from egosearch.sim.env import DISTANCE_REWARDS as ENV_DISTANCE_REWARDS
 
     assert DISTANCE_REWARDS == ENV_DISTANCE_REWARDS
+    # and a variant file's env may name each of them (the schema that checks it lists the same)
+    import json
+    from pathlib import Path
+
+    import egosearch.workflow
+
+    schema = json.loads((Path(egosearch.workflow.__file__).parent / "variant.schema.json").read_text())
+    found = [node["enum"] for node in _walk(schema) if "distance_reward" in node.get("properties", {})
+             for node in [node["properties"]["distance_reward"]]]
+    assert found and all(tuple(e) == ENV_DISTANCE_REWARDS for e in found)
+
+
+def _walk(node):
+    if isinstance(node, dict):
+        yield node
+        for value in node.values():
+            yield from _walk(value)
+    elif isinstance(node, list):
+        for value in node:
+            yield from _walk(value)
 
 
 def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):

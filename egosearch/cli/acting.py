@@ -73,10 +73,13 @@ def check_searcher_env(kind: str, env_id: str | None) -> None:
                          "body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out")
     wanted, head = searchers.get(kind).head, env_options(env_id).head
     if wanted is not None and wanted != head:
-        other = kind.removesuffix("_head_off") if not wanted else f"{kind}_head_off"
+        # the same searcher with the other head, where one is registered (the same policy factory)
+        factory = searchers.get(kind).factory
+        others = [s.name for s in searchers.SEARCHERS.values() if s.head == head and s.factory == factory]
+        hint = f", or use --policy {others[0]}" if others else ""
         raise ValueError(f"--env-id={env_id} {'moves' if head else 'fixes'} the head, and --policy {kind} is the "
                          f"searcher with the head {'moving' if wanted else 'fixed'}: its rows would be read under "
-                         f"that name; leave --env-id out, or use --policy {other}")
+                         f"that name; leave --env-id out{hint}")
 
 
 STORED_PROFILE = "cpu"

@@ -148,13 +148,14 @@ class PooledSettings:
     average-pooled, then convs of which the first few have stride 2."""
 
     obs_downsample: int = 1
-    """Ours ("sac_drq" only; the paper: 1): the 100 x 100 depth frames are average-pooled by this
+    """Ours (the pooled learners, every one with these settings: sac_drq, sac_drq_recurrent, ppo; the paper: 1):
+    the 100 x 100 depth frames are average-pooled by this
     factor before the encoder (2 -> 50 x 50), as PointNav learners train from 64 x 64 depth
     (Shacklett et al., bps-nav, ICLR 2021). The env, its mask and success test stay at 100 x 100.
     The ``cpu`` profile sets 2 (see :func:`cpu_profile`)."""
     encoder_stride2_layers: int = 1
-    """CURL: 1 (the first conv has stride 2, the rest stride 1). "sac_drq" only: the first this
-    many convs have stride 2 (smaller maps, far fewer FLOPs)."""
+    """CURL: 1 (the first conv has stride 2, the rest stride 1). The pooled learners (sac_drq,
+    sac_drq_recurrent, ppo): the first this many convs have stride 2 (smaller maps, far fewer FLOPs)."""
 
     def own_checks(self, bad: Complaint) -> None:
         if self.obs_downsample < 1:
@@ -174,8 +175,9 @@ class RandomShiftSettings(PooledSettings):
     """DrQ-v2's random shift of the pooled frames in SAC-DrQ's updates."""
 
     aug_pad: int = 4
-    """DrQ-v2: 4 ("sac_drq" only): the random shift pads by this many pixels (replicating the
-    border) and crops back to the pooled size. "sac_curl" uses Table 2's random crop instead."""
+    """DrQ-v2: 4 (the SAC-DrQ learners: sac_drq, sac_drq_recurrent): the random shift pads by this many
+    pixels (replicating the border) and crops back to the pooled size. "sac_curl" uses Table 2's random
+    crop instead."""
 
     def own_checks(self, bad: Complaint) -> None:
         if self.aug_pad < 0:
