@@ -9,9 +9,28 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
+from egosearch.workflow.cluster import is_cluster, partitions_asked, slurm_run_problem, snakemake_executor
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
 from egosearch.workflow.check import claims_pairs
+
+# The executor of this run (--executor, or a profile's executor:, as profiles/slurm names slurm): Snakemake
+# parses the Snakefile before it hands the run its executor, so workflow.local_exec cannot tell
+# (egosearch.workflow.cluster). Under a cluster executor each job is a cluster job of its own.
+EXECUTOR = snakemake_executor()
+LOCAL_RUN = not is_cluster(EXECUTOR)
+if EXECUTOR == "slurm" and workflow.is_main_process:
+    # sbatch, squeue and sinfo on PATH (a real run), and every slurm_partition the run names on the cluster:
+    # one line here, before the first job, not an sbatch error per job once the run has started
+    _problem = slurm_run_problem(
+        workflow.output_settings.dryrun,
+        partitions_asked(getattr(workflow.resource_settings.default_resources, "args", None) or [],
+                         workflow.resource_settings.overwrite_resources or {}))
+    if _problem:
+        import sys
+
+        print(f"egosearch: error: {_problem}", file=sys.stderr)
+        sys.exit(1)
 
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"
@@ -66,7 +85,7 @@ def cores_given():
     import sys
 
     argv = sys.argv[1:]
-    if not workflow.local_exec or any(a in ("-e", "--executor") or a.startswith("--executor=") for a in argv):
+    if not LOCAL_RUN:
         return None
     named = any(a == "--cores" or a.startswith("--cores=") or (a.startswith("-c") and not a.startswith("--"))
                 for a in argv)
@@ -123,7 +142,6 @@ def provenance_file():
 # machine each asks for one of `gpu_slots`, which the run offers that many of (unless the command line's
 # --resources names gpu_slots: then that many), and takes a fair share of --cores; under a cluster executor each
 # training is a job asking for a whole GPU. Outputs and paths are the same either way.
-LOCAL_RUN = workflow.local_exec
 if PROFILE == "paper":
     try:
         TRAININGS_PER_GPU = resolve_trainings_per_gpu(config.get("trainings_per_gpu", "auto"), LOCAL_RUN)
