@@ -274,26 +274,28 @@ def killed_jobs(log_text: str, read=lambda path: Path(path).read_text(errors="re
 
 
 def killed_job_line(job: dict, checkpoint: Path | None, exists=Path.exists) -> str:
-    """One line for a job Slurm killed: what stopped it, what the same command does next (a training resumes
-    from ``checkpoint`` where one was written; nothing the job wrote is taken for an output), and the
-    ``--set-resources`` that gives it more."""
+    """One line for a job Slurm killed: which limit stopped it, that none of its outputs is kept (Snakemake
+    deletes a failed job's outputs; a training publishes its own only once it is complete), the
+    ``--set-resources`` that gives it more, and what running it again does (a training resumes from
+    ``checkpoint`` where one was written)."""
     rule = job["rule"]
     what = f"{rule} ({', '.join(job['outputs'][:1]) or 'no output'}; Slurm job {job['slurm_job']})"
     if job["limit"] == "time":
         asked = f"runtime={job['runtime']} min" if job["runtime"] else "its runtime"
         stopped = f"stopped by Slurm at its time limit ({asked})"
-        more = f"--set-resources {rule}:runtime={2 * job['runtime'] if job['runtime'] else 'MINUTES'}"
+        doubled = 2 * job["runtime"] if job["runtime"] else "MINUTES"
+        more = f"with more time if it needs it (--set-resources {rule}:runtime={doubled})"
     else:
         asked = f"mem_mb={job['mem_mb']}" if job["mem_mb"] else "its mem_mb"
         stopped = f"killed by Slurm for using more memory than it asked for ({asked})"
-        more = f"--set-resources {rule}:mem_mb={2 * job['mem_mb'] if job['mem_mb'] else 'MB'}"
+        more = f"with more memory (--set-resources {rule}:mem_mb={2 * job['mem_mb'] if job['mem_mb'] else 'MB'})"
     if checkpoint is not None and exists(checkpoint):
-        again = f"the same command resumes it from its checkpoint ({checkpoint})"
+        again = f"it resumes from its checkpoint ({checkpoint})"
     elif checkpoint is not None:
-        again = "the same command starts it again (it had written no checkpoint yet)"
+        again = "it starts over (it had written no checkpoint yet)"
     else:
-        again = "the same command runs it again"
-    return f"egosearch: {what} was {stopped}; none of its outputs is kept: {again}; to give it more: {more}"
+        again = "it starts over"
+    return f"egosearch: {what} was {stopped}; none of its outputs is kept; run it again {more}: {again}"
 
 
 def killed_job_lines(log_paths, checkpoint_of: Callable[[str, list[str]], Path | None] = lambda rule, outputs: None,
