@@ -81,19 +81,9 @@ if (workflow.is_main_process and workflow.output_settings.dryrun
 # printed at exit, once Snakemake has built the DAG and listed its jobs (a dry run calls no onstart).
 if (workflow.is_main_process and workflow.output_settings.dryrun and EXECUTOR == "slurm"
         and Quietness.ALL not in (workflow.output_settings.quiet or ())):
-    import atexit
+    from egosearch.workflow.cluster import print_sbatch_plan_at_exit
 
-    def print_sbatch_plan():
-        from egosearch.workflow.cluster import sbatch_plan
-
-        dag = getattr(workflow, "dag", None)
-        lines = sbatch_plan(dag.jobs, workflow.resource_settings.overwrite_threads,
-                            getattr(workflow, "_localrules", ())) if dag is not None else []
-        if lines:
-            print("What each job asks sbatch for (the slurm plugin adds its job name, log and account):", *lines,
-                  sep="\n", file=sys.stderr)
-
-    atexit.register(print_sbatch_plan)
+    print_sbatch_plan_at_exit(workflow)
 
 
 # A job that Slurm killed at its time or memory limit: one line each when the run stops, saying which
@@ -101,14 +91,9 @@ if (workflow.is_main_process and workflow.output_settings.dryrun and EXECUTOR ==
 # --set-resources that gives it more (egosearch.workflow.cluster.killed_job_lines).
 onerror:
     if EXECUTOR == "slurm":
-        from egosearch.rl.run_files import CHECKPOINT_NAME
         from egosearch.workflow.cluster import killed_job_lines
 
-        def checkpoint_of(rule, outputs):
-            # the train rule's work folder (rules/train.smk: params.work_dir) beside its outputs
-            return Path(outputs[0]).parent / "partial" / CHECKPOINT_NAME if rule == "train" and outputs else None
-
-        for line in killed_job_lines(log, checkpoint_of):
+        for line in killed_job_lines(log, train_checkpoint):
             print(line, file=sys.stderr)
 
 

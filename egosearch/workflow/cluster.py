@@ -200,6 +200,22 @@ def sbatch_plan(jobs, overwrite_threads: Mapping[str, int] | None = None, local_
     return lines
 
 
+def print_sbatch_plan_at_exit(workflow, file=None) -> None:
+    """Print :func:`sbatch_plan` of ``workflow``'s DAG when the process exits: after a dry run has built the DAG
+    and listed its jobs (Snakemake calls no hook after a dry run). Nothing where no DAG was built."""
+    import atexit
+
+    def print_plan():
+        dag = getattr(workflow, "dag", None)
+        lines = sbatch_plan(dag.jobs, workflow.resource_settings.overwrite_threads,
+                            getattr(workflow, "_localrules", ())) if dag is not None else []
+        if lines:
+            print("What each job asks sbatch for (the slurm plugin adds its job name, log and account):", *lines,
+                  sep="\n", file=file or sys.stderr)
+
+    atexit.register(print_plan)
+
+
 # ---- a job Slurm killed ------------------------------------------------------------------------------------
 
 _TIME_SIGNS = ("DUE TO TIME LIMIT",)

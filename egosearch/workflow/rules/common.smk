@@ -102,6 +102,14 @@ def eval_files(variant, homes=None):
                   seed=SEEDS, home=homes or HOMES, placement=PLACEMENTS, height=HEIGHTS)
 
 
+def train_checkpoint(rule, outputs):
+    """The checkpoint a job of ``rule`` resumes from after a kill: a training's, in its work folder beside its
+    outputs (rules/train.smk: params.work_dir); None for every other rule, which starts over."""
+    from egosearch.rl.run_files import CHECKPOINT_NAME
+
+    return Path(outputs[0]).parent / "partial" / CHECKPOINT_NAME if rule == "train" and outputs else None
+
+
 def start_actor(actor_path):
     """The start actor file beside a run's actor.pt (imported here, not at the top: it loads torch)."""
     from egosearch.rl.run_files import START_ACTOR_NAME
