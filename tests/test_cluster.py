@@ -28,7 +28,13 @@ from egosearch.workflow.cluster import (
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
+RUNNING_MD = REPO / "docs" / "running.md"
 PLAN_HEAD = "What each job asks sbatch for (the slurm plugin adds its job name, log and account):"
+
+
+def _running_md() -> str:
+    """docs/running.md as one line of words (its "On a cluster" section names the options)."""
+    return " ".join(RUNNING_MD.read_text(encoding="utf-8").split())
 
 
 def _dry_run(*args) -> str:
@@ -108,6 +114,7 @@ def test_a_paper_training_under_slurm_asks_for_one_gpu_and_the_dry_run_says_so()
     assert "egosearch train --force --variant head_on --profile paper --seed 0 --threads 1 " in text
     plan = _plan(text)
     assert plan["train"] == (1, "-t 720 --mem 8000 --cpus-per-task=1 --gpus=1")
+    assert f"A paper-profile training asks for `{plan['train'][1]}`" in _running_md()
     assert plan["scenarios"] == (1, "-t 10 --mem 1000 --ntasks=1 --cpus-per-task=1")
     _check_plan_against_the_jobs(text)
     # on this machine the same training asks for one of the run's GPU shares, and no plan is printed
@@ -139,6 +146,7 @@ def test_the_slurm_profile_asks_sbatch_for_what_each_job_uses():
     assert profile["executor"] == "slurm" and profile["slurm-status-command"] == "squeue"
     assert _plan(text)["table1"][1] == (f"-t {profile['default-resources']['runtime']} "
                                         f"--mem {profile['default-resources']['mem_mb']} --ntasks=1 --cpus-per-task=1")
+    assert f"a cpu-profile one for `{_plan(text)['train'][1]}`" in _running_md()  # the page says what is asked
     asked = {}
     for rule, jobs in jobs_by_rule.items():
         for job in jobs:
