@@ -76,6 +76,27 @@ if (workflow.is_main_process and workflow.output_settings.dryrun
         print_costs(named, config, PROFILE, SEEDS, REF, cores_given(), trainings_per_gpu=TRAININGS_PER_GPU)
 
 
+# A dry run under --executor slurm (`snakemake -n --workflow-profile profiles/slurm all`) ends with what each of
+# its jobs asks sbatch for, per rule, as the slurm plugin renders it (egosearch.workflow.cluster.sbatch_plan):
+# printed at exit, once Snakemake has built the DAG and listed its jobs (a dry run calls no onstart).
+if (workflow.is_main_process and workflow.output_settings.dryrun and EXECUTOR == "slurm"
+        and Quietness.ALL not in (workflow.output_settings.quiet or ())):
+    from egosearch.workflow.cluster import print_sbatch_plan_at_exit
+
+    print_sbatch_plan_at_exit(workflow)
+
+
+# A job that Slurm killed at its time or memory limit: one line each when the run stops, saying which
+# limit, what the same command does next (a training resumes from its checkpoint in partial/) and the
+# --set-resources that gives it more (egosearch.workflow.cluster.killed_job_lines).
+onerror:
+    if EXECUTOR == "slurm":
+        from egosearch.workflow.cluster import killed_job_lines
+
+        for line in killed_job_lines(log, train_checkpoint):
+            print(line, file=sys.stderr)
+
+
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other
 # snakemake runs here, then --rerun-incomplete (profiles/default) reruns the killed jobs.
 if workflow.is_main_process:

@@ -1,6 +1,7 @@
 """Bad input as a new user types it: each is exactly one line naming what is wrong, before any
 work starts, and never a traceback. The cases are the README's bad-input table."""
 
+import os
 import re
 import shutil
 import subprocess
@@ -1467,3 +1468,96 @@ def test_a_smoke_runs_outputs_are_git_ignored():
     out = subprocess.run(["git", "check-ignore", *paths], cwd=REPO, capture_output=True, text=True)
     assert out.stdout.split() == paths
     assert subprocess.run(["git", "check-ignore", "-q", "results/cpu/provenance.json"], cwd=REPO).returncode == 1
+
+
+# --------------------------------------------------------------------------- issue 58: the DAG on a cluster
+# The form of issue 57's snakemake rows, with the PATH each runs with: "no slurm" (Slurm's commands taken off
+# PATH: a machine that cannot submit), "sinfo lists" (sbatch, squeue and a sinfo listing the partitions debug,
+# the default, and gpu: a login node) or "sinfo fails" (the same, its controller not answering); and whether it
+# is a dry run (-n) or a real one, stopped before its first job. A job Slurm kills at its time or memory limit
+# is one line too, when the run stops (tests/test_cluster.py, tests/test_slurm.py on a real Slurm).
+SLURM_PAPER = ["--config", "profile=paper"]
+ISSUE58_SNAKEMAKE = [
+    ("slurm_without_sbatch", "cryptic", "no slurm", False,
+     ["table2", "--executor", "slurm", "--jobs", "2", "--config", "profile=smoke"],
+     "egosearch: error: --executor slurm: sbatch is not on PATH here, so no job could be submitted or followed; run "
+     "snakemake on a machine that submits to Slurm (a login node, where sbatch, squeue, sinfo are), or leave "
+     "--executor slurm (and --workflow-profile profiles/slurm) out to run on this machine"),
+    ("slurm_trainings_per_gpu_two", "silent", None, True,
+     ["all", "--executor", "slurm", "--jobs", "6", *SLURM_PAPER, "trainings_per_gpu=2"],
+     "egosearch: error: config trainings_per_gpu: 2 shares one GPU between trainings on the machine snakemake runs "
+     "on; under a cluster executor each training is a job of its own with a whole GPU (gpu=1): leave it auto or 1 "
+     "there, or run snakemake with --cores inside one GPU allocation"),
+    ("slurm_partition_unknown", "cryptic", "sinfo lists", True,
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke", "--default-resources",
+      "slurm_partition=gpuz"],
+     "egosearch: error: --default-resources slurm_partition=gpuz: no such partition on this cluster (sinfo lists: "
+     "debug, gpu); name one of them, or leave slurm_partition out (each job then goes to the cluster's default "
+     "partition, debug)"),
+    ("slurm_rule_partition_unknown", "cryptic", "sinfo lists", False,
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke", "--set-resources",
+      "table2:slurm_partition=gpus"],
+     "egosearch: error: --set-resources table2:slurm_partition=gpus: no such partition on this cluster (sinfo "
+     "lists: debug, gpu); name one of them, or leave slurm_partition out (each job then goes to the cluster's "
+     "default partition, debug)"),
+    ("slurm_controller_unreachable", "cryptic", "sinfo fails", False,
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke"],
+     "egosearch: error: --executor slurm: sinfo failed: sinfo: error: Unable to contact slurm controller (connect "
+     "failure); run snakemake where Slurm's controller answers (a login node; SLURM_CONF names the cluster's "
+     "slurm.conf)"),
+]
+COUNTS_BEFORE_58 = {"clear": 0, "cryptic": 4, "traceback": 0, "silent": 1, "damage": 0}
+"""What the rows did before: the first, third, fourth and fifth ran the DAG and failed at its first submission
+(`Job submission failed with exception: [Errno 2] No such file or directory: 'sacct'`; an sbatch error, `invalid
+partition specified`, per job; sinfo's DNS lookup); the second ran, each training asking for a share of this
+machine's GPU (gpu_slots) instead of a GPU of its own."""
+SLURM_NOTICE = "Using workflow specific profile profiles/slurm for setting default command line arguments."
+
+
+@pytest.fixture(scope="module")
+def slurm_paths(tmp_path_factory):
+    """PATH for each row: this one without Slurm's commands (a folder of links to everything else on it), or
+    with stand-ins for them first."""
+    root = tmp_path_factory.mktemp("slurm_paths")
+    bare = root / "no_slurm"
+    bare.mkdir()
+    for folder in os.environ.get("PATH", "").split(os.pathsep):
+        if not os.path.isdir(folder):
+            continue
+        for entry in sorted(os.listdir(folder)):
+            if entry in ("sbatch", "squeue", "sinfo", "sacct", "scontrol", "srun", "scancel", "salloc", "sstat"):
+                continue
+            if not (bare / entry).exists() and os.access(os.path.join(folder, entry), os.X_OK):
+                (bare / entry).symlink_to(os.path.join(folder, entry))
+    paths = {"no slurm": str(bare)}
+    for name, sinfo in (("sinfo lists", "printf 'debug*\\ngpu\\n'"),
+                        ("sinfo fails", "echo 'sinfo: error: Unable to contact slurm controller (connect failure)' >&2"
+                                        "; exit 1")):
+        stand_ins = root / name.replace(" ", "_")
+        stand_ins.mkdir()
+        for command, body in (("sbatch", "exit 1"), ("squeue", "exit 1"), ("sinfo", sinfo)):
+            (stand_ins / command).write_text(f"#!/bin/sh\n{body}\n")
+            (stand_ins / command).chmod(0o755)
+        paths[name] = f"{stand_ins}{os.pathsep}{os.environ.get('PATH', '')}"
+    return paths
+
+
+def test_issue_58s_counts_before():
+    before = dict.fromkeys(BEFORE_KINDS_48, 0)
+    for case in ISSUE58_SNAKEMAKE:
+        before[case[1]] += 1
+    assert before == COUNTS_BEFORE_58
+    names = [c[0] for c in ISSUE58_SNAKEMAKE] + [name for name, _ in issue57_rows()] + [c[0] for c in CLI_CASES]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("case", ISSUE58_SNAKEMAKE, ids=[c[0] for c in ISSUE58_SNAKEMAKE])
+def test_issue_58s_cluster_rows_are_one_line_before_any_job(case, suite, slurm_paths):
+    _, _, path, dry, args, message = case
+    env = {**os.environ, **({"PATH": slurm_paths[path]} if path else {})}
+    out = subprocess.run([sys.executable, "-m", "snakemake", *(["-n"] if dry else []), *args], cwd=suite, env=env,
+                         capture_output=True, text=True, timeout=600)
+    lines = [line for line in (out.stdout + out.stderr).splitlines()
+             if line.strip() and line not in (*NOTICES, SLURM_NOTICE)]
+    assert out.returncode == 1 and lines == [message], (out.stdout + out.stderr)[-3000:]
+    assert not (suite / "results" / "smoke").exists()      # no job ran

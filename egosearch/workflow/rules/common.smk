@@ -9,9 +9,28 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
+from egosearch.workflow.cluster import is_cluster, partitions_asked, slurm_run_problem, snakemake_executor
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
 from egosearch.workflow.check import claims_pairs
+
+# The executor of this run (--executor, or a profile's executor:, as profiles/slurm names slurm): Snakemake
+# parses the Snakefile before it hands the run its executor, so workflow.local_exec cannot tell
+# (egosearch.workflow.cluster). Under a cluster executor each job is a cluster job of its own.
+EXECUTOR = snakemake_executor()
+LOCAL_RUN = not is_cluster(EXECUTOR)
+if EXECUTOR == "slurm" and workflow.is_main_process:
+    # sbatch, squeue and sinfo on PATH (a real run), and every slurm_partition the run names on the cluster:
+    # one line here, before the first job, not an sbatch error per job once the run has started
+    _problem = slurm_run_problem(
+        workflow.output_settings.dryrun,
+        partitions_asked(getattr(workflow.resource_settings.default_resources, "args", None) or [],
+                         workflow.resource_settings.overwrite_resources or {}))
+    if _problem:
+        import sys
+
+        print(f"egosearch: error: {_problem}", file=sys.stderr)
+        sys.exit(1)
 
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"
@@ -66,7 +85,7 @@ def cores_given():
     import sys
 
     argv = sys.argv[1:]
-    if not workflow.local_exec or any(a in ("-e", "--executor") or a.startswith("--executor=") for a in argv):
+    if not LOCAL_RUN:
         return None
     named = any(a == "--cores" or a.startswith("--cores=") or (a.startswith("-c") and not a.startswith("--"))
                 for a in argv)
@@ -81,6 +100,14 @@ def cores_given():
 def eval_files(variant, homes=None):
     return expand(f"{RESULTS}/eval/{variant}/seed{{seed}}/{{home}}/{{placement}}/h{{height}}.csv",
                   seed=SEEDS, home=homes or HOMES, placement=PLACEMENTS, height=HEIGHTS)
+
+
+def train_checkpoint(rule, outputs):
+    """The checkpoint a job of ``rule`` resumes from after a kill: a training's, in its work folder beside its
+    outputs (rules/train.smk: params.work_dir); None for every other rule, which starts over."""
+    from egosearch.rl.run_files import CHECKPOINT_NAME
+
+    return Path(outputs[0]).parent / "partial" / CHECKPOINT_NAME if rule == "train" and outputs else None
 
 
 def start_actor(actor_path):
@@ -123,7 +150,6 @@ def provenance_file():
 # machine each asks for one of `gpu_slots`, which the run offers that many of (unless the command line's
 # --resources names gpu_slots: then that many), and takes a fair share of --cores; under a cluster executor each
 # training is a job asking for a whole GPU. Outputs and paths are the same either way.
-LOCAL_RUN = workflow.local_exec
 if PROFILE == "paper":
     try:
         TRAININGS_PER_GPU = resolve_trainings_per_gpu(config.get("trainings_per_gpu", "auto"), LOCAL_RUN)
@@ -158,9 +184,10 @@ def train_resources(profile):
         # machine a share of its GPU (gpu_slots, above), under a cluster executor a whole one
         return dict(mem_mb=8000, runtime=12 * 60, **(dict(gpu_slots=1) if LOCAL_RUN else dict(gpu=1)))
     if profile == "cpu":
-        # a per-step training with its teacher's episodes takes about an hour alone on the reference CPU;
-        # hosts differ up to 3x
-        return dict(mem_mb=3000, runtime=180, gpu=0)
+        # a per-step training with its teacher's episodes takes about an hour alone on the reference CPU, and
+        # hosts differ up to 3x: the stored run's longest took 191 min (a 50 px variant with the target memory),
+        # its profile's own trainings up to 108 min; the largest held 2.5 GB (tests/test_cluster.py reads them)
+        return dict(mem_mb=3000, runtime=6 * 60, gpu=0)
     return dict(mem_mb=1500, runtime=10, gpu=0)
 
 
