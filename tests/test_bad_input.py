@@ -1125,7 +1125,47 @@ def bad(tmp_path_factory):
         copy(ref, f"prof/results/cpu/eval/{variant}/seed0/kitchen_living/everywhere/h1.05.csv")
         write(f"prof/results/cpu/train/{variant}/seed0/config.json",
               json.dumps({"variant": variant, "config": config}).encode())
+    # issue 57: a stopped run of head_on at the cpu profile (its checkpoint's header) whose demonstrations are not
+    # its own, or not whole
+    from egosearch.rl.demos import wanted_summary
+    from egosearch.rl.run_files import CHECKPOINT_FORMAT
+
+    wanted = wanted_summary(resolved.env_id, resolved.config, resolved.train_env, "head_on")
+    other = resolve_variant("head_off", "cpu", {"seed": 0})
+    smoke = resolve_variant("head_on", "smoke", {"seed": 0})
+    runs = {"dr_variant": (wanted | wanted_summary(other.env_id, other.config, other.train_env, "head_off"), 50, 2),
+            "dr_profile": ({k: v for k, v in (wanted | wanted_summary(smoke.env_id, smoke.config, smoke.train_env,
+                                                                    episodes=1500)).items() if k != "variant"}, 100, 2),
+            "dr_npz": (wanted, 100, 3), "dr_cut": (wanted, 50, 2), "dr_nosummary": (wanted, 50, 2)}
+    for run, (summary, side, transitions) in runs.items():
+        header = {"format": CHECKPOINT_FORMAT, "variant": "head_on", "env_id": resolved.env_id,
+                  "env_kwargs": env_kwargs_key(resolved.train_env), "config": resolved.config.to_dict()}
+        (t / run / "ckpt").mkdir(parents=True)
+        torch.save(header, t / run / "ckpt" / "train_state.ckpt")
+        fake_demos(t / run / "ckpt" / "demos.replay.npz", side, transitions, {**summary, "transitions": 2})
+    cut = (t / "dr_cut/ckpt/demos.replay.npz").read_bytes()
+    (t / "dr_cut/ckpt/demos.replay.npz").write_bytes(cut[: len(cut) // 2])
+    (t / "dr_nosummary/ckpt/demos.json").unlink()
     return t
+
+
+def fake_demos(path: Path, side: int, transitions: int, summary: dict) -> None:
+    """A demonstrations file of ``transitions`` blank steps with ``side`` px frames, and the summary ``summary``."""
+    import json
+
+    import numpy as np
+
+    from egosearch.rl.demos import DEMO_FORMAT, summary_path
+    from egosearch.rl.replay import ReplayBuffer
+
+    k, state_dim = summary["frame_history"], 4
+    buffer = ReplayBuffer(transitions, side, k, 8, 4, 5, state_dim=state_dim)
+    obs = {"depth": np.zeros((k, side, side), np.uint8), "mask": np.zeros(8), "proprio": np.zeros(4),
+           "state": np.zeros(state_dim)}
+    for step in range(transitions):
+        buffer.add(obs, np.zeros(5), 0.0, obs, False, step == transitions - 1)
+    buffer.save(path)
+    summary_path(path).write_text(json.dumps({"format": DEMO_FORMAT, **summary, "state_dim": state_dim}))
 
 
 @pytest.fixture
@@ -1369,18 +1409,45 @@ ISSUE57_ENV_OPTIONS = [
      "max_steps=-5: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
      "before an episode is truncated)"),
 ]
+# Item 3: a stopped run of head_on (cpu, seed 0) resumed with demonstrations that are not its own, or not whole
+# (fixture `bad`): refused before any env is built, naming the file and what was expected.
+RESUME = "egosearch train: error: --out-dir: {t}/%s/ckpt/train_state.ckpt cannot resume with its demonstrations: "
+HEAD_ON_KWARGS = ("{'distance_reward': 'progress', 'train_heights': [0.45, 1.8], 'privileged_state': True, 'layout': "
+                  "'paper_homes', 'placement': 'everywhere'}")
+ISSUE57_DEMOS = [
+    ("train_resume_with_another_variants_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
+                                                               "{t}/dr_variant"],
+     RESUME % "dr_variant" + "{t}/dr_variant/ckpt/demos.replay.npz holds other demonstrations than this run's: "
+     "variant='head_off', env_id='EgoSearchNoHeadMemory-v0'; expected variant='head_on', env_id='EgoSearchMemory-v0'"),
+    ("train_resume_with_another_profiles_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
+                                                               "{t}/dr_profile"],
+     RESUME % "dr_profile" + "{t}/dr_profile/ckpt/demos.replay.npz holds other demonstrations than this run's: "
+     "env_id='EgoSearch-v0', env_kwargs={'layout': 'paper_homes', 'placement': 'everywhere'}, image_size=100; "
+     f"expected env_id='EgoSearchMemory-v0', env_kwargs={HEAD_ON_KWARGS}, image_size=50"),
+    ("train_resume_with_the_npz_replaced", "cryptic", ["train", "--variant", "head_on", "--out-dir", "{t}/dr_npz"],
+     RESUME % "dr_npz" + "{t}/dr_npz/ckpt/demos.replay.npz does not match its summary demos.json: the file holds "
+     "image_size=100, transitions=3; the summary says image_size=50, transitions=2"),
+    ("train_resume_with_a_truncated_npz", "traceback", ["train", "--variant", "head_on", "--out-dir", "{t}/dr_cut"],
+     RESUME % "dr_cut" + "{t}/dr_cut/ckpt/demos.replay.npz: not a readable demonstrations file, truncated or corrupt "
+     "(BadZipFile: File is not a zip file); expected the .npz `egosearch demos` writes, of 2 transitions as "
+     "demos.json says"),
+    ("train_resume_without_the_demos_summary", "cryptic", ["train", "--variant", "head_on", "--out-dir",
+                                                           "{t}/dr_nosummary"],
+     RESUME % "dr_nosummary" + "{t}/dr_nosummary/ckpt/demos.replay.npz: its summary {t}/dr_nosummary/ckpt/demos.json "
+     "is not there (`egosearch demos` writes both)"),
+]
 # (id, before, the input): accepted now, as what it means
 ISSUE57_ACCEPTED = [
     ("variant_file_bare_config", "cryptic", HEAD + "config:\n"),
 ]
-COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 9, "traceback": 0, "silent": 12, "damage": 0}
+COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 11, "traceback": 3, "silent": 12, "damage": 0}
 """What the rows above did before the fix; after it each is one clear line before any work."""
 
 
 def issue57_rows():
     return ([c[:2] for c in ISSUE57_CASES] + [c[:2] for c in ISSUE57_CONFIGS]
             + [c[:2] for c in ISSUE57_VARIANT_FILES] + [c[:2] for c in ISSUE57_SNAKEMAKE]
-            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS])
+            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS] + [c[:2] for c in ISSUE57_DEMOS])
 
 
 def test_issue_57s_counts_before():
@@ -1394,6 +1461,17 @@ def test_issue_57s_counts_before():
 
 @pytest.mark.parametrize("case", ISSUE57_CASES, ids=[c[0] for c in ISSUE57_CASES])
 def test_issue_57s_commands_are_one_clear_line(case, bad, capsys, monkeypatch, nothing_runs):
+    test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
+
+
+@pytest.mark.parametrize("case", ISSUE57_DEMOS, ids=[c[0] for c in ISSUE57_DEMOS])
+def test_issue_57s_demonstrations_are_refused_on_resume_before_any_env(case, bad, capsys, monkeypatch, nothing_runs):
+    import egosearch.rl.train
+
+    def built(*args, **kwargs):
+        raise AssertionError("an env was built before the demonstrations were refused")
+
+    monkeypatch.setattr(egosearch.rl.train, "make_train_env", built)
     test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
 
 
