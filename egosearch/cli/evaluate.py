@@ -19,7 +19,7 @@ def run(args) -> None:
     check_suffix("--traces", args.traces, (".npz",), "a trace file")
     check_seed("--seed", args.seed)
     check_threads(args.threads)
-    if args.env_id and args.env_id not in ALL_ENV_IDS:
+    if args.env_id is not None and args.env_id not in ALL_ENV_IDS:  # '' too: it would read as no --env-id
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
     set_acting_threads(args.threads)
     make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,
