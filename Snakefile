@@ -50,30 +50,16 @@ rule all:
 
 
 onstart:
-    # The cost of the run before its first job (egosearch.cost.estimate.print_costs); no target given:
-    # Snakemake builds the first rule, `all`.
-    from egosearch.cost.estimate import print_costs
-
-    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given(),
-                trainings_per_gpu=TRAININGS_PER_GPU)
+    # before a real run's first job: the cost of its plan (rules/common.smk)
+    print_the_plans_cost()
 
 
 # A dry run is where a user plans (`snakemake -n screen --config variant=NAME`): it prints the same cost
-# line, here, since Snakemake calls onstart only before a real run's first job. Its targets are read from
-# the command line, as checked_variants reads them (the DAG's settings are not set yet). The DAG's own
-# quiet child (egosearch.workflow.dag, which `estimate all` runs) prints nothing.
+# line once its DAG is built, just above Snakemake's job stats (rules/common.smk). The DAG's own quiet child
+# (egosearch.workflow.dag, which `estimate all` runs) prints nothing.
 if (workflow.is_main_process and workflow.output_settings.dryrun
         and Quietness.ALL not in (workflow.output_settings.quiet or ())):
-    from egosearch.cost.estimate import print_costs
-
-    named = [word for word in sys.argv[1:] if word in {rule.name for rule in workflow.rules}] or ["all"]
-    # `all` on a complete tree (its inputs stored, nothing forced) runs nothing: Snakemake says "Nothing to be
-    # done", and a fresh clone's estimate above it would read as this run's cost
-    forced = {"-F", "--forceall", "-R", "--forcerun", "-f", "--force"} & set(sys.argv[1:])
-    if "all" in named and not forced and all(os.path.exists(path) for path in rules.all.input):
-        named.remove("all")
-    if named:
-        print_costs(named, config, PROFILE, SEEDS, REF, cores_given(), trainings_per_gpu=TRAININGS_PER_GPU)
+    print_the_plans_cost_once_built()
 
 
 # A dry run under --executor slurm (`snakemake -n --workflow-profile profiles/slurm all`) ends with what each of

@@ -1126,7 +1126,59 @@ def bad(tmp_path_factory):
         copy(ref, f"prof/results/cpu/eval/{variant}/seed0/kitchen_living/everywhere/h1.05.csv")
         write(f"prof/results/cpu/train/{variant}/seed0/config.json",
               json.dumps({"variant": variant, "config": config}).encode())
+    # issue 57: a stopped run of head_on at the cpu profile (its checkpoint's header) whose demonstrations are not
+    # its own, or not whole
+    from egosearch.rl.demos import wanted_summary
+    from egosearch.rl.run_files import CHECKPOINT_FORMAT
+
+    wanted = wanted_summary(resolved.env_id, resolved.config, resolved.train_env, "head_on")
+    other = resolve_variant("head_off", "cpu", {"seed": 0})
+    smoke = resolve_variant("head_on", "smoke", {"seed": 0})
+    runs = {"dr_variant": (wanted | wanted_summary(other.env_id, other.config, other.train_env, "head_off"), 50, 2),
+            "dr_profile": ({k: v for k, v in (wanted | wanted_summary(smoke.env_id, smoke.config, smoke.train_env,
+                                                                    episodes=1500)).items() if k != "variant"}, 100, 2),
+            "dr_npz": (wanted, 100, 3), "dr_cut": (wanted, 50, 2), "dr_nosummary": (wanted, 50, 2)}
+    for run, (summary, side, transitions) in runs.items():
+        header = {"format": CHECKPOINT_FORMAT, "variant": "head_on", "env_id": resolved.env_id,
+                  "env_kwargs": env_kwargs_key(resolved.train_env), "config": resolved.config.to_dict()}
+        (t / run / "ckpt").mkdir(parents=True)
+        torch.save(header, t / run / "ckpt" / "train_state.ckpt")
+        fake_demos(t / run / "ckpt" / "demos.replay.npz", side, transitions, {**summary, "transitions": 2})
+    # item 8: per-step traces for the failure-kind table, in and out of the workflow's layout
+    trace = REPO / "results/cpu/traces/head_on/seed0/kitchen_living/everywhere/h1.05.npz"
+    cell = "head_on/seed0/kitchen_living/everywhere"
+    for dest in (f"f57/tr/{cell}/h1.05.npz", "f57/flat/h1.05.npz", "f57/odd/head_on/seed0/kitchen_living/under_sofa/"
+                 "h1.05.npz", f"f57/odd/{cell}/trace.npz", f"f57/odd/{cell}/h7.npz",
+                 f"f57/results/cpu/traces/{cell}/h1.05.npz", f"f57/results/smoke/traces/{cell}/h1.65.npz"):
+        copy(trace, dest)
+    copy(trace.with_suffix(".csv"), f"f57/tr/{cell}/h1.05.csv")
+    with np.load(trace) as data:
+        arrays = {k: (data[k][:0] if data[k].ndim else data[k]) for k in data.files}
+    (t / f"f57/noep/{cell}").mkdir(parents=True)
+    np.savez(t / f"f57/noep/{cell}/h1.05.npz", **arrays)
+    cut = (t / "dr_cut/ckpt/demos.replay.npz").read_bytes()
+    (t / "dr_cut/ckpt/demos.replay.npz").write_bytes(cut[: len(cut) // 2])
+    (t / "dr_nosummary/ckpt/demos.json").unlink()
     return t
+
+
+def fake_demos(path: Path, side: int, transitions: int, summary: dict) -> None:
+    """A demonstrations file of ``transitions`` blank steps with ``side`` px frames, and the summary ``summary``."""
+    import json
+
+    import numpy as np
+
+    from egosearch.rl.demos import DEMO_FORMAT, summary_path
+    from egosearch.rl.replay import ReplayBuffer
+
+    k, state_dim = summary["frame_history"], 4
+    buffer = ReplayBuffer(transitions, side, k, 8, 4, 5, state_dim=state_dim)
+    obs = {"depth": np.zeros((k, side, side), np.uint8), "mask": np.zeros(8), "proprio": np.zeros(4),
+           "state": np.zeros(state_dim)}
+    for step in range(transitions):
+        buffer.add(obs, np.zeros(5), 0.0, obs, False, step == transitions - 1)
+    buffer.save(path)
+    summary_path(path).write_text(json.dumps({"format": DEMO_FORMAT, **summary, "state_dim": state_dim}))
 
 
 @pytest.fixture
@@ -1370,18 +1422,208 @@ ISSUE57_ENV_OPTIONS = [
      "max_steps=-5: every episode would end before its first step; allowed: an integer >= 1 (T_max: the steps "
      "before an episode is truncated)"),
 ]
+# Item 3: a stopped run of head_on (cpu, seed 0) resumed with demonstrations that are not its own, or not whole
+# (fixture `bad`): refused before any env is built, naming the file and what was expected.
+RESUME = "egosearch train: error: --out-dir: {t}/%s/ckpt/train_state.ckpt cannot resume with its demonstrations: "
+HEAD_ON_KWARGS = ("{'distance_reward': 'progress', 'train_heights': [0.45, 1.8], 'privileged_state': True, 'layout': "
+                  "'paper_homes', 'placement': 'everywhere'}")
+ISSUE57_DEMOS = [
+    ("train_resume_with_another_variants_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
+                                                               "{t}/dr_variant"],
+     RESUME % "dr_variant" + "{t}/dr_variant/ckpt/demos.replay.npz holds other demonstrations than this run's: "
+     "variant='head_off', env_id='EgoSearchNoHeadMemory-v0'; expected variant='head_on', env_id='EgoSearchMemory-v0'"),
+    ("train_resume_with_another_profiles_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
+                                                               "{t}/dr_profile"],
+     RESUME % "dr_profile" + "{t}/dr_profile/ckpt/demos.replay.npz holds other demonstrations than this run's: "
+     "env_id='EgoSearch-v0', env_kwargs={'layout': 'paper_homes', 'placement': 'everywhere'}, image_size=100; "
+     f"expected env_id='EgoSearchMemory-v0', env_kwargs={HEAD_ON_KWARGS}, image_size=50"),
+    ("train_resume_with_the_npz_replaced", "cryptic", ["train", "--variant", "head_on", "--out-dir", "{t}/dr_npz"],
+     RESUME % "dr_npz" + "{t}/dr_npz/ckpt/demos.replay.npz does not match its summary demos.json: the file holds "
+     "image_size=100, transitions=3; the summary says image_size=50, transitions=2"),
+    ("train_resume_with_a_truncated_npz", "traceback", ["train", "--variant", "head_on", "--out-dir", "{t}/dr_cut"],
+     RESUME % "dr_cut" + "{t}/dr_cut/ckpt/demos.replay.npz: not a readable demonstrations file, truncated or corrupt "
+     "(BadZipFile: File is not a zip file); expected the .npz `egosearch demos` writes, of 2 transitions as "
+     "demos.json says"),
+    ("train_resume_without_the_demos_summary", "cryptic", ["train", "--variant", "head_on", "--out-dir",
+                                                           "{t}/dr_nosummary"],
+     RESUME % "dr_nosummary" + "{t}/dr_nosummary/ckpt/demos.replay.npz: its summary {t}/dr_nosummary/ckpt/demos.json "
+     "is not there (`egosearch demos` writes both)"),
+]
 # (id, before, the input): accepted now, as what it means
 ISSUE57_ACCEPTED = [
     ("variant_file_bare_config", "cryptic", HEAD + "config:\n"),
 ]
-COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 9, "traceback": 0, "silent": 12, "damage": 0}
+COUNTS_BEFORE_57 = {"clear": 1, "cryptic": 11, "traceback": 3, "silent": 12, "damage": 0}
 """What the rows above did before the fix; after it each is one clear line before any work."""
+
+
+# --------------------------------------------------------------------------- issue 57, item 8: 30 new bad inputs
+# In what the other open issues add: the failure-kind table (`egosearch report failures`, rule `failures`, its
+# traces and config claims_pairs), printing a config (`egosearch report table2`, `egosearch variant check`) and
+# env options at evaluation (`egosearch evaluate --env-id`). The cluster profile (profiles/slurm) is not on this
+# branch: none of its inputs here. (id, what it did before the fixes, argv, the one line now), as ISSUE_CASES.
+F57 = "{t}/f57/tr/head_on/seed0/kitchen_living/everywhere/h1.05"
+FAILURES = ["report", "failures", F57 + ".npz", "--out-prefix"]
+ENV_IDS = ("EgoSearch-v0, EgoSearchNoHead-v0, EgoSearchMemory-v0, EgoSearchNoHeadMemory-v0, EgoSearchMap-v0, "
+           "EgoSearchNoHeadMap-v0, EgoSearchModular-v0, EgoSearchNoHeadModular-v0")
+LAID_OUT = "expected .../{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"
+EVALUATE = ["evaluate", "--scenarios", S3, "--out", "{t}/o.csv"]
+HEAD_ON_ACTOR = "results/cpu/train/head_on/seed0/actor.pt"
+ISSUE57_NEW_CASES = [
+    ("failures_trace_outside_the_layout", "silent",  # its method was whatever folder held it
+     ["report", "failures", "{t}/f57/flat/h1.05.npz", "--out-prefix", "{t}/f"],
+     f"egosearch report: error: {{t}}/f57/flat/h1.05.npz: {LAID_OUT}"),
+    ("failures_an_evaluation_csv", "clear", ["report", "failures", ev("head_on"), "--out-prefix", "{t}/f"],
+     f"egosearch report: error: the input files: {ev('head_on')} is not an .npz file (numpy's zip format); a trace "
+     "file is written by `egosearch evaluate --traces`"),
+    ("failures_npz_without_the_trace_arrays", "traceback", ["report", "failures", TRACES[0], "--out-prefix", "{t}/f"],
+     f"egosearch report: error: {TRACES[0]}: not a per-step trace (it lacks scenario_id, collisions, visible, "
+     "success, geodesic); a trace file is written by `egosearch evaluate --traces`"),
+    ("failures_empty_npz", "clear", ["report", "failures", "{t}/zerotraces/head_on/seed0/kitchen_living/everywhere/"
+                                     "h1.65.npz", "--out-prefix", "{t}/f"],
+     "egosearch report: error: the input files: {t}/zerotraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz is "
+     "empty; a trace file is written by `egosearch evaluate --traces`"),
+    ("failures_trace_of_no_episode", "traceback",
+     ["report", "failures", "{t}/f57/noep/head_on/seed0/kitchen_living/everywhere/h1.05.npz", "--out-prefix", "{t}/f"],
+     "egosearch report: error: {t}/f57/noep/head_on/seed0/kitchen_living/everywhere/h1.05.npz: a trace of no episode "
+     "(its scenario set was empty); a failure table reads at least one"),
+    ("failures_same_trace_twice", "silent", [*FAILURES[:3], F57 + ".npz", "--out-prefix", "{t}/f"],
+     f"egosearch report: error: the input files: {F57}.npz is given twice: give each trace once (its episodes would "
+     "count twice)"),
+    ("failures_unknown_placement_folder", "silent",
+     ["report", "failures", "{t}/f57/odd/head_on/seed0/kitchen_living/under_sofa/h1.05.npz", "--out-prefix", "{t}/f"],
+     "egosearch report: error: {t}/f57/odd/head_on/seed0/kitchen_living/under_sofa/h1.05.npz: its placement folder "
+     "'under_sofa' is none of no_low_cabinets, everywhere; expected .../<method>/seed<N>/<home>/<placement>/"
+     "h<height>.npz, as the workflow lays traces out"),
+    ("failures_trace_not_named_by_its_height", "clear",
+     ["report", "failures", "{t}/f57/odd/head_on/seed0/kitchen_living/everywhere/trace.npz", "--out-prefix", "{t}/f"],
+     f"egosearch report: error: {{t}}/f57/odd/head_on/seed0/kitchen_living/everywhere/trace.npz: {LAID_OUT}"),
+    ("failures_height_of_no_camera", "silent",
+     ["report", "failures", "{t}/f57/odd/head_on/seed0/kitchen_living/everywhere/h7.npz", "--out-prefix", "{t}/f"],
+     "egosearch report: error: {t}/f57/odd/head_on/seed0/kitchen_living/everywhere/h7.npz: height 7 m is outside "
+     "[0.3, 2.0] m, the camera heights a trace can have"),
+    ("failures_out_prefix_ending_in_csv", "silent", [*FAILURES, "{t}/f.csv"],
+     "egosearch report: error: --out-prefix={t}/f.csv ends in .csv, and failures adds .csv, _stuck.csv and .md to it "
+     "({t}/f.csv.csv); allowed: the prefix without .csv, {t}/f"),
+    ("failures_out_prefix_beside_a_trace", "damage", [*FAILURES, F57],  # overwrote the trace's episodes CSV
+     f"egosearch report: error: --out-prefix={F57} writes {F57}.csv, which is also an input (the traces' episodes "
+     "CSVs): a command never writes over its own input; choose another output path"),
+    ("failures_out_prefix_stored", "clear", [*FAILURES, "paper_figs/cpu/failures"],
+     re.compile(r"egosearch report: error: --out-prefix=paper_figs/cpu/failures writes paper_figs/cpu/failures\.csv, "
+                rf"which is a stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
+    ("failures_stuck_read_twice", "silent", [*FAILURES, "{t}/f", "--stuck-read", "head_on", "head_on"],
+     "egosearch report: error: --stuck-read: head_on is given twice; each method's section is written once"),
+    ("failures_of_two_profiles", "silent",
+     ["report", "failures", "{t}/f57/results/cpu/traces/head_on/seed0/kitchen_living/everywhere/h1.05.npz",
+      "{t}/f57/results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", "--out-prefix", "{t}/f"],
+     "egosearch report: error: the input files mix profiles: {t}/f57/results/cpu/traces/head_on/seed0/kitchen_living/"
+     "everywhere/h1.05.npz is cpu's, {t}/f57/results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz "
+     "is smoke's; a failure table reads one profile's traces"),
+    ("failures_out_prefix_empty", "silent", [*FAILURES, ""],  # wrote .csv, _stuck.csv and .md where it ran
+     "egosearch report: error: --out-prefix='' is empty; allowed: a path to which failures adds .csv, _stuck.csv and "
+     ".md (e.g. paper_figs/cpu/failures)"),
+    ("failures_stuck_read_a_searcher_not_given", "clear", [*FAILURES, "{t}/f", "--stuck-read", "frontier"],
+     "egosearch report: error: --stuck-read: frontier has no trace among the input files (head_on)"),
+    ("table2_unknown_profile", "clear", ["report", "table2", "--profile", "fast", "--out-prefix", "{t}/t2"],
+     "egosearch report: error: unknown profile 'fast'; allowed: smoke, cpu, paper"),
+    ("table2_out_prefix_ending_in_md", "silent", ["report", "table2", "--profile", "cpu", "--out-prefix", "{t}/t2.md"],
+     "egosearch report: error: --out-prefix={t}/t2.md ends in .md, and table2 adds .md and .tex to it ({t}/t2.md.md); "
+     "allowed: the prefix without .md, {t}/t2"),
+    ("table2_out_prefix_stored", "clear",
+     ["report", "table2", "--profile", "paper", "--out-prefix", "paper_figs/table2"],
+     re.compile(r"egosearch report: error: --out-prefix=paper_figs/table2 writes paper_figs/table2\.md, which is a "
+                rf"stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
+    ("table2_out_prefix_empty", "silent", ["report", "table2", "--profile", "cpu", "--out-prefix", ""],
+     "egosearch report: error: --out-prefix='' is empty; allowed: a path to which table2 adds .md and .tex (e.g. "
+     "paper_figs/cpu/table2)"),
+    ("variant_check_a_profile_twice", "silent", ["variant", "check", "head_on", "--profile", "cpu", "cpu"],
+     "egosearch variant: error: --profile: cpu is given twice; each profile is checked once"),
+    ("variant_check_a_name_with_its_suffix", "clear", ["variant", "check", "head_on.yaml"],
+     f"egosearch variant: error: head_on.yaml: no such file; {NOT_A_VARIANT}"),
+    ("variant_check_capitalised", "clear", ["variant", "check", "Head_On"],
+     f"egosearch variant: error: variant='Head_On' is unknown; allowed: {ALLOWED} (files in ablations)"),
+    ("evaluate_env_id_as_gymnasium_writes_it", "clear", [*EVALUATE, "--policy", "random", "--env-id",
+                                                         "egosearch:EgoSearch-v0"],
+     f"egosearch evaluate: error: --env-id='egosearch:EgoSearch-v0'; allowed: {ENV_IDS}"),
+    ("evaluate_env_id_of_another_version", "clear", [*EVALUATE, "--policy", "random", "--env-id", "EgoSearch-v1"],
+     f"egosearch evaluate: error: --env-id='EgoSearch-v1'; allowed: {ENV_IDS}"),
+    ("evaluate_env_id_in_lower_case", "clear", [*EVALUATE, "--policy", "random", "--env-id", "egosearch-v0"],
+     f"egosearch evaluate: error: --env-id='egosearch-v0'; allowed: {ENV_IDS}"),
+    ("evaluate_env_id_empty", "silent", [*EVALUATE, "--policy", "random", "--env-id", ""],  # ran in EgoSearch-v0
+     f"egosearch evaluate: error: --env-id=''; allowed: {ENV_IDS}"),
+    ("evaluate_random_in_a_decision_env", "clear", [*EVALUATE, "--policy", "random", "--env-id",
+                                                    "EgoSearchModular-v0"],
+     "egosearch evaluate: error: --env-id=EgoSearchModular-v0 takes a modular searcher's decisions, and --policy "
+     "random acts at every body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out"),
+    ("evaluate_an_actor_without_its_memory", "clear", [*EVALUATE, "--weights", HEAD_ON_ACTOR, "--env-id",
+                                                       "EgoSearch-v0"],
+     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 (5 action values, 39 "
+     "observation values besides depth), not in EgoSearch-v0 (5 and 34): run it in EgoSearchMemory-v0"),
+    ("evaluate_an_actor_with_a_floor_map", "clear", [*EVALUATE, "--weights", HEAD_ON_ACTOR, "--env-id",
+                                                     "EgoSearchMap-v0"],
+     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 (5 action values, 39 "
+     "observation values besides depth), not in EgoSearchMap-v0 (5 and 186): run it in EgoSearchMemory-v0"),
+    ("evaluate_the_tuned_searcher_head_fixed", "clear", [*EVALUATE, "--policy", "frontier_tuned", "--env-id",
+                                                         "EgoSearchNoHeadMemory-v0"],
+     "egosearch evaluate: error: --env-id=EgoSearchNoHeadMemory-v0 fixes the head, and --policy frontier_tuned is the "
+     "searcher with the head moving: its rows would be read under that name; leave --env-id out, or use --policy "
+     "frontier_tuned_head_off"),
+    ("evaluate_env_id_for_an_actor_without_weights", "clear", [*EVALUATE, "--policy", "actor", "--env-id",
+                                                               "EgoSearch-v0"],
+     "egosearch evaluate: error: --policy actor needs --weights PATH/actor.pt"),
+]
+# The rule `failures` reads config claims_pairs (its traces, the pair whose stuck episodes it reads): as
+# ISSUE48_CONFIGS, (id, before, --config changes, target, the one line)
+ISSUE57_NEW_CONFIGS = [
+    ("claims_pair_given_twice", "silent", {"claims_pairs": [["head_on", "head_off"], ["head_on", "head_off"]]},
+     "failures", "config claims_pairs: ['head_on', 'head_off'] is given twice; each pair once"),
+    ("claims_pairs_empty", "clear", {"claims_pairs": []}, "failures", "config claims_pairs: [] should be non-empty"),
+]
+# accepted now, as what it means: a folder as the prefix (the other reports' rule) wrote hidden files .csv,
+# _stuck.csv and .md in it
+ISSUE57_NEW_ACCEPTED = [("failures_out_prefix_a_folder", "silent")]
+COUNTS_BEFORE_57_NEW = {"clear": 18, "cryptic": 0, "traceback": 2, "silent": 14, "damage": 1}
+"""What the 35 new inputs did before the fixes; after them each is one clear line before any work, or, for the
+folder prefix, what it means."""
+
+
+def test_issue_57s_new_inputs_count_before_and_after():
+    rows = ([c[:2] for c in ISSUE57_NEW_CASES] + [c[:2] for c in ISSUE57_NEW_CONFIGS] + ISSUE57_NEW_ACCEPTED)
+    before = dict.fromkeys(BEFORE_KINDS_48, 0)
+    for _, kind in rows:
+        before[kind] += 1
+    assert before == COUNTS_BEFORE_57_NEW and len(rows) >= 30
+    names = [name for name, _ in rows + issue57_rows()] + [c[0] for c in CLI_CASES]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("case", ISSUE57_NEW_CASES, ids=[c[0] for c in ISSUE57_NEW_CASES])
+def test_issue_57s_new_inputs_are_one_clear_line(case, bad, capsys, monkeypatch, nothing_runs):
+    test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
+
+
+@pytest.mark.parametrize("case", ISSUE57_NEW_CONFIGS, ids=[c[0] for c in ISSUE57_NEW_CONFIGS])
+def test_issue_57s_new_configs_are_one_line(case, suite, monkeypatch, capsys):
+    test_a_config_naming_no_variant_names_its_key(case, suite, monkeypatch, capsys)
+
+
+def test_a_folder_as_the_failure_tables_prefix_holds_its_files(bad, tmp_path, capsys):
+    """A folder as --out-prefix writes failures.csv, failures_stuck.csv and failures.md in it, as every other
+    report does with its own name (it wrote .csv, _stuck.csv and .md, hidden, and the overwrite guard had
+    checked failures.csv)."""
+    folder = tmp_path / "pages"
+    folder.mkdir()
+    trace = _filled(F57 + ".npz", bad)
+    assert main(["report", "failures", trace, "--out-prefix", f"{folder}/", "--stuck-read", "head_on"]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == ["failures.csv", "failures.md", "failures_stuck.csv"]
+    assert "## What `head_on` is stuck against" in (folder / "failures.md").read_text()
+    assert (folder / "failures.csv").read_text().splitlines()[1].startswith("head_on,1.05,everywhere,")
 
 
 def issue57_rows():
     return ([c[:2] for c in ISSUE57_CASES] + [c[:2] for c in ISSUE57_CONFIGS]
             + [c[:2] for c in ISSUE57_VARIANT_FILES] + [c[:2] for c in ISSUE57_SNAKEMAKE]
-            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS])
+            + [c[:2] for c in ISSUE57_ACCEPTED] + [c[:2] for c in ISSUE57_ENV_OPTIONS] + [c[:2] for c in ISSUE57_DEMOS])
 
 
 def test_issue_57s_counts_before():
@@ -1395,6 +1637,17 @@ def test_issue_57s_counts_before():
 
 @pytest.mark.parametrize("case", ISSUE57_CASES, ids=[c[0] for c in ISSUE57_CASES])
 def test_issue_57s_commands_are_one_clear_line(case, bad, capsys, monkeypatch, nothing_runs):
+    test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
+
+
+@pytest.mark.parametrize("case", ISSUE57_DEMOS, ids=[c[0] for c in ISSUE57_DEMOS])
+def test_issue_57s_demonstrations_are_refused_on_resume_before_any_env(case, bad, capsys, monkeypatch, nothing_runs):
+    import egosearch.rl.train
+
+    def built(*args, **kwargs):
+        raise AssertionError("an env was built before the demonstrations were refused")
+
+    monkeypatch.setattr(egosearch.rl.train, "make_train_env", built)
     test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
 
 

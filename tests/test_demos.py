@@ -113,3 +113,98 @@ def test_a_teacher_is_named_only_with_demonstrations():
         load_config("cpu", {**FROM_SCRATCH, "demo_teacher": "frontier_tuned"})
     with pytest.raises(ValueError, match="demo_teacher='oracle' .*allowed: frontier, frontier_tuned"):
         load_config("cpu", {**FROM_SCRATCH, "demo_episodes": 5, "demo_teacher": "oracle"})
+
+
+def test_demonstrations_are_collected_at_every_profile(tmp_path, capsys):
+    """Issue 57: at the smoke and paper profiles the learner (SAC+CURL) stores the env's frames unpooled, and has
+    no obs_downsample: `egosearch demos` and the `demos` rule stopped there on an AttributeError."""
+    from egosearch.cli import main
+    from egosearch.variants import resolve_variant
+
+    out = tmp_path / "d.replay.npz"
+    assert main(["demos", "--variant", "head_off", "--profile", "smoke", "--episodes", "1", "--out", str(out)]) == 0
+    cfg = resolve_variant("head_off", "smoke").config
+    assert not hasattr(cfg, "obs_downsample")
+    summary = json.loads(summary_path(out).read_text())
+    assert summary["variant"] == "head_off" and summary["image_size"] == cfg.image_size == 100
+    replay = load_demonstrations(out, cfg)
+    assert len(replay) == summary["transitions"] and replay.sample(2)["obs_depth"].shape[-1] == 100
+
+
+def test_a_demonstrations_file_is_checked_before_it_is_read(demos, tmp_path):
+    """A truncated or corrupt file, a summary that does not describe its file, and another run's
+    demonstrations are each one line naming the file and what was expected."""
+    import re
+    import shutil
+
+    from egosearch.rl.demos import DemonstrationsError, check_demonstrations, wanted_summary
+
+    cfg, path, summary = demos
+    copy = tmp_path / "d.replay.npz"
+
+    def fresh():
+        shutil.copy2(path, copy)
+        shutil.copy2(summary_path(path), summary_path(copy))
+
+    def refused(call, pattern):
+        with pytest.raises(DemonstrationsError) as err:
+            call()
+        assert "\n" not in str(err.value) and str(copy) in str(err.value), str(err.value)
+        assert re.search(pattern, str(err.value)), str(err.value)
+
+    own = wanted_summary("EgoSearch-v0", cfg, ENV, seed=1, episodes=3)
+    fresh()
+    assert check_demonstrations(copy, own)["transitions"] == summary["transitions"]
+    data = copy.read_bytes()
+    copy.write_bytes(data[: len(data) // 2])
+    refused(lambda: load_demonstrations(copy, cfg), r"truncated or corrupt \(BadZipFile")
+    fresh()
+    middle = len(data) // 2  # a member's bytes changed, the zip's directory whole: seen when the arrays are read
+    copy.write_bytes(data[:middle] + bytes(b ^ 0xFF for b in data[middle:middle + 64]) + data[middle + 64:])
+    refused(lambda: load_demonstrations(copy, cfg), r"expected the \.npz `egosearch demos` writes")
+    fresh()
+    summary_path(copy).write_text(json.dumps({**summary, "transitions": summary["transitions"] + 7}))
+    refused(lambda: check_demonstrations(copy), rf"does not match its summary .*: the file holds transitions="
+                                                rf"{summary['transitions']}; the summary says transitions=")
+    fresh()
+    refused(lambda: check_demonstrations(copy, {**own, "teacher": "frontier_tuned", "seed": 2}),
+            r"holds other demonstrations than this run's: teacher='frontier', seed=1; expected "
+            r"teacher='frontier_tuned', seed=2$")
+    refused(lambda: load_demonstrations(copy, load_config("cpu", {**FROM_SCRATCH, "obs_downsample": 1})),
+            r"holds 50 px frames .*; this learner's replay holds 100 px")
+    summary_path(copy).unlink()
+    refused(lambda: check_demonstrations(copy), r"its summary .*d\.json is not there")
+
+
+def test_a_fresh_run_collects_its_own_where_a_left_file_is_truncated(tmp_path, monkeypatch, capsys):
+    """A run stopped before its first checkpoint keeps its demonstrations to start from: one whose file was cut
+    short (a full disk) is said in one line and collected again, not read into a BadZipFile."""
+    from egosearch.rl import train as train_module
+    from egosearch.rl.demos import wanted_summary
+
+    small = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2,
+             "encoder_stride2_layers": 2, "aug_pad": 1, "target_memory": True, "critic_privileged_state": True,
+             "train_height_min": 0.45, "n_step": 3, "batch_size": 32, "seed": 4, "demo_episodes": 2,
+             "bc_updates": 20, "critic_warmup_updates": 10, "demo_batch_fraction": 0.25, "bc_weight": 0.4,
+             "bc_decay_steps": 200}
+    cfg = load_config("smoke", small)
+    left = tmp_path / "run" / "ckpt" / "demos.replay.npz"
+    left.parent.mkdir(parents=True)
+    left.write_bytes(b"PK\x03\x04" + bytes(100))
+    summary_path(left).write_text(json.dumps({"format": "egosearch-demos-v1", "transitions": 150, "state_dim": 9,
+                                              **wanted_summary("EgoSearch-v0", cfg, ENV, "run")}))
+
+    class Collected(Exception):
+        pass
+
+    def collect(*args, **kwargs):
+        raise Collected
+
+    monkeypatch.setattr(train_module, "collect_demonstrations", collect)
+    with pytest.raises(Collected):
+        train_module.train("EgoSearch-v0", cfg, tmp_path / "run", ENV, lambda policy: {}, variant="run",
+                           progress=False)
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("not reused: ")]
+    assert said == [f"not reused: {left}: not a readable demonstrations file, truncated or corrupt (BadZipFile: File "
+                    "is not a zip file); expected the .npz `egosearch demos` writes, of 150 transitions as demos.json "
+                    "says"]

@@ -2,6 +2,8 @@
 stored run's recorded id and config still resolve, and gymnasium finds the ids with no other import."""
 
 import json
+import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -81,3 +83,42 @@ def test_import_egosearch_envs_registers_every_id_without_the_physics():
             "heavy = [m for m in ('pybullet', 'torch', 'egosearch.sim.env') if m in sys.modules]\n"
             "assert not missing and not heavy, (missing, heavy)\n")
     _in_a_fresh_interpreter(code)
+
+
+def _readme_line() -> str:
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    return readme.split("```python\n", 1)[1].split("\n```", 1)[0]
+
+
+@pytest.mark.slow
+def test_the_readmes_line_runs_from_the_folder_above_a_clone_named_egosearch(tmp_path):
+    """Issue 57: run from the folder that holds a clone named ``egosearch`` (or from a script saved there),
+    Python finds the clone's folder on sys.path first. Under an editable install that imports the package
+    through a finder asked after sys.path, that folder became an empty namespace package and gymnasium found
+    no ids. The clone here is a copy of what an install reads, installed editable into a venv as the README
+    installs it (no dependencies: the venv sees this interpreter's)."""
+    clone = tmp_path / "egosearch"
+    clone.mkdir()
+    for name in ("pyproject.toml", "setup.py", "README.md"):
+        shutil.copy2(REPO / name, clone / name)
+    shutil.copytree(REPO / "egosearch", clone / "egosearch",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)], check=True,
+                   timeout=120)
+    python = str(venv / "bin" / "python")
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    install = subprocess.run([sys.executable, "-m", "pip", "--python", python, "install", "-q", "--no-deps",
+                              "--no-build-isolation", "--no-index", "-e", str(clone)], capture_output=True, text=True,
+                             env=env, timeout=600)
+    assert install.returncode == 0, install.stderr[-2000:]
+    line = _readme_line()
+    (tmp_path / "try_egosearch.py").write_text(line + "\nimport egosearch; print(egosearch.__file__)\n")
+    runs = {"the folder above the clone": ([python, "-c", line + "; import egosearch; print(egosearch.__file__)"],
+                                           tmp_path),
+            "a script saved there": ([python, "try_egosearch.py"], tmp_path),
+            "the clone": ([python, "-c", line + "; import egosearch; print(egosearch.__file__)"], clone)}
+    for where, (cmd, cwd) in runs.items():
+        out = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=env, timeout=300)
+        assert out.returncode == 0, f"from {where}: {out.stderr[-1500:]}"
+        assert out.stdout.split()[-1] == str(clone / "egosearch" / "__init__.py"), where

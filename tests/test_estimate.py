@@ -220,11 +220,62 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
     unpriced = "plus the teacher's {} episodes and the cloning (no stored measurement prices them)"
     for teacher_s, said in ((1800.0, "of which about 0.5 h the teacher's"), (None, unpriced)):
         monkeypatch.setattr(estimate, "teacher_cost_s", lambda config, results, bench, rate, s=teacher_s: s)
-        estimate.print_variant_cost("cpu", "screen", variant, [0], "head_on", 1)
+        estimate.print_plan_cost(f"screen of {variant} against head_on", [training_job(variant)], "cpu", 1,
+                                 "head_on")
         line = capsys.readouterr().err
         each = (rl_phase + (teacher_s or 0.0)) / 3600
         assert f"1 training(s) of {config.total_env_steps} env steps, about {each:.1f} h each" in line, line
         assert said.format(config.demo_episodes) in line
+
+
+def training_job(variant: str, seed: int = 0, deps=()):
+    """A plan's training job, as egosearch.workflow.dag.plan_jobs reads it from a DAG."""
+    from egosearch.workflow.dag import DagJob
+
+    return DagJob(id=f"train/{variant}/seed{seed}", rule="train", job=f"{variant}/seed{seed}", record_rule="train",
+                  threads=1, deps=tuple(deps), order=seed, wildcards={"profile": "cpu", "variant": variant,
+                                                                      "seed": str(seed)})
+
+
+def evaluation_job(variant: str, seed: int, cell: str, order: int):
+    from egosearch.workflow.dag import DagJob
+
+    return DagJob(id=f"eval/{variant}/seed{seed}/{cell}", rule="evaluate", job=f"{variant}/seed{seed}/{cell}",
+                  record_rule="eval", threads=1, deps=(f"train/{variant}/seed{seed}",), order=order,
+                  wildcards={"profile": "cpu", "variant": variant, "seed": str(seed)})
+
+
+def test_the_cost_line_counts_every_job_of_the_plan(tmp_path, monkeypatch, capsys):
+    """Issue 57: the line counts the plan's jobs by rule, as Snakemake's job stats do, the reference's
+    trainings and evaluations among them, each training at its own variant's steps, and lays them out."""
+    import egosearch.cost.estimate as estimate
+    from egosearch.cost import calibration
+    from egosearch.workflow.dag import DagJob
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": estimate.machine_key(calibration.this_machine()),
+                                                    "rate": 100.0, "steps": "body steps"}))
+    results = tmp_path / "results" / "cpu"
+    (results / "bench").mkdir(parents=True)
+    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+        {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0},
+        {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.65", "wall_s": 60.0}]}))
+    monkeypatch.setattr(estimate, "teacher_cost_s", lambda config, results, bench, rate: 360.0)
+    plan = [training_job("head_off", 3), training_job("head_on", 5), evaluation_job("head_off", 3, "c1", 2),
+            evaluation_job("head_on", 5, "c1", 3), evaluation_job("head_on", 5, "c2", 4),
+            DagJob(id="screen", rule="screen", job=None, record_rule=None, threads=1, order=5,
+                   deps=("eval/head_off/seed3/c1", "eval/head_on/seed5/c1", "eval/head_on/seed5/c2"))]
+    estimate.print_plan_cost("screen of head_off against head_on", plan, "cpu", 2, "head_on")
+    line = capsys.readouterr().err.strip()
+    assert line.startswith("screen of head_off against head_on: 6 jobs to run (3 evaluate, 1 screen, 2 train), "
+                           "2 training(s) (1 of them head_on's, the reference's) of 200000 env steps, about 0.7 h each "
+                           "on this machine (its last calibration), of which about 0.1 h the teacher's 1500 episodes "
+                           "and the cloning, 3 evaluations (2 of them head_on's) of about 50 s: about "), line
+    # the two trainings side by side on 2 cores, then head_on's two evaluations one after the other
+    hours = float(line.rsplit("about ", 1)[1].split(" h")[0])
+    assert hours == round((200_000 / 100.0 + 360.0 + 2 * 50.0) / 3600, 1)
+    assert estimate.plan_counts(plan) == {"evaluate": 3, "screen": 1, "train": 2, "total": 6}
 
 
 def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatch, capsys):
@@ -250,6 +301,7 @@ def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatc
         assert (calibration.cached_busy_line() == busy) is said
         line = estimate.training_time_line(180_000, "cpu")
         assert line.startswith("estimate: about 0.5 h of CPU time") and line.endswith(f"; {busy}") is said
-        estimate.print_variant_cost("cpu", "screen", "head_off", [0], "head_on", 1)
+        estimate.print_plan_cost("screen of head_off against head_on", [training_job("head_off")], "cpu", 1,
+                                 "head_on")
         err = capsys.readouterr().err
         assert "this machine (its last calibration)" in err and (f"  {busy}\n" in err) is said, err

@@ -1,5 +1,6 @@
 """The Snakemake suite: dry run, lint, schema, a smoke run of table1, and a cluster executor."""
 
+import re
 import shutil
 import subprocess
 import sys
@@ -263,23 +264,52 @@ def test_a_screen_trains_screen_seeds_against_the_references_spread_seeds():
     assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr
 
 
-def test_a_dry_run_prints_the_cost_line_a_run_prints(capsys, monkeypatch):
-    """`snakemake -n screen` is where a user plans: the line onstart prints before a real run's first job,
-    once (on the workflow profile's cores unless --cores says otherwise)."""
-    from egosearch.cost.estimate import print_variant_cost
+def job_stats(text: str) -> dict[str, int]:
+    """Snakemake's "Job stats" table of a dry run's output, as {rule: count, "total": n}."""
+    lines = text.split("Job stats:\n", 1)[1].splitlines()[2:]
+    stats = {}
+    for line in lines:
+        if not line.strip():
+            break
+        rule, count = line.split()
+        stats[rule] = int(count)
+    return stats
+
+
+def cost_line(text: str, opening: str) -> tuple[str, dict[str, int]]:
+    """The cost line that opens with ``opening``, and the counts it gives per rule (as job_stats reads them)."""
+    [line] = [x for x in text.splitlines() if x.startswith(opening)]
+    counted = re.match(r".*?: (\d+) jobs? to run \(([^)]*)\)", line)
+    counts = {rule: int(n) for n, rule in (part.split(" ") for part in counted.group(2).split(", "))}
+    return line, {**counts, "total": int(counted.group(1))}
+
+
+def test_the_cost_line_counts_every_job_of_the_plan():
+    """Issue 57: the line a dry run prints above its plan counts the plan's jobs as Snakemake's own job stats
+    count them, the reference's trainings and evaluations included (a comparison against a reference whose
+    seeds are not all stored trains them too), and a screen's; once, on the profile's cores."""
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    seeds = config["profiles"]["cpu"]["seeds"]
+    candidates = [v for v in ("head_on_ppo", "head_on_recurrent", "head_on_geodesic")
+                  if not all((REPO / f"results/cpu/train/{v}/seed{s}/done.json").exists() for s in seeds)]
+    reference = candidates[0]
+    missing = sum(not (REPO / f"results/cpu/train/{reference}/seed{s}/done.json").exists() for s in seeds)
+    out = run(["-n", "compare", "--config", "variant=head_off", f"reference_variant={reference}"])
+    assert out.returncode == 0, out.stderr[-3000:]
+    text = out.stdout + out.stderr
+    line, counted = cost_line(out.stderr, f"compare of head_off against {reference}: ")
+    assert counted == job_stats(text) and counted["train"] == missing >= 1, line
+    assert f"{missing} training(s) ({missing} of them {reference}'s, the reference's)" in line
+    assert f"{counted['evaluate']} evaluations ({counted['evaluate']} of them {reference}'s)" in line
+    assert line.endswith(f" on {PROFILE_CORES} core(s)") and out.stderr.splitlines().count(line) == 1
 
     out = run(["-n", "screen", "--config", "variant=head_off"])
-    assert out.returncode == 0, out.stderr
-    monkeypatch.chdir(REPO)
-    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    seeds = list(range(config["screen_seeds"]))
-    print_variant_cost("cpu", "screen", "head_off", seeds, "head_on", PROFILE_CORES,
-                       reference_seeds=config["profiles"]["cpu"]["spread_seeds"])
-    line = capsys.readouterr().err.strip()
-    assert line.startswith("screen of head_off against head_on: ") and "about" in line
-    assert out.stderr.splitlines().count(line) == 1
+    assert out.returncode == 0, out.stderr[-3000:]
+    text = out.stdout + out.stderr
+    line, counted = cost_line(out.stderr, "screen of head_off against head_on: ")
+    assert counted == job_stats(text) and counted["screen"] == 1 and counted["train"] >= 1, line
     # and the power of that screen, beside its cost
-    assert any(f"a screen of {len(seeds)} seed(s) against head_on" in x or x.startswith("(no power line")
+    assert any(f"a screen of {config['screen_seeds']} seed(s) against head_on" in x or x.startswith("(no power line")
                for x in out.stderr.splitlines())
 
 

@@ -25,5 +25,5 @@ def run(args) -> None:
                          "which it cannot learn from; give a variant that acts at every body step (e.g. "
                          "head_on_from_scratch)")
     summary = collect_demonstrations(resolved.env_id, resolved.config, resolved.train_env, args.episodes, args.out,
-                                     seed=args.seed)
+                                     seed=args.seed, variant=resolved.name)
     print(json.dumps(summary))

@@ -27,7 +27,7 @@ def run(args) -> None:
         raise ValueError(f"--profile={args.profile} is read with --curve-of only (a scenario file needs no profile)")
     curve = curve_set(args.curve_of, args.profile) if args.curve_of else None
     check_threads(args.threads)
-    if args.env_id and args.env_id not in ALL_ENV_IDS:
+    if args.env_id is not None and args.env_id not in ALL_ENV_IDS:  # '' too: it would read as no --env-id
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
     set_acting_threads(args.threads)
     make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,

@@ -64,10 +64,18 @@ def prefix_files(what: str, out_prefix: str, out_csv: str | None = None) -> list
     return files
 
 
+TRACE_REPORTS = ("behaviour", "searches", "failures")
+"""The reports that read per-step trace files (``.npz``), each beside its episodes CSV."""
+
+
 def report_inputs(args) -> dict[str, list[str]]:
-    """``{option: the files it names}`` of the reports that read files."""
+    """``{option: the files it names}`` of the reports that read files; for a report of traces, also the
+    episodes CSV beside each trace (the trace rule's other output): an output never lands on one."""
     if args.what == "budget":
         return {"--run": [f for spec in args.run for f in spec.partition("=")[2].split(":") if f]}
+    if args.what in TRACE_REPORTS:
+        beside = [str(Path(f).with_suffix(".csv")) for f in args.files if f.endswith(".npz")]
+        return {"the input files": args.files, "the traces' episodes CSVs": [f for f in beside if os.path.isfile(f)]}
     names = {"files": "the input files", "bounds": "--bounds", "levels": "--levels", "reference": "--reference",
              "candidate": "--candidate", "spread": "--spread", "scenarios": "--scenarios", "stored": "--stored",
              "fresh": "--fresh"}
@@ -79,9 +87,32 @@ def report_inputs(args) -> dict[str, list[str]]:
     return out
 
 
+PREFIX_TAILS = (".csv", ".md", ".tex", ".png", ".pdf")
+"""What a report adds to its ``--out-prefix`` for the files it writes: a prefix ending in one writes x.csv.csv."""
+
+
+def check_prefix(what: str, out_prefix: str | None) -> None:
+    """An ``--out-prefix`` is a path to which the report adds its files' endings (:data:`PREFIX_FILES`): an
+    empty one would write hidden files (``.csv``) where the command runs, and one that ends in an ending
+    itself (``failures.csv``) files named ``failures.csv.csv``."""
+    if out_prefix is None or what not in PREFIX_FILES:
+        return
+    default, endings = PREFIX_FILES[what]
+    adds = f"{what} adds " + (f"{', '.join(endings[:-1])} and {endings[-1]}" if len(endings) > 1 else endings[0])
+    if not out_prefix.strip():
+        raise ValueError(f"--out-prefix={out_prefix!r} is empty; allowed: a path to which {adds} (e.g. "
+                         f"paper_figs/cpu/{default})")
+    tail = Path(out_prefix).suffix
+    if what != "fresh" and tail in PREFIX_TAILS:  # fresh replaces a dotted tail (its own check)
+        raise ValueError(f"--out-prefix={out_prefix} ends in {tail}, and {adds} to it "
+                         f"({prefix_files(what, out_prefix)[0]}); allowed: the prefix without {tail}, "
+                         f"{out_prefix[: -len(tail)]}")
+
+
 def check_report_outputs(args) -> None:
     """Every path a report writes, checked before it reads anything."""
     out_prefix = getattr(args, "out_prefix", None)
+    check_prefix(args.what, out_prefix)
     check_outputs(files={"--out": getattr(args, "out", None), "--out-csv": getattr(args, "out_csv", None),
                          "--readme": None if args.what != "readme" or args.check else args.readme},
                   dirs={"--out-dir": getattr(args, "out_dir", None)},
@@ -267,8 +298,50 @@ def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
     return out
 
 
+def _check_failures(args) -> None:
+    """Each trace is one method's, seed's and cell's, laid out as the workflow lays them
+    (``.../<method>/seed<N>/<home>/<placement>/h<height>.npz``: the method is the fifth part from the end),
+    of one profile, given once, and holds episodes; each ``--stuck-read`` method once."""
+    # local: the simulator's body sizes are plain data, but its package is the CLI's to load
+    from egosearch.report.failures import check_trace_file
+    from egosearch.report.tables import PLACEMENT_LABELS
+    from egosearch.sim.agent import HEIGHT_RANGE
+
+    seen, profiles = {}, {}
+    for path in args.files:
+        where = parse_trace_path(path)
+        if where["placement"] not in PLACEMENT_LABELS:
+            raise ValueError(f"{path}: its placement folder {where['placement']!r} is none of "
+                             f"{', '.join(PLACEMENT_LABELS)}; expected .../<method>/seed<N>/<home>/<placement>/"
+                             "h<height>.npz, as the workflow lays traces out")
+        if not HEIGHT_RANGE[0] <= where["height"] <= HEIGHT_RANGE[1]:
+            raise ValueError(f"{path}: height {where['height']:g} m is outside [{HEIGHT_RANGE[0]}, {HEIGHT_RANGE[1]}] "
+                             "m, the camera heights a trace can have")
+        key = tuple(where[k] for k in ("variant", "seed", "layout", "placement", "height"))
+        if key in seen:
+            both = (f"{path} is given twice" if Path(path).resolve() == Path(seen[key]).resolve() else
+                    f"{path} and {seen[key]} are both {key[0]}'s trace of seed {key[1]} in {key[2]}, {key[3]}, "
+                    f"{key[4]:g} m")
+            raise ValueError(f"the input files: {both}: give each trace once (its episodes would count twice)")
+        seen[key] = path
+        parts = Path(path).resolve().parts
+        for folder, profile, traces in zip(parts, parts[1:], parts[2:]):
+            if folder == "results" and traces == "traces":
+                profiles.setdefault(profile, path)
+        if len(profiles) > 1:
+            (one, first), (other, second) = list(profiles.items())[:2]
+            raise ValueError(f"the input files mix profiles: {first} is {one}'s, {second} is {other}'s; a failure "
+                             "table reads one profile's traces")
+    for method in args.stuck_read:
+        if args.stuck_read.count(method) > 1:
+            raise ValueError(f"--stuck-read: {method} is given twice; each method's section is written once")
+    for path in args.files:
+        check_trace_file(path)
+
+
 INPUT_CHECKS = {"generalise": _check_generalise, "behaviour": _check_behaviour, "searches": _check_searches,
-                "fresh": _check_fresh, "budget": _check_budget, "compare": _check_compare}
+                "fresh": _check_fresh, "budget": _check_budget, "compare": _check_compare,
+                "failures": _check_failures}
 
 
 def curves_by_variant(paths: list[str]) -> dict[str, list[str]]:
@@ -441,8 +514,7 @@ def _failures(args) -> None:
     unknown = [m for m in args.stuck_read if m not in by_method]
     if unknown:
         raise ValueError(f"--stuck-read: {unknown[0]} has no trace among the input files ({', '.join(by_method)})")
-    csv, md = Path(args.out_prefix + ".csv"), Path(args.out_prefix + ".md")
-    stuck_csv = Path(args.out_prefix + "_stuck.csv")
+    csv, stuck_csv, md = prefix_files("failures", args.out_prefix)  # a folder as the prefix: failures.csv in it
     df = failure_table(by_method, csv)
     text = "# How each searcher fails\n\n" + failure_markdown(df, str(csv))
     contacts = stuck_contacts({m: by_method[m] for m in args.stuck_read}, stuck_csv)

@@ -24,6 +24,8 @@ def run(args) -> None:
         # else the profile's error reads as a fault of the first variant file
         if profile not in PROFILES:
             raise ValueError(f"--profile={profile!r}; allowed: {', '.join(PROFILES)}")
+        if args.profile.count(profile) > 1:
+            raise ValueError(f"--profile: {profile} is given twice; each profile is checked once")
     for name in args.names:
         variant = load_variant(name)
         for profile in args.profile:

@@ -1,8 +1,8 @@
 """How long ``snakemake --cores N all`` takes from a fresh clone, on this machine, from the stored run's job
-times laid out on N cores (:mod:`egosearch.cost.schedule`); what a comparison's or a screen's trainings
-and evaluations still cost; how long one training takes here. ``egosearch estimate all`` prints the
-first, the Snakefile's ``onstart`` (and a dry run) all of them before the first job, ``egosearch train``
-the last at its start.
+times laid out on N cores (:mod:`egosearch.cost.schedule`); what the plan of a run (its DAG's jobs still to
+run, a comparison's or a screen's trainings and evaluations, the reference's included) costs; how long one
+training takes here. ``egosearch estimate all`` prints the first, the Snakefile's ``onstart`` (and a dry
+run, once its DAG is built) the second before the first job, ``egosearch train`` the last at its start.
 
 The trainings dominate and their speed differs most between machines, so they are scaled to this
 machine: a minute of the learner benchmark (``egosearch bench learner``'s short real training,
@@ -39,40 +39,68 @@ from egosearch.cost.schedule import (
     simulate,
     trainings_at_rate,
 )
-from egosearch.report.workflow_jobs import job_cost_s, workflow_config, workflow_heights
+from egosearch.report.workflow_jobs import job_cost_s
 from egosearch.rl.config import BODY_STEPS, DECISIONS
 from egosearch.workflow.dag import dag_jobs
 
 
 def print_costs(targets, config: dict, profile: str, seeds: list[int], reference: str, cores: int | None,
-                trainings_per_gpu: int = 1) -> None:
+                trainings_per_gpu: int = 1, plan: list | None = None, whole: bool = False) -> None:
     """What ``snakemake`` prints before the first job of ``targets`` (the Snakefile's ``onstart``, and a
-    dry run's start): `all`'s whole DAG from scratch, simulated on ``cores`` (:func:`print_before_a_run`),
-    and a comparison's trainings and evaluations still to run (:func:`print_variant_cost`: every one of
-    ``seeds`` for compare; for screen ``screen_seeds`` seeds from ``screen_seed`` and the reference's
-    missing spread seeds, then the screen's power, :func:`print_screen_power`). Where no estimate can be
-    made, a line says why:
+    dry run once its DAG is built): the cost of ``plan``, the jobs this invocation runs (as
+    :func:`egosearch.workflow.dag.plan_jobs` reads them from its DAG), every one of them counted by rule as
+    Snakemake's job stats count them, trainings priced at this machine's rate and the other jobs at their
+    recorded times (:func:`print_plan_cost`); for `all` from scratch (``whole``: the plan is the whole DAG,
+    nothing stored or all forced) the simulated schedule of ``egosearch estimate all`` instead
+    (:func:`print_before_a_run`); for a screen then its power (:func:`print_screen_power`). An empty plan
+    prints nothing (Snakemake says "Nothing to be done"). Where no estimate can be made, a line says why:
     ``cores`` None (a cluster executor's run, which lays its jobs out itself) has no schedule to simulate.
     First, once, where paper-profile trainings share one GPU (``trainings_per_gpu`` > 1): whether they do
-    under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`)."""
+    under CUDA MPS, and what running without it costs (:func:`egosearch.core.gpu_share.warn_gpu_sharing`).
+    ``seeds`` is the profile's (what a comparison trains), kept for callers; the plan says what runs."""
     warn_gpu_sharing(profile, trainings_per_gpu)
+    if plan is not None and not plan:
+        return
+    variant = config.get("variant")
     if cores is None:
-        if "all" in targets or ({"compare", "screen"} & set(targets) and config.get("variant")):
+        if "all" in targets or ({"compare", "screen"} & set(targets) and variant):
             print("(no estimate of the cost: a cluster executor's run lays its jobs out itself, on no cores of this "
                   "machine to simulate)", file=sys.stderr)
         return
-    if "all" in targets:
+    if plan is None:
+        return
+    if "all" in targets and whole:
         print_before_a_run(profile, cores)
-    for target in ("compare", "screen"):
-        if target in targets and config.get("variant"):
-            if target == "compare":
-                print_variant_cost(profile, target, config["variant"], seeds, reference, cores)
-                continue
-            chosen = list(range(config["screen_seed"], config["screen_seed"] + config.get("screen_seeds", 1)))
-            spread = config["profiles"][profile].get("spread_seeds", seeds)
-            print_variant_cost(profile, target, config["variant"], chosen, reference, cores,
-                               reference_seeds=spread)
-            print_screen_power(profile, reference, len(chosen))
+    elif "all" in targets or ({"compare", "screen"} & set(targets) and variant) or any(
+            job_rule(j) not in UNPRICED_RULES for j in plan):
+        target = next((t for t in ("screen", "compare") if t in targets and variant), None)
+        what = f"{target} of {variant} against {reference}" if target else " ".join(sorted(map(str, targets)))
+        cost = f"the {target}'s cost" if target else "the run's time"
+        print_plan_cost(what, plan, profile, cores, reference, cost_name=cost)
+    if "screen" in targets and variant:
+        chosen = list(range(config["screen_seed"], config["screen_seed"] + config.get("screen_seeds", 1)))
+        print_screen_power(profile, reference, len(chosen))
+
+
+UNPRICED_RULES = ("all", "provenance")
+"""Rules of no cost of their own (a target's inputs, the record): a plan of these alone prints no cost line."""
+
+
+def job_rule(job) -> str:
+    """A plan job's rule (a :class:`egosearch.workflow.dag.DagJob`, or its dict)."""
+    return job["rule"] if isinstance(job, dict) else job.rule
+
+
+def _wildcards(job) -> dict:
+    return (job.get("wildcards") if isinstance(job, dict) else getattr(job, "wildcards", None)) or {}
+
+
+def plan_counts(plan: list) -> dict[str, int]:
+    """The plan's jobs per rule, as Snakemake's "Job stats" table counts them, its total under ``total``."""
+    counts: dict[str, int] = {}
+    for job in plan:
+        counts[job_rule(job)] = counts.get(job_rule(job), 0) + 1
+    return {**dict(sorted(counts.items())), "total": len(plan)}
 
 
 def print_before_a_run(profile: str, cores: int) -> None:
@@ -202,74 +230,112 @@ def print_screen_power(profile: str, reference: str, n_seeds: int) -> None:
         print(f"(no power line: {path}: {err})", file=sys.stderr)
 
 
-def print_variant_cost(profile: str, target: str, variant: str, seeds: list[int], reference: str,
-                       cores: int, reference_seeds: list[int] = ()) -> None:
-    """What ``snakemake compare``/``screen`` prints before its first job: the trainings and evaluations
-    of ``variant`` it still has to run (their files are missing), and of ``reference`` on
-    ``reference_seeds`` (a screen's spread seeds) where those are missing, each at this machine's rate (its
-    last calibration, else the stored learner benchmark's machine, said which), and the wall time on
-    ``cores`` cores (one-thread jobs side by side). Never stops the run."""
-    # local: the variants layer loads gymnasium's registry; only a comparison's start reads a variant
-    from egosearch.variants import resolve_variant
+class _Pricing:
+    """How this machine's trainings are priced, read once per cost line: the calibrated rate (this machine's
+    last calibration, else the stored learner benchmark's machine's, said which), the stored trainings'
+    ratio to the benchmark, and the record and benchmark the teacher's cost reads."""
 
+    def __init__(self, profile: str, results: Path, record: dict):
+        bench_path = results / "bench" / "learner.json"
+        self.bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
+        self.profile, self.results, self.record = profile, results, record
+        self.kind = steps_of_profile(profile)
+        self.ratio = benchmark_ratio(record, stored_training_rates(record, results, self.kind), self.bench, self.kind)
+        self.rate, self.where = cached_rate(), "this machine (its last calibration)"
+        if self.rate is None and steps_of_bench(self.bench) != self.kind:
+            self.bench = {}  # it timed the profile before it became what it is
+        if self.rate is None:
+            self.rate = self.bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
+            self.where = (f"{machine_key(self.bench.get('machine'))} (the stored learner benchmark; `egosearch "
+                          "estimate all` calibrates this machine)")
+
+    def training(self, variant: str) -> tuple[float, str, str, int]:
+        """One training of ``variant`` at this profile: (CPU seconds, on what machine's rate, what its
+        teacher's phase adds in words, its env steps)."""
+        # local: the variants layer loads gymnasium's registry; only a cost line with trainings reads a variant
+        from egosearch.variants import resolve_variant
+
+        config = resolve_variant(variant, self.profile).config
+        steps, rate, where = config.total_env_steps, self.rate, self.where
+        seconds = steps / ((self.ratio[0] if self.ratio else 1.0) * rate) if rate else float("nan")
+        if config.env_step_unit != self.kind or not rate:
+            # no calibration of this kind of env step: priced from the stored runs of its kind
+            per_step = stored_cpu_s_per_step(self.record, self.results, config.env_step_unit)
+            seconds = steps * per_step if per_step else float("nan")
+            where = f"the stored trainings' machines (their CPU time per env step, {config.env_step_unit})"
+        teacher = ""
+        if config.demo_episodes:
+            # the rates above are the RL phase's: a training that learns from the classical searcher first
+            # runs its episodes and clones them (training_time_line adds them the same way)
+            extra = teacher_cost_s(config, self.results, self.bench, rate) if rate else None
+            if extra is not None:
+                seconds += extra
+                teacher = f"the teacher's {config.demo_episodes} episodes and the cloning"
+                teacher = f", of which about {extra / 3600:.1f} h {teacher}"
+            else:
+                teacher = (f", plus the teacher's {config.demo_episodes} episodes and the cloning (no stored "
+                           "measurement prices them)")
+        return seconds, where, teacher, steps
+
+
+def print_plan_cost(what: str, plan: list, profile: str, cores: int, reference: str,
+                    cost_name: str = "the run's time") -> None:
+    """The cost line of a plan (the jobs a run or dry run will run: :func:`egosearch.workflow.dag.plan_jobs`),
+    opened by ``what``: its jobs per rule as Snakemake's job stats count them; its trainings, those of
+    ``reference`` counted apart, each at this machine's rate (:class:`_Pricing`); its evaluations at the
+    record's time; and the plan laid out on ``cores`` cores (:func:`egosearch.cost.schedule.simulate`, every
+    other job at its recorded time or its rule's median). Never stops the run."""
     results = Path("results") / profile
     if no_record(profile, results / "provenance.json"):
-        print(f"(no estimate of the {target}'s cost: {no_record(profile, results / 'provenance.json')})",
-              file=sys.stderr)
+        print(f"(no estimate of {cost_name}: {no_record(profile, results / 'provenance.json')})", file=sys.stderr)
         return
     try:
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
-        bench_path = results / "bench" / "learner.json"
-        bench = json.loads(bench_path.read_text(encoding="utf-8")) if bench_path.is_file() else {}
-        kind = steps_of_profile(profile)
-        ratio = benchmark_ratio(record, stored_training_rates(record, results, kind), bench, kind)
-        rate, where = cached_rate(), "this machine (its last calibration)"
-        if rate is None and steps_of_bench(bench) != kind:
-            bench = {}  # it timed the profile before it became what it is
-        if rate is None:
-            rate = bench.get("result", {}).get("env_steps_per_core_s_cpu_profile")
-            where = f"{machine_key(bench.get('machine'))} (the stored learner benchmark; `egosearch estimate all` " \
-                    "calibrates this machine)"
-        config_of_variant = resolve_variant(variant, profile).config
-        steps = config_of_variant.total_env_steps
-        runs = [(variant, s) for s in seeds] + [(reference, s) for s in reference_seeds]
-        trainings = [(v, s) for v, s in runs if not (results / "train" / v / f"seed{s}" / "done.json").exists()]
-        evals = [r["wall_s"] for r in record.get("jobs", []) if r.get("rule") == "eval"]
-        per_eval = statistics.median(evals) if evals else 0.0
-        config = workflow_config()
-        n_evals = sum(not (results / "eval" / v / f"seed{s}" / home / placement / f"h{height}.csv").exists()
-                      for v, s in runs for home in config["homes"] for placement in config["placements"]
-                      for height in workflow_heights(config))
-        of_reference = sum(v == reference for v, _ in trainings)
-        counted = f" ({of_reference} of them the reference's spread seeds)" if of_reference else ""
-        per_training = steps / ((ratio[0] if ratio else 1.0) * rate) if rate else float("nan")
-        variant_kind = config_of_variant.env_step_unit
-        if variant_kind != kind or not rate:
-            # no calibration of this kind of env step: priced from the stored runs of its kind
-            per_step = stored_cpu_s_per_step(record, results, variant_kind)
-            per_training = steps * per_step if per_step else float("nan")
-            where = f"the stored trainings' machines (their CPU time per env step, {variant_kind})"
-        teacher = ""
-        if config_of_variant.demo_episodes:
-            # the rates above are the RL phase's: a training that learns from the classical searcher first
-            # runs its episodes and clones them (training_time_line adds them the same way)
-            extra = teacher_cost_s(config_of_variant, results, bench, rate) if rate else None
-            if extra is not None:
-                per_training += extra
-                teacher = (f", of which about {extra / 3600:.1f} h the teacher's {config_of_variant.demo_episodes} "
-                           "episodes and the cloning")
-            else:
-                teacher = (f", plus the teacher's {config_of_variant.demo_episodes} episodes and the cloning (no "
-                           "stored measurement prices them)")
-        hours = (math.ceil(len(trainings) / cores) * per_training + n_evals * per_eval / cores) / 3600
-        print(f"{target} of {variant} against {reference}: {len(trainings)} training(s){counted} of {steps} env "
-              f"steps, about "
-              f"{per_training / 3600:.1f} h each on {where}{teacher}, and {n_evals} evaluations of about "
-              f"{per_eval:.0f} s: about {hours:.1f} h on {cores} core(s)", file=sys.stderr)
-        if where.startswith("this machine") and cached_busy_line():
+        durations = dict(durations_from_provenance(record, plan))
+        trainings = [j for j in plan if job_rule(j) == "train"]
+        evaluations = [j for j in plan if job_rule(j) == "evaluate"]
+        pricing = _Pricing(profile, results, record) if trainings else None
+        prices = {}
+        for job in trainings:
+            variant = _wildcards(job)["variant"]
+            if variant not in prices:
+                prices[variant] = pricing.training(variant)
+            durations[_job_id(job)] = prices[variant][0]
+        priced = all(math.isfinite(p[0]) for p in prices.values())
+        counts = plan_counts(plan)
+        parts = [f"{len(plan)} job{'s' if len(plan) != 1 else ''} to run ("
+                 + ", ".join(f"{n} {rule}" for rule, n in counts.items() if rule != "total") + ")"]
+        if trainings:
+            of_reference = sum(_wildcards(j).get("variant") == reference for j in trainings)
+            hours_each = sorted({round(p[0] / 360) / 10 for p in prices.values() if math.isfinite(p[0])})
+            steps = " or ".join(str(n) for n in sorted({p[3] for p in prices.values()}))
+            wheres = list(dict.fromkeys(p[1] for p in prices.values()))
+            teachers = list(dict.fromkeys(p[2] for p in prices.values() if p[2]))
+            each = (f"{hours_each[0]:.1f} h" if len(hours_each) == 1 else
+                    f"{hours_each[0]:.1f} to {hours_each[-1]:.1f} h" if hours_each else "an unknown time")
+            each += "" if priced else " (no calibration, and no stored training of its kind of env step, prices it)"
+            parts.append(f"{len(trainings)} training(s)"
+                         + (f" ({of_reference} of them {reference}'s, the reference's)" if of_reference else "")
+                         + f" of {steps} env steps, about {each} each on {' and '.join(wheres)}"
+                         + (teachers[0] if len(teachers) == 1 else ""))
+        if evaluations:
+            per_eval = statistics.median(durations[_job_id(j)] for j in evaluations)
+            of_reference = sum(_wildcards(j).get("variant") == reference for j in evaluations)
+            parts.append(f"{len(evaluations)} evaluations"
+                         + (f" ({of_reference} of them {reference}'s)" if of_reference else "")
+                         + f" of about {per_eval:.0f} s")
+        total = (f"about {simulate(plan, cores, durations).makespan / 3600:.1f} h on {cores} core(s)" if priced else
+                 f"its time on {cores} core(s) unknown")
+        print(f"{what}: " + ", ".join(parts) + f": {total}", file=sys.stderr)
+        if pricing is not None and any(p[1].startswith("this machine") for p in prices.values()) \
+                and cached_busy_line():
             print(f"  {cached_busy_line()}", file=sys.stderr)
     except (OSError, ValueError, KeyError, TypeError) as err:
-        print(f"(no estimate of the {target}'s cost: {err})", file=sys.stderr)
+        print(f"(no estimate of {cost_name}: {err})", file=sys.stderr)
+
+
+def _job_id(job) -> str:
+    return job["id"] if isinstance(job, dict) else job.id
 
 
 def training_time_line(steps: int, profile: str, config=None) -> str | None:

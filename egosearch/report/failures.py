@@ -45,8 +45,7 @@ def stuck_share(df: pd.DataFrame) -> float:
 def episode_kinds(trace: Mapping) -> pd.DataFrame:
     """One row per episode of a trace file's arrays: ``scenario_id, success, collisions, kind`` (``kind`` is
     ``success`` for a success, else one of :data:`KINDS`, module docstring)."""
-    df = pd.DataFrame({k: np.asarray(trace[k]) for k in ("scenario_id", "step", "collisions", "visible", "success",
-                                                            "geodesic")})
+    df = pd.DataFrame({k: np.asarray(trace[k]) for k in TRACE_ARRAYS})
     rows = []
     for sid, ep in df.groupby("scenario_id", sort=True):
         ep = ep.sort_values("step")
@@ -74,6 +73,23 @@ FAILURE_COLUMNS = ("method", "height", "placement", "episodes", "success", "stuc
 """One row per method and cell (both homes pooled): ``success`` and ``stuck`` (failed, >= 50 collisions,
 seen or not) and each failure kind as a share of ALL the cell's episodes (the kinds and ``success`` sum
 to 1)."""
+
+
+TRACE_ARRAYS = ("scenario_id", "step", "collisions", "visible", "success", "geodesic")
+"""What :func:`episode_kinds` reads of a trace file (``egosearch evaluate --traces`` writes them)."""
+
+
+def check_trace_file(path) -> None:
+    """A trace file holds :data:`TRACE_ARRAYS` and at least one episode; ValueError naming it otherwise (the
+    arrays are read only by name: numpy's KeyError, or pandas' on an empty table, would name neither)."""
+    with np.load(path, allow_pickle=False) as trace:
+        missing = [k for k in TRACE_ARRAYS if k not in trace.files]
+        if missing:
+            raise ValueError(f"{path}: not a per-step trace (it lacks {', '.join(missing)}); a trace file is written "
+                             "by `egosearch evaluate --traces`")
+        if trace["scenario_id"].size == 0:
+            raise ValueError(f"{path}: a trace of no episode (its scenario set was empty); a failure table reads "
+                             "at least one")
 
 
 def failure_table(traces: Mapping[str, Iterable], out_csv=None) -> pd.DataFrame:

@@ -60,7 +60,14 @@ from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
-from egosearch.rl.demos import collect_demonstrations, load_demonstrations, summary_path
+from egosearch.rl.demos import (
+    DemonstrationsError,
+    check_demonstrations,
+    collect_demonstrations,
+    load_demonstrations,
+    summary_path,
+    wanted_summary,
+)
 from egosearch.rl.imitation import clone, dagger_round
 from egosearch.rl.registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
@@ -243,7 +250,21 @@ def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
     ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if ckpt is not None:
         check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
+        if cfg.demo_episodes:
+            # the demonstrations it resumes with: the run's own, readable, before any env is built
+            demos = demos_path_of(ckpt_path)
+            if not demos.exists():
+                raise CheckpointError(f"{ckpt_path} needs the run's demonstrations {demos}, which are gone")
+            try:
+                check_demonstrations(demos, wanted_summary(env_id, cfg, env_kwargs, variant))
+            except DemonstrationsError as err:
+                raise CheckpointError(f"{ckpt_path} cannot resume with its demonstrations: {err}") from None
     return None, ckpt
+
+
+def demos_path_of(ckpt_path: Path) -> Path:
+    """Where a run keeps its demonstrations: beside its checkpoint, ``ckpt/demos.replay.npz``."""
+    return ckpt_path.parent / "demos.replay.npz"
 
 
 def _act_batch(agent: Agent, observations: list[dict]) -> list[np.ndarray]:
@@ -383,8 +404,11 @@ class LiveRun:
             path.parent.mkdir(parents=True, exist_ok=True)
             self.say(f"collecting {cfg.demo_episodes} demonstration episodes of {cfg.demo_teacher} -> {path}")
             collect_demonstrations(self.env_id, cfg, self.env_kwargs, cfg.demo_episodes, path, seed=cfg.seed,
-                                   progress=progress)
-        demos = load_demonstrations(path, cfg, str(self.device))
+                                   progress=progress, variant=self.variant)
+        try:
+            demos = load_demonstrations(path, cfg, str(self.device), self._wanted_demonstrations())
+        except DemonstrationsError as err:  # on resume: an array that does not read back
+            raise CheckpointError(f"{self.ckpt_path} cannot resume with its demonstrations: {err}") from None
         if ckpt is not None and "demo_rng" in ckpt:
             demos.buffers[0].rng.bit_generator.state = rng_from_plain(ckpt["demo_rng"])
         summary = json.loads(summary_path(path).read_text(encoding="utf-8"))
@@ -393,23 +417,28 @@ class LiveRun:
                  f"teacher success {summary['teacher_success']:.2f}, {summary['cpu_s']:.0f} CPU-s")
         return demos, summary
 
+    def _wanted_demonstrations(self) -> dict:
+        """What this run's demonstrations' summary says (:func:`egosearch.rl.demos.wanted_summary`)."""
+        wanted = wanted_summary(self.env_id, self.cfg, self.env_kwargs, self.variant)
+        assert wanted["image_size"] == self.agent.replay_image_size, "demonstrations stored as the replay stores"
+        return wanted
+
     def _own_demonstrations(self, path: Path) -> bool:
         """Whether ``path`` holds the demonstrations this run would collect (same teacher episodes, stored
-        as this learner stores them): a run killed while cloning starts again from them."""
-        try:
-            held = json.loads(summary_path(path).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+        as this learner stores them), whole: a run killed while cloning starts again from them. A file left
+        there that is not (truncated, another run's) is said in one line, and collected again."""
+        if not path.exists() and not summary_path(path).exists():
             return False
-        cfg = self.cfg
-        wanted = {"env_id": self.env_id, "env_kwargs": json.loads(json.dumps(train_env_kwargs(cfg, self.env_kwargs))),
-                  "teacher": cfg.demo_teacher,
-                  "seed": cfg.seed, "episodes": cfg.demo_episodes, "frame_history": cfg.frame_history,
-                  "image_size": self.agent.replay_image_size}
-        return path.exists() and all(held.get(key) == value for key, value in wanted.items())
+        try:
+            check_demonstrations(path, self._wanted_demonstrations())
+        except DemonstrationsError as err:
+            self.say(f"not reused: {err}")
+            return False
+        return True
 
     @property
     def demos_path(self) -> Path:
-        return self.ckpt_path.parent / "demos.replay.npz"
+        return demos_path_of(self.ckpt_path)
 
     def _restart_seeds(self) -> list[int]:
         return [self.cfg.seed + 7919 * self.step + 104_729 * i for i in range(len(self.envs))]

@@ -81,10 +81,13 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
         where, what = schema_error(err)
         raise ConfigError(f"config {where}: {what}") from None
     for where, pairs in every_claims_pairs(config):
-        for pair in pairs:
+        for i, pair in enumerate(pairs):
             if pair[0] == pair[1]:
                 raise ConfigError(f"config {where}: {pair} is one searcher twice; a pair is [head moving, head "
                                   "fixed]")
+            if list(pair) in [list(p) for p in pairs[:i]]:
+                # the behaviour pages and the failure table would read its traces twice
+                raise ConfigError(f"config {where}: {list(pair)} is given twice; each pair once")
     if config.get("fresh_scenario_seed") == config["scenario_seed"]:
         raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
                           "scenario_seed; the fresh-set check needs sets never stored")

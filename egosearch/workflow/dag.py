@@ -129,34 +129,50 @@ def _collect(target: str, cores: int, config_items: list[str]) -> list[dict]:
         workflow = workflow_api._workflow
         workflow._prepare_dag(forceall=True, ignore_incomplete=True, lock_warn_only=True, nolock=True)
         workflow._build_dag()
-        dag = workflow.dag
-        dag.update_priority()
-        profile = workflow.config.get("profile")
-        benchmarks = Path("results") / str(profile) / "benchmarks"
-        jobs = sorted(dag.needrun_jobs(), key=dag.jobid)
-        ids, keys, taken, wildcards = {}, {}, set(), {}
-        for job in jobs:
-            key = keys[job] = _benchmark_key(str(job.benchmark), benchmarks) if job.benchmark else None
-            wildcards[job] = {k: str(v) for k, v in job.wildcards_dict.items()}
-            ident = key or "/".join([job.rule.name, *(v for k, v in wildcards[job].items() if k != "profile")])
-            if ident in taken:
-                ident = f"{ident}#{dag.jobid(job)}"
-            ids[job] = ident
-            taken.add(ident)
-        rows = []
-        for job in jobs:
-            key = keys[job]
-            record_rule, _, record_job = key.partition("/") if key else (None, None, None)
-            rows.append({
-                "id": ids[job], "rule": job.rule.name, "job": record_job, "record_rule": record_rule,
-                "threads": int(job.threads),
-                "deps": [ids[dep] for dep in sorted(dag.dependencies[job], key=dag.jobid) if dep in ids],
-                "order": dag.jobid(job), "priority": job.priority,
-                "input_bytes": sum(_size(f) for f in job.input),
-                "temp_input_bytes": sum(_size(f) for f in job.input if f.is_flagged("temp")),
-                "wildcards": wildcards[job],
-            })
-        return rows
+        return plan_rows(workflow.dag, workflow.config.get("profile"))
+
+
+def plan_rows(dag, profile: str | None) -> list[dict]:
+    """The jobs a built Snakemake DAG will run (its ``needrun_jobs``: with ``forceall`` every job), as the
+    JSON rows of :class:`DagJob`, in Snakemake's job-id order; ``profile`` names the benchmark folder that
+    keys them. What the child process writes, and what the Snakefile's cost line reads from the live DAG
+    of a run or a dry run (:func:`plan_jobs`)."""
+    benchmarks = Path("results") / str(profile) / "benchmarks"
+    dag.update_priority()  # a job's priority is read from the DAG once computed (Snakemake does it later)
+    jobs = sorted(dag.needrun_jobs(), key=dag.jobid)
+    ids, keys, taken, wildcards = {}, {}, set(), {}
+    for job in jobs:
+        key = keys[job] = _benchmark_key(str(job.benchmark), benchmarks) if job.benchmark else None
+        wildcards[job] = {k: str(v) for k, v in job.wildcards_dict.items()}
+        ident = key or "/".join([job.rule.name, *(v for k, v in wildcards[job].items() if k != "profile")])
+        if ident in taken:
+            ident = f"{ident}#{dag.jobid(job)}"
+        ids[job] = ident
+        taken.add(ident)
+    rows = []
+    for job in jobs:
+        key = keys[job]
+        record_rule, _, record_job = key.partition("/") if key else (None, None, None)
+        rows.append({
+            "id": ids[job], "rule": job.rule.name, "job": record_job, "record_rule": record_rule,
+            "threads": int(job.threads),
+            "deps": [ids[dep] for dep in sorted(dag.dependencies[job], key=dag.jobid) if dep in ids],
+            "order": dag.jobid(job), "priority": job.priority,
+            "input_bytes": sum(_size(f) for f in job.input),
+            "temp_input_bytes": sum(_size(f) for f in job.input if f.is_flagged("temp")),
+            "wildcards": wildcards[job],
+        })
+    return rows
+
+
+def plan_jobs(dag, profile: str | None) -> list[DagJob]:
+    """:func:`plan_rows` as :class:`DagJob`: the plan of the run (or dry run) whose DAG ``dag`` is."""
+    return [DagJob(**(row | {"deps": tuple(row["deps"])})) for row in plan_rows(dag, profile)]
+
+
+def whole_dag(dag) -> bool:
+    """Whether a built DAG runs every job it holds: nothing of it is stored yet, or all is forced (``-F``)."""
+    return len(list(dag.needrun_jobs())) == len(list(dag.jobs))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

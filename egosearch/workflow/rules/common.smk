@@ -61,6 +61,31 @@ wildcard_constraints:
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
 
 
+def print_the_plans_cost():
+    """The cost of what this invocation runs (egosearch.cost.estimate.print_costs): the jobs of its DAG that
+    need to run, counted as Snakemake's job stats count them, trainings and evaluations of the reference
+    included; nothing when nothing is to be done. No target given: Snakemake builds the first rule, `all`."""
+    from egosearch.cost.estimate import print_costs
+    from egosearch.workflow.dag import plan_jobs, whole_dag
+
+    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given(),
+                trainings_per_gpu=TRAININGS_PER_GPU, plan=plan_jobs(workflow.dag, PROFILE),
+                whole=whole_dag(workflow.dag))
+
+
+def print_the_plans_cost_once_built():
+    """A dry run's cost line: Snakemake calls onstart only before a real run's first job and has no hook for a
+    dry run's DAG, so its DAG-building step is wrapped to print the line (print_the_plans_cost) when the DAG
+    is there, before Snakemake prints the plan."""
+    build_dag = workflow._build_dag
+
+    def build_then_print():
+        build_dag()
+        print_the_plans_cost()
+
+    workflow._build_dag = build_then_print
+
+
 def scenario_file(placement, height):
     return f"{RESULTS}/scenarios/{LAYOUT}/{placement}/h{height}.csv"
 
