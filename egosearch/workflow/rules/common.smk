@@ -76,8 +76,11 @@ def print_the_plans_cost():
 def print_the_plans_cost_once_built():
     """A dry run's cost line: Snakemake calls onstart only before a real run's first job and has no hook for a
     dry run's DAG, so its DAG-building step is wrapped to print the line (print_the_plans_cost) when the DAG
-    is there, before Snakemake prints the plan."""
-    build_dag = workflow._build_dag
+    is there, before Snakemake prints the plan. A Snakemake without that step (pyproject pins 9.x, which has
+    it) gets no dry-run cost line rather than a failed dry run."""
+    build_dag = getattr(workflow, "_build_dag", None)
+    if build_dag is None:
+        return
 
     def build_then_print():
         build_dag()
