@@ -13,6 +13,7 @@ back into its options."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 from egosearch.searchers.decision_envs import MODULAR_ENV_IDS, MODULAR_MAP_DIM, decision_env_id, modular_decision_dim
@@ -20,6 +21,32 @@ from egosearch.sim.envs import ENV_IDS, body_env_id, body_options
 
 ALL_ENV_IDS = (*ENV_IDS, *MODULAR_ENV_IDS)
 """Every id a policy may be trained and evaluated in."""
+OBSERVATION_OPTIONS = ("contact_signal",)
+"""The body env's keyword options that change what a policy observes with no id of their own (no new id per
+combination of options): a learner config field of the same name sets each, the run's config records it in
+its actor file, and ``egosearch evaluate`` builds the actor's env with the recorded ones
+(:func:`observation_kwargs`; ``--env-option`` overrides them, and an actor that does not fit is refused)."""
+
+
+def observation_kwargs(config: Mapping | None) -> dict[str, bool]:
+    """The observation options a learner config (its ``to_dict()``, or the one an actor file records) turns
+    on, as the env's keyword arguments; those off are left out, so a config without them builds the env it
+    always did."""
+    return {name: True for name in OBSERVATION_OPTIONS if (config or {}).get(name)}
+
+
+def parse_env_options(pairs: list[str] | None) -> dict[str, bool]:
+    """``--env-option key=value`` pairs -> the env's keyword arguments; one clear line for a key not in
+    :data:`OBSERVATION_OPTIONS` or a value other than true/false."""
+    out: dict[str, bool] = {}
+    for pair in pairs or []:
+        key, sep, value = pair.partition("=")
+        if not sep or key not in OBSERVATION_OPTIONS:
+            raise ValueError(f"--env-option {pair!r}: KEY=true|false with KEY one of {', '.join(OBSERVATION_OPTIONS)}")
+        if value.lower() not in ("true", "false", "1", "0"):
+            raise ValueError(f"--env-option {pair!r}: the value is true or false, not {value!r}")
+        out[key] = value.lower() in ("true", "1")
+    return out
 
 
 @dataclass(frozen=True)
@@ -73,13 +100,18 @@ def observed_env_id(env_id: str, target_memory: bool, modular_searcher: bool = F
     return EnvOptions(**{**asdict(options), "target_memory": options.target_memory or bool(target_memory)}).env_id
 
 
-def env_space_dims(env_id: str) -> dict[str, int]:
-    """``{"action", "mask", "proprio"}`` sizes of a registered id, without building its env."""
+def env_space_dims(env_id: str, env_kwargs: Mapping | None = None) -> dict[str, int]:
+    """``{"action", "mask", "proprio"}`` sizes of a registered id with these observation options
+    (:data:`OBSERVATION_OPTIONS`), without building its env."""
     # local: registering the ids must not load pybullet and the sensor (the Snakefile's checks import this)
     from egosearch.sim.env import MASK_FEATURE_DIM, space_dims
 
     options = env_options(env_id)
+    observed = {k: bool(v) for k, v in (env_kwargs or {}).items() if k in OBSERVATION_OPTIONS}
     if options.modular:
+        if any(observed.values()):
+            unread = ", ".join(k for k, v in observed.items() if v)
+            raise ValueError(f"{env_id} is a decision env: it does not read {unread}")
         return {**space_dims(options.head), "action": modular_decision_dim(options.head),
                 "mask": MASK_FEATURE_DIM + MODULAR_MAP_DIM}
-    return space_dims(options.head, options.target_memory, options.floor_map)
+    return space_dims(options.head, options.target_memory, options.floor_map, **observed)

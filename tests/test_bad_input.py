@@ -80,7 +80,7 @@ BAD_VARIANT_FILES = [
      "ablations/split_without_generated.yaml: train_env: home_seeds is only read with layout: generated"),
     ("split_draws_heldout", HEAD.replace("layout: kitchen_living", "layout: generated, home_seeds: [899990, 900005]"),
      "ablations/split_draws_heldout.yaml: train_env: home_seeds=[899990, 900005) overlaps the held-out homes "
-     "[900000, 900020) that no training may draw (egosearch.sim.home_pool.HELDOUT_HOME_SEEDS)"),
+     "[900000, 900020) that no training may draw (egosearch.scene.layouts.HELDOUT_HOME_SEEDS)"),
 ]
 
 # (--config entries, the one line) of `snakemake -n all`.

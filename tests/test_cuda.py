@@ -331,7 +331,7 @@ def test_the_default_profile_imitates_then_fine_tunes_on_cuda_and_its_actor_walk
     the critic's warm-up, SAC with demonstrations in every batch, the privileged critic), and the actor and
     the start it leaves walk the body env on the CPU as evaluation runs them."""
     from egosearch.cli.acting import policy_factory
-    from egosearch.rl.run_files import START_ACTOR_NAME
+    from egosearch.core.staging import START_ACTOR_NAME
     from egosearch.runs.evaluate import evaluate
     from egosearch.sim.scenarios import generate_scenarios
 
@@ -345,7 +345,7 @@ def test_the_default_profile_imitates_then_fine_tunes_on_cuda_and_its_actor_walk
     for name in ("actor.pt", START_ACTOR_NAME):
         state = torch.load(tmp_path / name, weights_only=True)
         assert all(v.device.type == "cpu" for v in state["state_dict"].values())
-        make_policy, env_id = policy_factory("actor", str(tmp_path / name), 0)
+        make_policy, env_id, _ = policy_factory("actor", str(tmp_path / name), 0)
         assert env_id == "EgoSearchMemory-v0"
         rows = evaluate(env_id, make_policy, generate_scenarios("kitchen_living", "everywhere", 1.05, n=2, seed=4),
                         seed=0)

@@ -73,7 +73,7 @@ def test_the_tuning_candidates_are_the_shipped_parameters_and_one_weight_halved_
 
 def test_the_splits_share_no_scenario_seed_or_home_with_the_stored_sets():
     from egosearch.runs.teacher_tuning import SPLITS
-    from egosearch.sim.home_pool import HELDOUT_HOME_SEEDS
+    from egosearch.scene.layouts import HELDOUT_HOME_SEEDS
 
     fit, held = SPLITS["fit"], SPLITS["held_out"]
     assert {fit.paper_seed, held.paper_seed}.isdisjoint({2021, 7})  # Table 1's sets, the fresh-set check

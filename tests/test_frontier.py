@@ -161,8 +161,8 @@ def test_the_tuned_searcher_reads_only_its_pose_and_is_named_by_its_head():
     from egosearch.cli.acting import policy_factory
     from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
 
-    assert policy_factory("frontier_tuned", None, 0) == (FrontierTunedPolicy, "EgoSearch-v0")
-    assert policy_factory("frontier_tuned_head_off", None, 0) == (FrontierTunedPolicy, "EgoSearchNoHead-v0")
+    assert policy_factory("frontier_tuned", None, 0) == (FrontierTunedPolicy, "EgoSearch-v0", {})
+    assert policy_factory("frontier_tuned_head_off", None, 0) == (FrontierTunedPolicy, "EgoSearchNoHead-v0", {})
     scenarios = generate_scenarios("kitchen_living", "everywhere", 1.65, n=6, seed=11)
     for env_id in ("EgoSearch-v0", "EgoSearchNoHead-v0"):
         rows = evaluate(env_id, lambda env: FrontierTunedPolicy(PoseOnly(env)), scenarios, seed=0)

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.core.staging import CHECKPOINT_NAME, START_ACTOR_NAME
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.config import load_config
 from egosearch.rl.demos import collect_demonstrations, load_demonstrations
-from egosearch.rl.run_files import CHECKPOINT_NAME, START_ACTOR_NAME
 from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import train
 from egosearch.variants import load_variant

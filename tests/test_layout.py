@@ -3,6 +3,7 @@ imports that run one way (no circles, no arrow back up a stage), shared pieces p
 
 import ast
 import re
+import subprocess
 import sys
 from pathlib import Path
 
@@ -154,6 +155,50 @@ def find_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
         if node not in state:
             visit(node, [node])
     return found
+
+
+RULE_FILES = [PACKAGE.parent / "Snakefile", *sorted((PACKAGE / "workflow" / "rules").glob("*.smk"))]
+RULES_MAY_IMPORT = {"core", "scene", "variants", "report", "workflow", "cost"}
+"""What the Snakefile and the rules (``workflow/rules/*.smk``) may import: the workflow's own stage and what it
+reads (its checks, the report's readers of stored jobs, the variants, the scene's home splits), the cost model
+(the dry run's cost line) and the shared plumbing; never a stage that loads torch or the simulator, which
+every ``snakemake`` call, a dry run included, would then pay for."""
+
+
+def _rule_imports(path: Path) -> list[tuple[str, str]]:
+    """The egosearch imports of a Snakefile or ``.smk`` file, at its top and inside its functions: the file is
+    no Python module (rule blocks), so each import statement is read on its own."""
+    statements, pending = [], ""
+    for line in path.read_text().splitlines():
+        stripped = line.strip()
+        if pending:
+            pending += " " + stripped
+        elif re.match(r"(from|import)\s+egosearch\b", stripped):
+            pending = stripped
+        if pending and (pending.count("(") == pending.count(")")):
+            statements.append(pending)
+            pending = ""
+    return [pair for statement in statements for pair in _imports(statement)]
+
+
+def test_the_rules_read_the_package_without_torch_or_the_simulator():
+    assert ("egosearch.workflow.check", "checked_variants") in _rule_imports(RULE_FILES[0])
+    modules = _modules()
+    seen, wrong = set(), []
+    for path in RULE_FILES:
+        for imported, item in _rule_imports(path):
+            target = _target(imported, item, modules)
+            seen.add(target if target in modules else imported)
+            if _stage(target) not in RULES_MAY_IMPORT and target not in OPEN_MODULES:
+                wrong.append(f"{path.name} -> {imported}")
+    assert not wrong, wrong
+    assert len(seen) >= 10  # the reader found the rules' imports (common.smk alone has more)
+    # what the layers promise, run: importing everything the rules import loads neither torch nor pybullet
+    probe = ("import importlib, sys\n"
+             f"for name in {sorted(seen)!r}:\n    importlib.import_module(name)\n"
+             "print(sorted(m for m in ('torch', 'pybullet') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out
 
 
 def test_no_import_circles():

@@ -129,7 +129,7 @@ def test_a_training_in_the_modular_env_leaves_an_actor_that_evaluation_runs(tmp_
     # the commands run it step by step in the body env, and that is the same search
     from egosearch.cli.acting import policy_factory
 
-    make_policy, env_id = policy_factory("actor", str(tmp_path / "actor.pt"), 0)
+    make_policy, env_id, _ = policy_factory("actor", str(tmp_path / "actor.pt"), 0)
     assert env_id == "EgoSearch-v0"
     assert evaluate(env_id, make_policy, scenarios, seed=0) == rows
 
@@ -261,7 +261,7 @@ def test_the_random_decision_floor_walks_the_modular_searcher_on_uniform_decisio
             return policy
         return make_policy
 
-    make, env_id = policy_factory(kind, None, seed=0)
+    make, env_id, _ = policy_factory(kind, None, seed=0)
     assert env_id == body_env
     first = evaluate(env_id, recording(make), scenarios, seed=0)
     ours = np.array(decided)
@@ -271,6 +271,6 @@ def test_the_random_decision_floor_walks_the_modular_searcher_on_uniform_decisio
     assert evaluate(env_id, recording(make), scenarios, seed=0) == first
     assert np.array_equal(np.array(decided), ours)
     decided.clear()
-    make_other, _ = policy_factory(kind, None, seed=1)
+    make_other, _, _ = policy_factory(kind, None, seed=1)
     evaluate(env_id, recording(make_other), scenarios, seed=1)
     assert not np.array_equal(np.array(decided)[:3], ours[:3])

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 import torch
 
+from egosearch.core.staging import CHECKPOINT_NAME
 from egosearch.rl.actor import ActorPolicy, load_any_actor_net
 from egosearch.rl.config import load_config, table2_rows
 from egosearch.rl.replay import MultiReplay
-from egosearch.rl.run_files import CHECKPOINT_NAME
 from egosearch.rl.sac_drq_recurrent import (
     ACTOR_FORMAT,
     SacDrqRecurrentAgent,

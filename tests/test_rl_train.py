@@ -17,10 +17,11 @@ import pytest
 import torch
 
 from egosearch.core.machine import cpu_model
+from egosearch.core.staging import CHECKPOINT_NAME
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
-from egosearch.rl.run_files import CHECKPOINT_NAME, CheckpointError
+from egosearch.rl.run_files import CheckpointError
 from egosearch.rl.train import CURVE_COLUMNS, TRAIN_COLUMNS, default_evaluator, train
 
 TESTS = Path(__file__).parent

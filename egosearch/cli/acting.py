@@ -30,12 +30,16 @@ def check_threads(threads: int) -> None:
     at_least("--threads", threads, 0, "a number of threads (0: all cores)")
 
 
-def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None):
-    """(make_policy(env), the env id it acts in): ``env_id`` when given, else the policy's own (a
-    registered searcher's, :mod:`egosearch.searchers.registry`; a trained actor's is the one it was
-    trained in). An actor that cannot act in the env id is refused here, before any episode, and so
-    are weights given to a policy that has none; an actor trained at another learner profile than the
-    results ``out`` is written beside gets a note."""
+def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None,
+                   env_kwargs: dict | None = None):
+    """(make_policy(env), the env id it acts in, the env's observation options): ``env_id`` when given,
+    else the policy's own (a registered searcher's, :mod:`egosearch.searchers.registry`; a trained actor's
+    is the one it was trained in), and the options a trained actor's file records with ``env_kwargs`` (the
+    caller's, :data:`egosearch.envs.OBSERVATION_OPTIONS`) on top. An actor that cannot act in the env id
+    with those options is refused here, before any episode, and so are weights given to a policy that has
+    none; an actor trained at another learner profile than the results ``out`` is written beside gets a
+    note."""
+    given = dict(env_kwargs or {})
     if kind in searchers.SEARCHERS:
         if weights:
             # a searcher that is not learned would run and the weights be ignored without a word
@@ -43,22 +47,23 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
                              "drop one of them")
         searcher = searchers.get(kind)
         check_searcher_env(kind, env_id)
-        return searcher.maker(seed), env_id or searcher.env_id
+        return searcher.maker(seed), env_id or searcher.env_id, given
     if kind == searchers.ACTOR:
         if not weights:
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
         actor = ActorPolicy(weights)
         trained = actor.trained_env_id()
         note_profile(weights, actor, reference_profile(out))
+        options = {**actor.env_kwargs, **given}
         if trained in BODY_ENV_IDS and env_id in (None, BODY_ENV_IDS[trained]):
             # a modular searcher's decisions act step by step in the body env (ModularPolicy), so that
             # traces, the video and the replanner see every body step
             from egosearch.searchers.modular import ModularPolicy  # local: it loads the physics
 
-            return (lambda env: ModularPolicy(actor, env)), BODY_ENV_IDS[trained]
+            return (lambda env: ModularPolicy(actor, env)), BODY_ENV_IDS[trained], given
         env_id = env_id or trained or "EgoSearch-v0"
-        actor.check_env(env_id)
-        return (lambda env: actor), env_id
+        actor.check_env(env_id, options)
+        return (lambda env: actor), env_id, options
     raise ValueError(f"--policy={kind!r}; allowed: {', '.join(searchers.names())}, {searchers.ACTOR}")
 
 

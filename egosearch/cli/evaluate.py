@@ -6,7 +6,7 @@ from egosearch.cli.acting import check_threads, policy_factory, set_acting_threa
 from egosearch.cli.checks import check_seed, check_suffix
 from egosearch.core.csvio import write_csv_atomic
 from egosearch.core.outputs import check_outputs, check_overwrites
-from egosearch.envs import ALL_ENV_IDS
+from egosearch.envs import ALL_ENV_IDS, parse_env_options
 from egosearch.runs.evaluate import CURVE_LEVEL_COLUMNS, curve_episodes, curve_scenarios, evaluate, write_episodes
 from egosearch.runs.metrics import spl
 from egosearch.runs.trace import TraceRecorder
@@ -29,17 +29,19 @@ def run(args) -> None:
     check_threads(args.threads)
     if args.env_id is not None and args.env_id not in ALL_ENV_IDS:  # '' too: it would read as no --env-id
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
+    given = parse_env_options(args.env_option)
     set_acting_threads(args.threads)
-    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,
-                                           out=args.out)
+    make_policy, env_id, env_kwargs = policy_factory(args.policy, args.weights, args.seed, env_id=args.env_id,
+                                                     out=args.out, env_kwargs=given)
     recorder = TraceRecorder() if args.traces else None
     desc = f"evaluate {args.policy} on {env_id}"
     if curve is not None:
-        rows = curve_episodes(env_id, make_policy, curve, progress=True, desc=desc, recorder=recorder)
+        rows = curve_episodes(env_id, make_policy, curve, progress=True, desc=desc, recorder=recorder,
+                              env_kwargs=env_kwargs)
         write_csv_atomic(args.out, CURVE_LEVEL_COLUMNS, rows)
     else:
         rows = evaluate(env_id, make_policy, read_scenarios(args.scenarios), seed=args.seed, progress=True,
-                        desc=desc, recorder=recorder)
+                        desc=desc, recorder=recorder, env_kwargs=env_kwargs)
         write_episodes(args.out, rows)
     if recorder is not None:
         print(f"wrote {recorder.write(args.traces)}: {len(recorder.columns['step'])} steps of {len(rows)} episodes")

@@ -20,10 +20,10 @@ def run(args) -> None:
     check_seed("--seed", args.seed)
     check_threads(args.threads)
     set_acting_threads(args.threads)
-    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, out=args.out)
+    make_policy, env_id, env_kwargs = policy_factory(args.policy, args.weights, args.seed, out=args.out)
     scenarios = read_scenarios(args.scenarios)[: args.limit or None]
     rows = evaluate_fullbody(env_id, make_policy, scenarios, method=method, mg_name=mg, M=m, T=args.T,
-                             seed=args.seed, progress=True)
+                             seed=args.seed, progress=True, env_kwargs=env_kwargs)
     write_fullbody(args.out, rows)
     rate = sum(r["success"] for r in rows) / len(rows)
     print(f"{args.setting} ({args.policy}): success {rate:.3f} over {len(rows)} episodes -> {args.out}")

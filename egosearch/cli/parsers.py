@@ -81,6 +81,9 @@ def add_evaluate(sub) -> None:
     p.add_argument("--policy", default="actor", help=policy_help())
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help=env_id_help())
+    p.add_argument("--env-option", action="append", metavar="KEY=true|false",
+                   help="an observation option of the env (contact_signal), repeatable; default: the ones a trained "
+                        "actor's file records (an actor that does not fit the options given is refused)")
     p.add_argument("--seed", type=int, help=POLICY_SEED + " (not with --curve-of, whose episodes are seeded as the "
                                             "curve's)")
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")

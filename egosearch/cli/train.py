@@ -9,6 +9,7 @@ from egosearch.cli.checks import at_least, check_seed
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.core.staging import publish_run
 from egosearch.cost.estimate import training_time_line
+from egosearch.envs import observation_kwargs
 from egosearch.rl.run_files import CheckpointError, check_same_run
 from egosearch.rl.train import train
 from egosearch.rl.train_stacked import train_stacked
@@ -31,7 +32,8 @@ def run(args) -> None:
     resolved = resolve_variant(args.variant, args.profile, overrides)
     env = resolved.train_env
     evaluator = LazyEvaluator(lambda: scenario_evaluator(resolved.env_id, curve_homes(env), env["placement"],
-                                                         n=resolved.config.eval_episodes))
+                                                         n=resolved.config.eval_episodes,
+                                                         env_kwargs=observation_kwargs(resolved.config.to_dict())))
     if args.work_dir and not args.force:  # the DAG (--force) retrains over its own finished runs
         try:
             check_published_run(Path(args.out_dir), resolved)
@@ -120,7 +122,9 @@ def run_stacked(args) -> None:
     resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}) for s in seeds]
     env = resolved[0].train_env
     evaluators = [LazyEvaluator(lambda r=r: scenario_evaluator(r.env_id, curve_homes(env), env["placement"],
-                                                               n=r.config.eval_episodes)) for r in resolved]
+                                                               n=r.config.eval_episodes,
+                                                               env_kwargs=observation_kwargs(r.config.to_dict())))
+                  for r in resolved]
     if works and not args.force:
         for out, r in zip(outs, resolved):
             try:

@@ -46,7 +46,7 @@ def run(args) -> None:
                   f"penetrating pose; filming scenario {args.scenario_id} instead")
     if not candidates and args.scenario_id not in scenarios:
         raise ValueError(f"--scenario-id={args.scenario_id} is not in {args.scenarios}")
-    make_policy, env_id = policy_factory(args.policy, args.weights, args.seed, out=args.out)
+    make_policy, env_id, env_kwargs = policy_factory(args.policy, args.weights, args.seed, out=args.out)
     row = None
     # Seeded as `egosearch fullbody` seeds scenario k (--seed + k), the film replays the CSV's episode;
     # should the replay differ, the film takes the next candidate rather than show a penetration.
@@ -54,7 +54,8 @@ def run(args) -> None:
         try:
             row = write_search_video(scenarios[scenario_id].layout, args.character, make_policy,
                                      scenarios[scenario_id], args.out, still_path=args.still, M=args.M, T=args.T,
-                                     seed=args.seed + scenario_id, env_id=env_id, require_clean=True)
+                                     seed=args.seed + scenario_id, env_id=env_id, require_clean=True,
+                                     env_kwargs=env_kwargs)
             break
         except NotACleanSuccess as err:
             print(f"note: the replay differs from {args.first_success}: {err}; trying the next scenario")
@@ -64,7 +65,7 @@ def run(args) -> None:
         scenario = scenarios[args.scenario_id]
         row = write_search_video(scenario.layout, args.character, make_policy, scenario, args.out,
                                  still_path=args.still, M=args.M, T=args.T, seed=args.seed + args.scenario_id,
-                                 env_id=env_id)
+                                 env_id=env_id, env_kwargs=env_kwargs)
     print(f"{args.character}: scenario {row['scenario_id']}, success {row['success']} in {row['steps']} steps, "
           f"{row['penetrations']} penetrating pose(s) -> {args.out}, {args.still}")
 

@@ -15,6 +15,10 @@ from pathlib import Path
 
 LAST = "done.json"
 """Published last: its presence in the final folder means every other file is there."""
+CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
+"""The resumable state inside a run's folder (``*.ckpt`` is git-ignored: it holds the replay)."""
+START_ACTOR_NAME = "actor_start.pt"
+"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train.LiveRun.write_start_actor`)."""
 
 
 def _copy_atomic(src: Path, dest: Path) -> None:

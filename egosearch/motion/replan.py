@@ -289,9 +289,10 @@ def run_fullbody_episode(env, policy, mg: MotionGenerator, scenario: Scenario, T
 
 def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], method: str = "ours",
                       mg_name: str = "humanoid_phase", M: int | None = DEFAULT_M, T: int = DEFAULT_T,
-                      seed: int = 0, progress: bool = False) -> list[dict]:
+                      seed: int = 0, progress: bool = False, env_kwargs: dict | None = None) -> list[dict]:
     """``make_policy(env)`` realised by motion generator ``mg_name`` with ``method`` on every scenario.
-    ``M=None`` takes the method's default (the one-step baselines execute their whole line)."""
+    ``M=None`` takes the method's default (the one-step baselines execute their whole line);
+    ``env_kwargs``: the env's observation options (a trained actor's recorded ones)."""
     meth = get_method(method)
     check_plan(meth, M, T)  # before the first episode, not in it
     if mg_name not in MOTION_GENERATORS:
@@ -309,7 +310,7 @@ def evaluate_fullbody(env_id: str, make_policy, scenarios: list[Scenario], metho
                 if env is not None:
                     env.close()
                     counter.close()
-                env, key = make_env(env_id, sc), k
+                env, key = make_env(env_id, sc, **(env_kwargs or {})), k
                 policy = make_policy(env)
                 mg = make_motion_generator(mg_name, env.unwrapped.world)
                 counter = PenetrationCounter(env.unwrapped.scene, mg.character)

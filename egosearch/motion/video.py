@@ -258,7 +258,7 @@ VIDEO_SUFFIXES = (".mp4", ".gif")
 def write_search_video(layout: str, character: str, policy, scenario, out_path: str | os.PathLike,
                        still_path: str | os.PathLike | None = None, method: str = "ours", M: int = 5,
                        T: int = 20, seed: int = 0, env_id: str = "EgoSearch-v0",
-                       require_clean: bool = False) -> dict:
+                       require_clean: bool = False, env_kwargs: dict | None = None) -> dict:
     """Run one full-body episode and write it as a video (``.mp4`` or ``.gif``) plus one still PNG.
 
     Args:
@@ -268,6 +268,7 @@ def write_search_video(layout: str, character: str, policy, scenario, out_path: 
         seed: the episode's seed; ``egosearch fullbody`` seeds scenario k with its ``--seed`` + k.
         require_clean: raise :class:`NotACleanSuccess` before drawing anything unless the episode
             succeeds with no penetrating pose.
+        env_kwargs: the env's observation options (a trained actor's recorded ones).
     Returns the episode's row (see :data:`egosearch.motion.replan.FULLBODY_COLUMNS`) with the paths.
     """
     import imageio.v2 as imageio
@@ -282,7 +283,7 @@ def write_search_video(layout: str, character: str, policy, scenario, out_path: 
         raise ValueError(f"{os.fspath(still_path)}: the still is written as .png")
     if scenario.layout != layout:
         raise ValueError(f"scenario {scenario.scenario_id} is in {scenario.layout!r}, not {layout!r}")
-    env = make_env(env_id, scenario)
+    env = make_env(env_id, scenario, **(env_kwargs or {}))
     view = None
     try:
         u = env.unwrapped

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from egosearch.envs import ALL_ENV_IDS, env_space_dims
+from egosearch.envs import ALL_ENV_IDS, env_space_dims, observation_kwargs
 from egosearch.rl.agent import ActorFileNet, Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.registry import actor_loader
@@ -103,9 +103,16 @@ class ActorPolicy:
         self.recurrent = bool(getattr(self.net, "recurrent", False))
         self._h = None
 
-    def fits(self, env_id: str) -> bool:
-        """Whether the actor's action and observation sizes are those of the registered ``env_id``."""
-        dims = env_space_dims(env_id)
+    @property
+    def env_kwargs(self) -> dict[str, bool]:
+        """The observation options it was trained with (:data:`egosearch.envs.OBSERVATION_OPTIONS`), from the
+        config its file records: the env it is evaluated in is built with them."""
+        return observation_kwargs(self.config if isinstance(self.config, dict) else None)
+
+    def fits(self, env_id: str, env_kwargs: dict | None = None) -> bool:
+        """Whether the actor's action and observation sizes are those of the registered ``env_id`` with the
+        observation options ``env_kwargs`` (default: those it was trained with)."""
+        dims = env_space_dims(env_id, self.env_kwargs if env_kwargs is None else env_kwargs)
         if "mask_dim" in self.arch and "proprio_dim" in self.arch:
             return (self.action_dim, int(self.arch["mask_dim"]), int(self.arch["proprio_dim"])) == (
                 dims["action"], dims["mask"], dims["proprio"])
@@ -116,22 +123,29 @@ class ActorPolicy:
         whose sizes it fits (None when no single id does)."""
         if self.env_id:
             return self.env_id
-        fitting = [env_id for env_id in ALL_ENV_IDS if self.fits(env_id)]
+        fitting = [env_id for env_id in ALL_ENV_IDS if not (self.env_kwargs and env_id.endswith("Modular-v0"))
+                   and self.fits(env_id)]
         return fitting[0] if len(fitting) == 1 else None
 
-    def check_env(self, env_id: str) -> None:
-        """Raise :class:`AgentStateError` (one line naming the env id it was trained for) unless the
-        actor can act in ``env_id``: a mismatch otherwise surfaces only as a broadcasting error in
-        the first episode's step."""
-        if self.fits(env_id):
+    def check_env(self, env_id: str, env_kwargs: dict | None = None) -> None:
+        """Raise :class:`AgentStateError` (one line naming the env id and options it was trained for) unless
+        the actor can act in ``env_id`` with the observation options ``env_kwargs`` (default: its own): a
+        mismatch otherwise surfaces only as a broadcasting error in the first episode's step."""
+        options = self.env_kwargs if env_kwargs is None else env_kwargs
+        if self.fits(env_id, options):
             return
         trained = self.trained_env_id()
-        dims = env_space_dims(env_id)
-        told = f"was trained in {trained}" if trained else "fits no registered env id"
-        hint = f": run it in {trained}" if trained else ""
+        dims = env_space_dims(env_id, options)
+
+        def named(kwargs: dict) -> str:
+            on = [k for k, v in kwargs.items() if v]
+            return f" with {', '.join(on)}" if on else ""
+
+        told = f"was trained in {trained}{named(self.env_kwargs)}" if trained else "fits no registered env id"
+        hint = f": run it in {trained}{named(self.env_kwargs)}" if trained else ""
         raise AgentStateError(f"{self.path}: this actor {told} ({self.action_dim} action values, "
-                              f"{self.arch['extra_dim']} observation values besides depth), not in {env_id} "
-                              f"({dims['action']} and {dims['mask'] + dims['proprio']}){hint}")
+                              f"{self.arch['extra_dim']} observation values besides depth), not in {env_id}"
+                              f"{named(options)} ({dims['action']} and {dims['mask'] + dims['proprio']}){hint}")
 
     def reset(self, seed: int | None = None) -> None:
         self._h = None

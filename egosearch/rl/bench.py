@@ -44,6 +44,7 @@ import torch
 
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit, own_cpu_seconds
+from egosearch.envs import observation_kwargs
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import DECISIONS, LearnerConfig, load_config
 from egosearch.rl.registry import make_agent
@@ -355,7 +356,7 @@ def _timed_training(seconds: float, out_dir: str, run: TrainingRun, cfg: Learner
     its rates read back from its CSVs."""
     env_id = run.env_id
     evaluator = scenario_evaluator(env_id, curve_homes(run.train_env), run.train_env["placement"],
-                                   n=cfg.eval_episodes)
+                                   n=cfg.eval_episodes, env_kwargs=observation_kwargs(cfg.to_dict()))
     eval_s: list[float] = []
 
     def timed_evaluator(policy) -> dict:

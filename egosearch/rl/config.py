@@ -66,7 +66,7 @@ FIELD_ORDER = (
     # CURL (not in Table 2)
     "curl_latent", "curl_double_encoder_step", "actor_update_freq", "critic_target_update_freq", "curl_update_freq",
     # the learner and its training-only aids (the cpu profile's departures)
-    "algorithm", "num_envs", "n_step", "obs_downsample", "target_memory", "modular_searcher",
+    "algorithm", "num_envs", "n_step", "obs_downsample", "target_memory", "contact_signal", "modular_searcher",
     "encoder_stride2_layers", "aug_pad", "train_distance_reward", "curriculum_steps", "critic_privileged_state",
     "encoder_aux_loss", "encoder_aux_weight", "recurrent_hidden_dim", "sequence_length", "burn_in",
     "ppo_epochs", "ppo_minibatches", "ppo_clip", "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm",

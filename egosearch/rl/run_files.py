@@ -22,10 +22,6 @@ from egosearch.rl.config import LearnerConfig, field_defaults
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
 
-CHECKPOINT_NAME = Path("ckpt") / "train_state.ckpt"
-START_ACTOR_NAME = "actor_start.pt"
-"""The run's policy at step 0, beside ``actor.pt`` (:meth:`egosearch.rl.train.LiveRun.write_start_actor`)."""
-"""The resumable state inside ``out_dir`` (``*.ckpt`` is git-ignored: it holds the replay)."""
 
 
 RESUMABLE_FIELDS = ("device", "num_threads", "compile", "cuda_graph", "keep_checkpoint")
@@ -229,28 +225,20 @@ def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str
                               f"{' ...' if len(diff) > 4 else ''}; use another out_dir")
 
 
-_DEFAULTS_OF_LATER_FIELDS = {f: field_defaults()[f]
-                             for f in ("recurrent_hidden_dim", "sequence_length", "burn_in", "encoder_aux_loss",
-                                       "encoder_aux_weight", "ppo_epochs", "ppo_minibatches", "ppo_clip",
-                                       "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm", "ppo_init_std",
-                                       "target_memory", "critic_layer_norm", "demo_teacher",
-                                       "critic_privileged_state", "demo_episodes", "bc_updates", "dagger_rounds",
-                                       "dagger_episodes", "critic_warmup_updates", "demo_batch_fraction",
-                                       "bc_weight", "bc_decay_steps")}
-"""Fields added after runs were stored: a checkpoint or done.json without them ran as their defaults (each
-default is the field's "off")."""
-
 ENV_ID_FIELDS = ("target_memory", "modular_searcher")
 """Config fields whose whole effect is the env id a run observes (``observed_env_id``)."""
 
 
 def saved_config(saved: dict) -> dict:
     """The config a checkpoint or done.json ran with, fields added after it was stored at their defaults."""
-    theirs = {**_DEFAULTS_OF_LATER_FIELDS, **saved.get("config", {})}
+    # a field added after the run was stored: the run ran as its default (each new field's default is its "off")
+    theirs = {**field_defaults(), **saved.get("config", {})}
     env_id = str(saved.get("env_id"))
     # runs saved before these fields existed named them in their env id only: read them from the id's table
     options = env_options(env_id) if env_id in ALL_ENV_IDS else None
-    theirs.setdefault("modular_searcher", bool(options and options.modular))
-    if "target_memory" not in saved.get("config", {}):
+    recorded = saved.get("config", {})
+    if "modular_searcher" not in recorded:
+        theirs["modular_searcher"] = bool(options and options.modular)
+    if "target_memory" not in recorded:
         theirs["target_memory"] = bool(options and options.target_memory)
     return theirs

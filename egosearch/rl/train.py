@@ -55,7 +55,8 @@ import torch
 
 from egosearch.core.allocator import keep_freed_memory
 from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
-from egosearch.envs import observed_env_id
+from egosearch.core.staging import CHECKPOINT_NAME, START_ACTOR_NAME
+from egosearch.envs import observation_kwargs, observed_env_id
 from egosearch.rl.actor import AgentPolicy
 from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
@@ -73,8 +74,6 @@ from egosearch.rl.registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (
     CHECKPOINT_FORMAT,
-    CHECKPOINT_NAME,
-    START_ACTOR_NAME,
     CheckpointError,
     CsvLogger,
     atomic_json,
@@ -89,6 +88,7 @@ from egosearch.rl.run_files import (
     to_tensors,
 )
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.sim.env import CONTACT_SIGNAL_DIM
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
@@ -168,9 +168,11 @@ def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
     if tuple(depth.shape) != want or depth.dtype != np.uint8:
         raise ValueError(f"env depth is {tuple(depth.shape)} {depth.dtype}; config expects {want} uint8 "
                          "(frame_history, image_size)")
-    if proprio.shape[0] != 2 * (1 + cfg.head_history):
+    # the head's pose and its last changes, then the contact signal's values when the config observes it
+    wanted = 2 * (1 + cfg.head_history) + (CONTACT_SIGNAL_DIM if cfg.contact_signal else 0)
+    if proprio.shape[0] != wanted:
         raise ValueError(f"env proprio has {proprio.shape[0]} values; head_history={cfg.head_history} "
-                         f"expects {2 * (1 + cfg.head_history)}")
+                         f"and contact_signal={cfg.contact_signal} expect {wanted}")
     act = env.action_space
     if not isinstance(act, gymnasium.spaces.Box) or len(act.shape) != 1:
         raise ValueError(f"action space must be a 1-d Box, got {act}")
@@ -290,7 +292,8 @@ def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwarg
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
     run = LiveRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
     own_eval = evaluate_fn is None
-    evaluate_fn = evaluate_fn or default_evaluator(env_id, env_kwargs, cfg.eval_episodes)
+    evaluate_fn = evaluate_fn or default_evaluator(env_id, {**env_kwargs, **observation_kwargs(cfg.to_dict())},
+                                                   cfg.eval_episodes)
     bar = run.open_progress(progress)
     run.start_clock()
     last_row = None

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gymnasium
 
+from egosearch.envs import observation_kwargs
 from egosearch.rl.config import LearnerConfig
 from egosearch.scene.layouts import LAYOUT_NAMES
 from egosearch.sim.agent import AgentSpec
@@ -24,9 +25,10 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     """The training envs' keyword arguments: the variant's, with r_d's form
     (``train_distance_reward``) and the training heights (``train_height_min``) from the learner
     config unless the variant sets ``distance_reward`` / ``train_heights`` itself, and the
-    privileged state when the critic reads it (``critic_privileged_state``). The paper's values are
-    the env's defaults, so they are not passed (envs without the options still train)."""
-    aids: dict = {}
+    privileged state when the critic reads it (``critic_privileged_state``), and the observation options
+    the config turns on (``contact_signal``: the policy observes them at evaluation too). The paper's values
+    are the env's defaults, so they are not passed (envs without the options still train)."""
+    aids: dict = dict(observation_kwargs(cfg.to_dict()))
     if cfg.train_distance_reward != "distance":
         aids["distance_reward"] = cfg.train_distance_reward
     paper_low, paper_high = AgentSpec().train_height_range

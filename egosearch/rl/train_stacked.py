@@ -24,7 +24,7 @@ from typing import Any
 import torch
 
 from egosearch.core.allocator import keep_freed_memory
-from egosearch.envs import observed_env_id
+from egosearch.envs import observation_kwargs, observed_env_id
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.stacked import SeedStreams, StackingError, check_stackable, stack_agents
 from egosearch.rl.train import LiveRun, default_evaluator, open_run, torch_threads
@@ -80,7 +80,7 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
     envs: list[list] = []
     own = [evaluate_fns is None] * len(cfgs)
     evaluators = list(evaluate_fns) if evaluate_fns is not None else [
-        default_evaluator(env_id, env_kwargs, c.eval_episodes) for c in cfgs]
+        default_evaluator(env_id, {**env_kwargs, **observation_kwargs(c.to_dict())}, c.eval_episodes) for c in cfgs]
     try:
         for _ in todo:
             envs.append([make_train_env(env_id, train_env_kwargs(cfg, env_kwargs)) for _ in range(cfg.num_envs)])

@@ -51,10 +51,11 @@ def run_episode(env: gymnasium.Env, policy, scenario: Scenario, seed: int = 0, r
     }
 
 
-def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
-             progress: bool = False, desc: str = "evaluate", recorder=None) -> list[dict]:
+def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0, progress: bool = False,
+             desc: str = "evaluate", recorder=None, env_kwargs: dict | None = None) -> list[dict]:
     """Run ``make_policy(env)`` on every scenario; the env is rebuilt only when the home or
-    height changes. ``recorder``: see :func:`run_episode`."""
+    height changes. ``recorder``: see :func:`run_episode`; ``env_kwargs``: the env's observation options
+    (:data:`egosearch.envs.OBSERVATION_OPTIONS`, a trained actor's recorded ones)."""
     rows, env, env_key, policy = [], None, None, None
     iterator = scenarios
     if progress:
@@ -67,7 +68,7 @@ def evaluate(env_id: str, make_policy, scenarios: list[Scenario], seed: int = 0,
             if key != env_key:
                 if env is not None:
                     env.close()
-                env, env_key = make_env(env_id, sc), key
+                env, env_key = make_env(env_id, sc, **(env_kwargs or {})), key
                 policy = make_policy(env)
             rows.append(run_episode(env, policy, sc, seed=seed + sc.scenario_id, recorder=recorder))
     finally:
@@ -98,21 +99,24 @@ def curve_scenarios(layout: str | list[str], placement: str, n: int, seed: int =
 
 
 def curve_episodes(env_id: str, make_policy, scenarios: list[Scenario], progress: bool = False,
-                   desc: str = "evaluate", recorder=None) -> list[dict]:
+                   desc: str = "evaluate", recorder=None, env_kwargs: dict | None = None) -> list[dict]:
     """``make_policy(env)`` on a training curve's scenarios (:func:`curve_scenarios`), each episode seeded as
     the curve's are: rows of :data:`CURVE_LEVEL_COLUMNS`."""
     # by home and height, so that each env is built once (the curve interleaves them)
     grouped = sorted(scenarios, key=lambda sc: (sc.layout, sc.height, sc.scenario_id))
-    rows = evaluate(env_id, make_policy, grouped, seed=CURVE_SEED, progress=progress, desc=desc, recorder=recorder)
+    rows = evaluate(env_id, make_policy, grouped, seed=CURVE_SEED, progress=progress, desc=desc, recorder=recorder,
+                    env_kwargs=env_kwargs)
     return [{"home": sc.layout, "height": sc.height, **row} for sc, row in zip(grouped, rows, strict=True)]
 
 
-def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = CURVE_SEED):
+def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: int, seed: int = CURVE_SEED,
+                       env_kwargs: dict | None = None):
     """``evaluate(policy) -> {success_rate, spl, episode_return, episodes}`` on ``n`` fixed held-out
     scenarios of ``layout`` (a home, or a list of homes taken in turn), the three evaluation heights
     in turn. The learner calls it every ``eval_every`` steps: these rows are Figure 6's data.
     ``episode_return`` is always the paper's reward (the env's default r_d), whatever reward a
-    variant trains with, so that the curves of variants are on one scale."""
+    variant trains with, so that the curves of variants are on one scale. ``env_kwargs``: the observation
+    options the policy trains with (:data:`egosearch.envs.OBSERVATION_OPTIONS`)."""
     scenarios = curve_scenarios(layout, placement, n, seed)
     envs: dict = {}
 
@@ -121,7 +125,7 @@ def scenario_evaluator(env_id: str, layout: str | list[str], placement: str, n: 
         for sc in scenarios:
             key = (sc.layout, sc.height)
             if key not in envs:
-                envs[key] = make_env(env_id, sc)
+                envs[key] = make_env(env_id, sc, **(env_kwargs or {}))
             rows.append(run_episode(envs[key], policy, sc, seed=seed + sc.scenario_id))
         episodes = [{"home": sc.layout, "height": sc.height, "scenario_id": sc.scenario_id, "success": r["success"],
                      "shortest_path": r["shortest_path"], "path_length": r["path_length"]}

@@ -30,6 +30,10 @@ EASY_LAYOUTS = ("studio",)
 """Small homes where the target is often in view: for learning tests, not for the paper's tables."""
 WALL_HEIGHT = F.WALL_HEIGHT
 _ALLOWED = "kitchen_living, bedroom_bath, studio, home<seed>"
+HELDOUT_HOME_SEEDS = range(900_000, 900_020)
+"""The held-out split: generated homes ``home900000`` ... ``home900019``, evaluated by
+``snakemake generalise``, never trained in (:mod:`egosearch.sim.home_pool` refuses a training split that
+overlaps it)."""
 
 Rect = tuple[float, float, float, float]
 

@@ -35,7 +35,8 @@ def decision_env_id(head: bool) -> str:
     return "EgoSearchModular-v0" if head else "EgoSearchNoHeadModular-v0"
 
 
-UNREAD_OPTIONS = {"target_memory": "EgoSearchMemory-v0", "floor_map": "EgoSearchMap-v0"}
+UNREAD_OPTIONS = {"target_memory": "EgoSearchMemory-v0", "floor_map": "EgoSearchMap-v0",
+                  "contact_signal": "EgoSearch-v0"}
 """Body-env options a decision env does not read (its observation is the decision's: the mask's features and
 the searcher's map), with the body id that does."""
 

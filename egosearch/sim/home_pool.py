@@ -19,10 +19,8 @@ from __future__ import annotations
 import gymnasium
 
 import egosearch.sim.envs  # noqa: F401  (registers the ids this env builds)
+from egosearch.scene.layouts import HELDOUT_HOME_SEEDS
 
-HELDOUT_HOME_SEEDS = range(900_000, 900_020)
-"""The held-out split: generated homes ``home900000`` ... ``home900019``, evaluated by
-``snakemake generalise``, never trained in."""
 GENERATED = "generated"
 """``train_env: layout`` of a variant that trains in generated homes (with ``home_seeds``)."""
 PAPER_HOMES = "paper_homes"
@@ -55,7 +53,7 @@ def check_home_split(home_seeds) -> range:
     held = HELDOUT_HOME_SEEDS
     if first < held.stop and held.start < stop:
         raise ValueError(f"home_seeds=[{first}, {stop}) overlaps the held-out homes [{held.start}, {held.stop}) "
-                         "that no training may draw (egosearch.sim.home_pool.HELDOUT_HOME_SEEDS)")
+                         "that no training may draw (egosearch.scene.layouts.HELDOUT_HOME_SEEDS)")
     return range(first, stop)
 
 

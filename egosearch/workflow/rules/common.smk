@@ -133,14 +133,14 @@ def eval_files(variant, homes=None):
 def train_checkpoint(rule, outputs):
     """The checkpoint a job of ``rule`` resumes from after a kill: a training's, in its work folder beside its
     outputs (rules/train.smk: params.work_dir); None for every other rule, which starts over."""
-    from egosearch.rl.run_files import CHECKPOINT_NAME
+    from egosearch.core.staging import CHECKPOINT_NAME
 
     return Path(outputs[0]).parent / "partial" / CHECKPOINT_NAME if rule == "train" and outputs else None
 
 
 def start_actor(actor_path):
-    """The start actor file beside a run's actor.pt (imported here, not at the top: it loads torch)."""
-    from egosearch.rl.run_files import START_ACTOR_NAME
+    """The start actor file beside a run's actor.pt."""
+    from egosearch.core.staging import START_ACTOR_NAME
 
     return str(Path(actor_path).with_name(START_ACTOR_NAME))
 
@@ -319,7 +319,7 @@ def budget_inputs():
 
 # The generalisation benchmark (generalise.smk): each group of homes is one scenario file per
 # placement; GEN_GROUPS maps a group to its generated home seeds [first, stop).
-from egosearch.sim.home_pool import HELDOUT_HOME_SEEDS
+from egosearch.scene.layouts import HELDOUT_HOME_SEEDS
 
 GEN = config["generalise"]
 GEN_HEIGHT = f"{GEN['height']:g}"
