@@ -81,7 +81,7 @@ def test_the_registered_searchers_are_todays_and_agree_with_their_envs():
 def test_a_name_is_registered_once_and_never_as_actor(toy):
     with pytest.raises(ValueError, match="registered already"):
         registry.register(TOY, AlwaysTurns)
-    with pytest.raises(ValueError, match="not 'actor'"):
+    with pytest.raises(ValueError, match="'actor' is reserved: --policy actor is a trained actor"):
         registry.register("actor", AlwaysTurns)
     with pytest.raises(ValueError, match="table_row='middle'; allowed: floor, beside, ceiling"):
         registry.register("toy_other", AlwaysTurns, table_row="middle")
@@ -156,3 +156,27 @@ def test_an_unknown_or_unregistered_name_is_refused_in_one_line(toy, tmp_path, c
 def test_a_variant_may_not_take_a_registered_searchers_name(toy, tmp_path):
     with pytest.raises(VariantError, match=f"variant name '{TOY}' is a reference searcher's.*{TOY}\\)"):
         new_variant(TOY, directory=tmp_path)
+
+
+def test_both_registries_are_one_helper_and_answer_alike():
+    """The learners' and the searchers' registries keep their entries in the one helper's dict
+    (egosearch.core.registry): an unknown name is the same one line in each, and a name that could not name a
+    folder is refused by both."""
+    from egosearch.core.registry import Registry
+    from egosearch.rl import registry as learners
+
+    assert learners.LEARNERS is learners._REGISTRY.entries and registry.SEARCHERS is registry._REGISTRY.entries
+    with pytest.raises(ValueError, match=r"^unknown algorithm 'nope'; registered: sac_curl, sac_drq, "):
+        learners.learner("nope")
+    with pytest.raises(ValueError, match=r"^unknown searcher 'nope'; registered: random, oracle, "):
+        registry.get("nope")
+    for register in (lambda n: learners.register(n, "x", "m:a"), lambda n: registry.register(n, AlwaysTurns)):
+        with pytest.raises(ValueError, match="letters, digits, '_' and '-' only"):
+            register("a/b")
+    own = Registry("thing")
+    own.add("one", 1)
+    with pytest.raises(ValueError, match=r"^thing 'one' is registered already$"):
+        own.add("one", 2)
+    assert own.add("one", 3, replace=True) == 3 and own.names() == ("one",) and own.remove("one") == 3
+    with pytest.raises(ValueError, match="unknown thing 'one'; registered: $"):
+        own.remove("one")

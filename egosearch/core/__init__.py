@@ -1,2 +1,2 @@
-"""Plumbing every stage shares: checked output paths, staged runs, atomic CSVs, the machine's record, stale locks.
+"""Plumbing every stage shares: checked paths, staged runs, atomic CSVs, the machine, stale locks, registries.
 Imports nothing else of egosearch; any module may import it."""

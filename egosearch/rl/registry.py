@@ -12,21 +12,14 @@ config (:mod:`egosearch.rl.config` imports it); it types configs as :class:`egos
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from egosearch.core.registry import Registry, resolve
+
 if TYPE_CHECKING:
     from egosearch.rl.agent import ActorFileNet, Agent, LearnerSettings
-
-
-def _resolve(ref: str | Callable) -> Callable:
-    """A ``"module:attribute"`` reference -> the attribute (imported now); anything else as it is."""
-    if not isinstance(ref, str):
-        return ref
-    module, _, attribute = ref.partition(":")
-    return getattr(importlib.import_module(module), attribute)
 
 
 @dataclass(frozen=True)
@@ -41,7 +34,8 @@ class Learner:
     :class:`egosearch.rl.agent.ActorFileNet`;
     ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size);
     ``settings``: the dataclass of its own settings (or ``"module:Class"``), which
-    :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone."""
+    :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone;
+    ``stacked``: its seeds can train in one process, their updates vmapped (:mod:`egosearch.rl.stacked`)."""
 
     name: str
     display_name: str
@@ -49,12 +43,13 @@ class Learner:
     actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] = field(default_factory=dict)
     takes_state_dim: bool = True
     settings: str | type | None = None
+    stacked: bool = False
 
     def settings_class(self) -> type | None:
-        return None if self.settings is None else _resolve(self.settings)
+        return None if self.settings is None else resolve(self.settings)
 
     def agent_factory(self) -> Callable[..., Agent]:
-        return _resolve(self.agent)
+        return resolve(self.agent)
 
     def make(self, cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
              state_dim: int = 0) -> Agent:
@@ -64,7 +59,8 @@ class Learner:
         return factory(cfg, action_dim, mask_dim, proprio_dim, device=device)
 
 
-LEARNERS: dict[str, Learner] = {}
+_REGISTRY: Registry[Learner] = Registry("algorithm", describe=lambda entry: entry.display_name)
+LEARNERS: dict[str, Learner] = _REGISTRY.entries
 """Every registered learner by algorithm name, in registration order."""
 ALGORITHMS = LEARNERS.keys()
 """The registered algorithm names (a live view of :data:`LEARNERS`)."""
@@ -72,26 +68,28 @@ ALGORITHMS = LEARNERS.keys()
 
 def register(name: str, display_name: str, agent: str | Callable[..., Agent],
              actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] | None = None, *,
-             takes_state_dim: bool = True, settings: str | type | None = None, replace: bool = False) -> Learner:
+             takes_state_dim: bool = True, settings: str | type | None = None, stacked: bool = False,
+             replace: bool = False) -> Learner:
     """Register a learner under algorithm ``name`` (see :class:`Learner` for the arguments); a name
     already taken needs ``replace``, and an actor format another learner loads differently is refused."""
+    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim, settings, stacked)
     if name in LEARNERS and not replace:
-        raise ValueError(f"algorithm {name!r} is registered already ({LEARNERS[name].display_name})")
-    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim, settings)
+        _REGISTRY.add(name, learner)  # the registry's one line: the name is taken
     for other in LEARNERS.values():
         for fmt, loader in learner.actor_formats.items():
             if other.name != name and fmt in other.actor_formats and other.actor_formats[fmt] != loader:
                 raise ValueError(f"actor format {fmt!r} is loaded differently by algorithm {other.name!r}")
-    LEARNERS[name] = learner
-    return learner
+    return _REGISTRY.add(name, learner, replace=replace)
 
 
 def learner(algorithm: str) -> Learner:
     """The learner registered as ``algorithm``."""
-    try:
-        return LEARNERS[algorithm]
-    except KeyError:
-        raise ValueError(f"unknown algorithm {algorithm!r}; registered: {', '.join(LEARNERS)}") from None
+    return _REGISTRY.get(algorithm)
+
+
+def stacked_algorithms() -> tuple[str, ...]:
+    """The learners whose seeds can be stacked (:mod:`egosearch.rl.stacked`), in registration order."""
+    return tuple(name for name, entry in LEARNERS.items() if entry.stacked)
 
 
 def make_agent(cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
@@ -110,17 +108,17 @@ def actor_loader(fmt: str) -> Callable[..., ActorFileNet] | None:
     """The function ``(state, device) -> ActorFileNet`` that loads an actor file of format ``fmt``
     (None for a format no registered learner writes)."""
     loader = actor_formats().get(fmt)
-    return None if loader is None else _resolve(loader)
+    return None if loader is None else resolve(loader)
 
 
 # ---- the learners -------------------------------------------------------------------------------
 
 register("sac_curl", "SAC+CURL", "egosearch.rl.sac_curl:SacCurlAgent",
          {"egosearch-sac-curl-actor-v1": "egosearch.rl.sac_curl:load_actor_net"}, takes_state_dim=False,
-         settings="egosearch.rl.sac_curl_settings:SacCurlSettings")
+         settings="egosearch.rl.sac_curl_settings:SacCurlSettings", stacked=True)
 register("sac_drq", "SAC-DrQ", "egosearch.rl.sac_drq:SacDrqAgent",
          {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"},
-         settings="egosearch.rl.sac_drq_settings:SacDrqSettings")
+         settings="egosearch.rl.sac_drq_settings:SacDrqSettings", stacked=True)
 register("sac_drq_recurrent", "recurrent SAC-DrQ", "egosearch.rl.sac_drq_recurrent:SacDrqRecurrentAgent",
          {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"},
          settings="egosearch.rl.sac_drq_recurrent_settings:SacDrqRecurrentSettings")

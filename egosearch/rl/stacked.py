@@ -48,6 +48,7 @@ from torch.func import functional_call, vmap
 
 from egosearch.rl.common import METRIC_KEYS, crop_at, gaussian_entropy, squashed_sample
 from egosearch.rl.cuda_graph import GraphedUpdate
+from egosearch.rl.registry import stacked_algorithms
 from egosearch.rl.sac_curl import SacCurlAgent, crop_offsets
 from egosearch.rl.sac_drq import SacDrqAgent
 
@@ -111,15 +112,13 @@ class SeedStreams:
 
 # ---- what can be stacked ------------------------------------------------------------------
 
-ALGORITHMS = ("sac_curl", "sac_drq")
-"""The learners (``LearnerConfig.algorithm``) whose seeds can be stacked: the SAC learners without memory."""
-
-
 def check_stackable(cfg: Any) -> None:
-    """Raise :class:`StackingError` (one line) for a learner config whose update is not stacked; the
-    stacked training asks before it writes anything."""
-    if cfg.algorithm not in ALGORITHMS:
-        raise StackingError(f"algorithm {cfg.algorithm} is not stacked; stacked: {', '.join(ALGORITHMS)}")
+    """Raise :class:`StackingError` (one line) for a learner config whose update is not stacked (the learner
+    registry's ``stacked`` entries: the SAC learners without memory); the stacked training asks before it
+    writes anything."""
+    stackable = stacked_algorithms()
+    if cfg.algorithm not in stackable:
+        raise StackingError(f"algorithm {cfg.algorithm} is not stacked; stacked: {', '.join(stackable)}")
     if cfg.algorithm == "sac_curl" and (cfg.share_encoder_forward or cfg.compile):
         raise StackingError("SAC+CURL with share_encoder_forward or compile is not stacked")
     if cfg.algorithm == "sac_drq" and cfg.encoder_aux_loss != "none":

@@ -14,19 +14,20 @@ training-side sets only) are bound rows of their own, beside the untuned classic
 classical reference.
 
 Every stage may read this module, the report layer and the workflow included (tests/test_layout.py
-allows it, and only it, of searchers/): it imports nothing of egosearch nor any package outside the
-standard library, so reading it never loads the simulator. Factories are named ``"module:attribute"``
-and imported on first use, as :mod:`egosearch.rl.registry` names its learners.
+allows it, and only it, of searchers/): it imports nothing of egosearch but the registry helper
+(:mod:`egosearch.core.registry`, which the learners' registry uses too) and no package outside the standard
+library, so reading it never loads the simulator. Factories are named ``"module:attribute"`` and imported on
+first use, as :mod:`egosearch.rl.registry` names its learners.
 """
 
 from __future__ import annotations
 
-import importlib
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 from typing import Any
+
+from egosearch.core.registry import Registry, resolve
 
 FLOOR, BESIDE, CEILING = "floor", "beside", "ceiling"
 """Where a bound's rows stand in Table 1: the floor before the policy and the ceiling after every other
@@ -34,16 +35,6 @@ row, both shown (as "not run") even without files; the others after the policy, 
 TABLE_ROWS = (FLOOR, BESIDE, CEILING)
 ACTOR = "actor"
 """``--policy actor``: a trained actor (``--weights``), the one ``--policy`` that is no registered searcher."""
-NAME = re.compile(r"[A-Za-z0-9_\-]+")
-"""A searcher's name names its output folders, as a variant's does (the workflow's wildcards)."""
-
-
-def _resolve(ref: str | Callable) -> Callable:
-    """A ``"module:attribute"`` reference -> the attribute (imported now); anything else as it is."""
-    if not isinstance(ref, str):
-        return ref
-    module, _, attribute = ref.partition(":")
-    return getattr(importlib.import_module(module), attribute)
 
 
 @dataclass(frozen=True)
@@ -81,7 +72,7 @@ class Searcher:
     fig6_level: tuple | None = None
 
     def policy_factory(self) -> Callable[..., Any]:
-        return _resolve(self.factory)
+        return resolve(self.factory)
 
     def maker(self, seed: int = 0) -> Callable[[Any], Any]:
         """``make(env) -> policy`` for ``--seed``: the factory itself when it takes no seed."""
@@ -93,41 +84,33 @@ class Searcher:
         return self.maker(seed)(env)
 
 
-SEARCHERS: dict[str, Searcher] = {}
+_REGISTRY: Registry[Searcher] = Registry("searcher", reserved={ACTOR: "--policy actor is a trained actor"})
+SEARCHERS: dict[str, Searcher] = _REGISTRY.entries
 """Every registered searcher by name, in registration order."""
 
 
 def register(name: str, factory: str | Callable[..., Any], *, replace: bool = False, **fields) -> Searcher:
     """Register a searcher under ``name`` (see :class:`Searcher` for the fields); a name already taken
     needs ``replace``."""
-    if not NAME.fullmatch(name) or name == ACTOR:
-        raise ValueError(f"searcher name {name!r}: letters, digits, '_' and '-' only, and not {ACTOR!r} (it names "
-                         "output folders, and --policy actor is a trained actor)")
-    if name in SEARCHERS and not replace:
-        raise ValueError(f"searcher {name!r} is registered already")
     searcher = Searcher(name, factory, **fields)
     if searcher.table_row not in TABLE_ROWS:
         raise ValueError(f"searcher {name!r}: table_row={searcher.table_row!r}; allowed: {', '.join(TABLE_ROWS)}")
-    SEARCHERS[name] = searcher
-    return searcher
+    return _REGISTRY.add(name, searcher, replace=replace)
 
 
 def unregister(name: str) -> Searcher:
     """Remove a registered searcher (a test's own, after it); returns it."""
-    return SEARCHERS.pop(get(name).name)
+    return _REGISTRY.remove(name)
 
 
 def get(name: str) -> Searcher:
     """The searcher registered as ``name``."""
-    try:
-        return SEARCHERS[name]
-    except KeyError:
-        raise ValueError(f"unknown searcher {name!r}; registered: {', '.join(SEARCHERS)}") from None
+    return _REGISTRY.get(name)
 
 
 def names() -> tuple[str, ...]:
     """Every registered name, in registration order: what ``--policy`` takes without ``--weights``."""
-    return tuple(SEARCHERS)
+    return _REGISTRY.names()
 
 
 def bounds() -> tuple[str, ...]:
