@@ -119,8 +119,9 @@ class SacSettings(NetworkSettings):
     critic_tau: float = 0.01
     """Table 2 "Critic: tau (polyak averaging)": target Q-heads move by this fraction."""
     encoder_lr: float = 1e-3
-    """Table 2 "Encoder (CNN): learning rate": Adam step of the CURL (contrastive) loss on the
-    encoder and on the bilinear matrix W."""
+    """Table 2 "Encoder (CNN): learning rate". SAC+CURL: Adam step of the CURL (contrastive) loss on the
+    encoder and on the bilinear matrix W. SAC-DrQ, its recurrent form and PPO's actor: the encoder's own
+    learning rate inside the critic's optimiser (the critic's loss trains the encoder; no contrastive loss)."""
 
     # ---- CURL's schedule (not in Table 2) -----------------------------------------------
     actor_update_freq: int = 2

@@ -1,9 +1,13 @@
 """The run settings: what every learner and the training loop share (paper 4.2 and Table 2).
 
-:class:`RunSettings` holds the settings of a training run that do not depend on which learner it trains:
-the observation and the data (image size, frame history, replay, discount, env steps, batch), the envs and
+:class:`RunSettings` holds the settings of a training run that every learner's config carries: the
+observation and the data (image size, frame history, replay, discount, env steps, batch), the envs and
 their training-only aids, the demonstrations and the imitation phase, the loop's schedule (warm-up,
-updates, evaluations, checkpoints, logs) and where the run is placed on the machine. Each learner's own
+updates, evaluations, checkpoints, logs) and where the run is placed on the machine. Not every learner
+reads all of them: the demonstration, cloning, DAgger and critic warm-up fields only where the learner
+``learns_from_demonstrations``, ``critic_privileged_state`` only where it has a ``privileged_critic``
+(both class flags of its settings; a learner without them refuses the fields), ``cuda_graph`` on a GPU by
+SAC+CURL and the stacked update, ``compile`` by SAC+CURL only. Each learner's own
 settings (its networks, optimisers and losses) live beside it (:mod:`egosearch.rl.sac_curl_settings`,
 :mod:`egosearch.rl.sac_drq_settings`, :mod:`egosearch.rl.sac_drq_recurrent_settings`,
 :mod:`egosearch.rl.ppo_settings`, built from :mod:`egosearch.rl.network_settings`), and
@@ -83,7 +87,8 @@ class RunSettings:
     critic, trained on replayed sequences with burn-in (:mod:`egosearch.rl.sac_drq_recurrent`;
     Ni et al. 2022, Kapturowski et al. 2019): a recurrent policy, which CHANGES THE ALGORITHM
     further (the paper's policy sees only the last ``frame_history`` frames); no profile uses it,
-    a variant sets it. Every "sac_drq" field applies to it as well.
+    a variant sets it. Every "sac_drq" field applies to it as well but ``critic_layer_norm`` and the
+    reconstruction decoder's (``encoder_aux_loss``, ``encoder_aux_weight``); it adds its own memory fields.
     "ppo" = ours, PPO (Schulman et al. 2017) on SAC-DrQ's actor, with a separate value network
     (:mod:`egosearch.rl.ppo`): an on-policy learner, which CHANGES THE ALGORITHM (the paper's is
     SAC + CURL); no profile uses it, a variant sets it (see the "ppo_*" fields)."""
@@ -247,7 +252,7 @@ class RunSettings:
     every learner. For SAC-DrQ at 50 px the gain on the 2-core CPU is small and noisy (short real
     trainings, not a stored benchmark); results differ only by float rounding."""
     compile: bool = False
-    """Ours: ``torch.compile`` the encoders and MLPs. Off: measured on the 2-core CPU it costs
+    """Ours, read by SAC+CURL only: ``torch.compile`` its encoders and MLPs. Off: measured on the 2-core CPU it costs
     ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
     kernels near the CPU's peak; see ``egosearch.rl.bench``). May help on a GPU."""
     cuda_graph: bool = False
