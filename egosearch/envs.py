@@ -5,7 +5,7 @@ is how ``gymnasium.make("egosearch:EgoSearch-v0")`` finds them with no other imp
 neither the physics nor the sensor.
 
 What a policy observes and what it learns are options (:class:`EnvOptions`): the head, the target memory,
-the floor map (keyword options of the body env, :mod:`egosearch.sim.envs`) and the modular searcher's
+the floor map (keyword options of the body env, :mod:`egosearch.sim.body_envs`) and the modular searcher's
 decisions (its own env, :mod:`egosearch.searchers.decision_envs`). A learner config names two of them
 (``target_memory``, ``modular_searcher``) and a variant its env id; :func:`observed_env_id` turns the three
 into the id a run trains and is evaluated in, and :func:`env_options` any id, a stored run's included,
@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 from egosearch.searchers.decision_envs import MODULAR_ENV_IDS, MODULAR_MAP_DIM, decision_env_id, modular_decision_dim
-from egosearch.sim.envs import ENV_IDS, body_env_id, body_options
+from egosearch.sim.body_envs import ENV_IDS, body_env_id, body_options
 
 ALL_ENV_IDS = (*ENV_IDS, *MODULAR_ENV_IDS)
 """Every id a policy may be trained and evaluated in."""

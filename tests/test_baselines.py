@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from egosearch.motion.replan import NoisySearchPolicy, line_plan
-from egosearch.sim.agent import AgentSpec, AgentState
+from egosearch.sim.body import AgentSpec, AgentState
 
 
 class Recorder:

@@ -16,7 +16,7 @@ import pytest
 
 from egosearch.scene.geometry import deepest_penetration, part_penetration
 from egosearch.scene.parts import TAG_OBSTACLE, Part
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.env import SearchEnv
 from egosearch.sim.scenarios import _sample_start, navgrid_for
 

@@ -12,7 +12,7 @@ import pytest
 from egosearch.sim.bullet import connect, pybullet, quiet_native_output
 
 _SCRIPT = """
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.motion.collision import PenetrationCounter
 from egosearch.scene.layouts import get_scene
 from egosearch.sim.world import World

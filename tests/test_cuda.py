@@ -30,7 +30,7 @@ import torch
 # cuBLAS reads this when it starts: before any test of this process touches CUDA (deterministic GEMMs)
 os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
 
-from egosearch.rl.bench import _filled_replay  # noqa: E402
+from egosearch.rl.bench_learner import _filled_replay  # noqa: E402
 from egosearch.rl.config import load_config  # noqa: E402
 from egosearch.rl.registry import make_agent  # noqa: E402
 from egosearch.rl.sac_curl import load_actor_net  # noqa: E402

@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from egosearch.rl.base import pool_depth
 from egosearch.rl.config import load_config
 from egosearch.rl.demos import DEMO_SEED_BASE, collect_demonstrations, load_demonstrations, summary_path
+from egosearch.rl.pooled import pool_depth
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.variants import load_variant

@@ -7,8 +7,8 @@ from gymnasium.utils.env_checker import check_env
 
 from egosearch.runs.evaluate import evaluate, make_env
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
+from egosearch.sim.body_envs import ENV_IDS
 from egosearch.sim.env import FLOOR_MAP_DIM, TARGET_MEMORY_DIM
-from egosearch.sim.envs import ENV_IDS
 from egosearch.sim.scenarios import generate_scenarios
 
 

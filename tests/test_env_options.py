@@ -7,7 +7,7 @@ import gymnasium
 import numpy as np
 import pytest
 
-import egosearch.sim.envs  # noqa: F401
+import egosearch.sim.body_envs  # noqa: F401
 from egosearch.sim.env import CONTACT_WINDOW, MASK_FEATURE_DIM, PROPRIO_DIM, TARGET_MEMORY_DIM
 
 

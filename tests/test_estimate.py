@@ -165,7 +165,7 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
     import types
 
     import egosearch.cost.estimate as estimate
-    import egosearch.rl.bench
+    import egosearch.rl.bench_learner
     from egosearch.cost import calibration
     from egosearch.workflow.dag import DagJob
 
@@ -175,8 +175,8 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
 
     monkeypatch.chdir(REPO)
     monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
-    monkeypatch.setattr(egosearch.rl.bench, "training_throughput", short_training)
-    monkeypatch.setattr(egosearch.rl.bench, "cpu_profile_run_steps", lambda: 10)
+    monkeypatch.setattr(egosearch.rl.bench_learner, "training_throughput", short_training)
+    monkeypatch.setattr(egosearch.rl.bench_learner, "cpu_profile_run_steps", lambda: 10)
     monkeypatch.setattr(estimate, "dag_jobs", lambda target, cores, config: [
         DagJob(id="train/head_on/seed0", rule="train", job="head_on/seed0", record_rule="train", threads=1, deps=(),
                order=1)])

@@ -3,7 +3,7 @@ finds targets without learning."""
 
 import numpy as np
 
-import egosearch.sim.envs  # noqa: F401
+import egosearch.sim.body_envs  # noqa: F401
 from egosearch.runs.evaluate import evaluate, make_env
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.sim.scenarios import generate_scenarios

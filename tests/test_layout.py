@@ -103,8 +103,8 @@ def test_the_top_of_the_package_holds_few_modules_and_every_subpackage_says_what
 def test_imports_under_type_checking_and_in_functions_count():
     source = ("from typing import TYPE_CHECKING\n"
               "if TYPE_CHECKING:\n    from egosearch.variants import ResolvedVariant\n"
-              "def f():\n    import egosearch.sim.envs\n")
-    assert _imports(source) == [("egosearch.variants", "ResolvedVariant"), ("egosearch.sim.envs", "")]
+              "def f():\n    import egosearch.sim.body_envs\n")
+    assert _imports(source) == [("egosearch.variants", "ResolvedVariant"), ("egosearch.sim.body_envs", "")]
     # a relative import is an arrow too, resolved from the module's package
     assert _imports("from ..variants import load_variant\nfrom . import envs\n", "egosearch.rl") == [
         ("egosearch.variants", "load_variant"), ("egosearch.rl", "envs")]

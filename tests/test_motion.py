@@ -25,7 +25,7 @@ from egosearch.motion.replan import (
 )
 from egosearch.motion.video import TARGET_RING_COLOR
 from egosearch.searchers.policies import OraclePolicy
-from egosearch.sim.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
+from egosearch.sim.body import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
 from egosearch.sim.scenarios import Scenario, generate_scenarios
 
 LAYOUT = "kitchen_living"

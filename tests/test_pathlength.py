@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from egosearch.cli import main
-from egosearch.report.cli import cmd_compare
+from egosearch.report.commands import cmd_compare
 from egosearch.report.pathlength import (
     BY_LENGTH_COLUMNS,
     DETOUR_BINS,

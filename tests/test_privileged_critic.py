@@ -16,7 +16,7 @@ from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.sac_drq import SacDrqAgent
 from egosearch.rl.train import train, train_env_kwargs
 from egosearch.scene.parts import Part
-from egosearch.sim.agent import AgentState
+from egosearch.sim.body import AgentState
 from egosearch.sim.env import PRIVILEGED_STATE_DIM, SearchEnv, privileged_state
 from egosearch.variants import load_variant
 

@@ -27,7 +27,7 @@ from egosearch.report import (
     table2,
     wilson_ci,
 )
-from egosearch.report.cli import cmd_compare, cmd_fig6, cmd_fig7, cmd_table1, cmd_table2
+from egosearch.report.commands import cmd_compare, cmd_fig6, cmd_fig7, cmd_table1, cmd_table2
 from egosearch.report.stats import detectable_difference, scenario_seed_matrix, two_level_ci
 
 EPISODE_COLUMNS = ["scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
@@ -637,13 +637,13 @@ def test_cli_helpers(tmp_path, capsys):
 
 # --------------------------------------------------------------------------------------------- isolation
 def test_report_imports_no_torch_or_simulator():
-    code = ("import sys, egosearch.report, egosearch.report.cli\n"
+    code = ("import sys, egosearch.report, egosearch.report.commands\n"
             "bad = sorted(m for m in sys.modules if m.split('.')[0] in "
             "('torch', 'pybullet', 'gymnasium', 'pyrender', 'trimesh', 'pybullet_data'))\n"
             "mods = sorted(m for m in sys.modules if m.startswith('egosearch.') "
             "and not m.startswith('egosearch.report') and m not in ('egosearch.core', 'egosearch.core.machine', "
-            # the searchers' registry, plain data open to every stage (tests/test_layout.py): Table 1's bounds
-            "'egosearch.searchers', 'egosearch.searchers.registry'))\n"
+            # the searchers' registry and the registry helper, plain data open to every stage (tests/test_layout.py)
+            "'egosearch.searchers', 'egosearch.searchers.registry', 'egosearch.core.registry'))\n"
             "print(bad, mods)\n"
             "assert not bad and not mods, (bad, mods)\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)

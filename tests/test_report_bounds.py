@@ -53,7 +53,7 @@ def _eval_csv(root: Path, who: str, placement: str, height: float, successes: li
 
 
 def test_table1_puts_the_policy_between_the_random_searcher_and_the_oracle(tmp_path):
-    from egosearch.report.cli import cmd_table1
+    from egosearch.report.commands import cmd_table1
 
     cells = [("everywhere", 1.05), ("no_low_cabinets", 1.05)]
     ours = [_eval_csv(tmp_path, "head_on", pl, h, [1, 0, 0, 0], seed) for pl, h in cells for seed in (0, 1)]
@@ -226,7 +226,7 @@ def test_the_provenance_log_line_is_the_same_whether_the_record_was_rewritten_or
 
 def test_verify_and_compare_refuse_a_truncated_or_edited_csv(tmp_path, capsys):
     from egosearch.cli import main
-    from egosearch.report.cli import cmd_compare
+    from egosearch.report.commands import cmd_compare
     from egosearch.report.provenance import StoredFileError, verify
 
     results, files = _stored_run(tmp_path)

@@ -10,9 +10,9 @@ import pytest
 import torch
 
 from egosearch.rl.actor import ActorPolicy
-from egosearch.rl.base import PooledConvEncoder, conv_sides, pool_depth
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
+from egosearch.rl.pooled import PooledConvEncoder, conv_sides, pool_depth
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.sac_drq import SacDrqAgent, random_shift
 from egosearch.rl.train import train
@@ -229,7 +229,7 @@ def test_curriculum_radius_grows_linearly_then_stops():
 
 
 def test_training_throughput_counts_env_steps_per_core_second():
-    from egosearch.rl.bench import training_throughput
+    from egosearch.rl.bench_learner import training_throughput
 
     r = training_throughput("smoke", env_steps=120, overrides={"num_threads": 1})
     assert r["env_steps"] == 120 and r["core_s"] > 0
@@ -240,7 +240,7 @@ def test_training_throughput_leaves_the_imitation_phase_out():
     """A profile that learns from the classical searcher first is timed in its RL phase alone (what the stored
     rates count), with a token imitation phase whatever the profile's (its 1,500 demonstrations would take
     many minutes of a one-minute benchmark)."""
-    from egosearch.rl.bench import training_throughput
+    from egosearch.rl.bench_learner import training_throughput
 
     big = {**DRQ, "num_threads": 1, "demo_episodes": 500, "bc_updates": 5000, "demo_batch_fraction": 0.5,
            "critic_warmup_updates": 1000}

@@ -1,6 +1,6 @@
 """The learner registry and the Agent protocol: every registered learner is an Agent, and a learner
 registered from outside egosearch (a toy defined here) trains through the real training loop and its
-actor file acts through ActorPolicy, as every written contract (egosearch.rl.agent) says it will."""
+actor file acts through ActorPolicy, as every written contract (egosearch.rl.learner) says it will."""
 
 from __future__ import annotations
 
@@ -14,9 +14,9 @@ import pytest
 import torch
 
 from egosearch.rl.actor import ActorPolicy, AgentPolicy, load_any_actor_net
-from egosearch.rl.agent import ActorFileNet, Agent, AgentBase
 from egosearch.rl.common import METRIC_KEYS, AgentStateError
 from egosearch.rl.config import load_config
+from egosearch.rl.learner import ActorFileNet, Agent, AgentBase
 from egosearch.rl.registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
 from egosearch.rl.train import train
 
@@ -31,7 +31,7 @@ TOY_AGENT_FORMAT, TOY_ACTOR_FORMAT = "toy-agent-v1", "toy-actor-v1"
 
 class ToyActorNet(torch.nn.Module):
     """A linear policy on [mask, proprio] (it ignores depth), called as an actor file's network is
-    (``egosearch.rl.agent.ActorFileNet``): ``(depth, extra) -> (mean before the tanh, None)``."""
+    (``egosearch.rl.learner.ActorFileNet``): ``(depth, extra) -> (mean before the tanh, None)``."""
 
     def __init__(self, extra_dim: int, action_dim: int):
         super().__init__()

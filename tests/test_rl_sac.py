@@ -320,10 +320,10 @@ def _walk(node):
 
 
 def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
-    """One image size (egosearch.sim.agent.IMAGE_SIZE): the env's frames, the sensor's default, and every
+    """One image size (egosearch.sim.body.IMAGE_SIZE): the env's frames, the sensor's default, and every
     profile's image_size; a config that differs is refused in one line when it is loaded or trained."""
     from egosearch.rl.train import train
-    from egosearch.sim.agent import IMAGE_SIZE
+    from egosearch.sim.body import IMAGE_SIZE
     from egosearch.sim.env import SearchEnv
     from egosearch.sim.sensor import DEFAULT_HEIGHT, DEFAULT_WIDTH
 
@@ -394,7 +394,7 @@ def test_departures_list_exactly_the_fields_that_differ_from_the_paper():
 
 
 def test_bench_timer_runs():
-    from egosearch.rl.bench import time_updates
+    from egosearch.rl.bench_learner import time_updates
 
     r = time_updates("smoke", threads=1, warmup=1, updates=2)
     assert 0 < r["best_s"] <= r["median_s"] < 10
@@ -406,7 +406,7 @@ def test_bench_timer_runs():
 def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_graphs(monkeypatch):
     """The eager Table 2 rows are the baseline the graphed row is read against: they must turn the
     paper profile's cuda_graph off themselves, or on a GPU both sides would be graphed."""
-    import egosearch.rl.bench as bench
+    import egosearch.rl.bench_learner as bench
 
     asked = []
 

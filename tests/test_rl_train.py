@@ -272,7 +272,7 @@ def test_target_memory_trains_the_policy_in_the_memory_env_of_its_head(tmp_path)
     """The config field and a variant naming the *Memory-v0 id are one observation: a head-off run with
     target_memory acts, and is checked, in EgoSearchNoHeadMemory-v0, whose mask is wider."""
     from egosearch.envs import env_space_dims, observed_env_id
-    from egosearch.sim.envs import ENV_IDS
+    from egosearch.sim.body_envs import ENV_IDS
 
     assert observed_env_id("EgoSearch-v0", True) == "EgoSearchMemory-v0"
     assert observed_env_id("EgoSearchNoHead-v0", True) == "EgoSearchNoHeadMemory-v0"

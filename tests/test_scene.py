@@ -413,7 +413,7 @@ def test_everywhere_puts_a_real_share_inside_low_cabinets(layout):
 
 
 def test_studio_is_small_connected_and_named():
-    from egosearch.sim.agent import AgentSpec
+    from egosearch.sim.body import AgentSpec
     from egosearch.sim.navgrid import NavGrid
 
     scene = get_scene("studio")

@@ -9,10 +9,10 @@ import pandas as pd
 import pytest
 
 from egosearch.cli import main
-from egosearch.report.cli import cmd_table1, group_bounds
+from egosearch.report.commands import cmd_table1, group_bounds
 from egosearch.report.workflow_jobs import bound_eval_files
 from egosearch.searchers import registry
-from egosearch.sim.envs import ENV_IDS
+from egosearch.sim.body_envs import ENV_IDS
 from egosearch.sim.scenarios import generate_scenarios, write_scenarios
 from egosearch.variants import VariantError, new_variant
 

@@ -22,7 +22,7 @@ from egosearch.scene import layouts
 from egosearch.scene.objects import get_object, target_part
 from egosearch.scene.parts import TAG_OBSTACLE, TAG_TARGET, TAG_WALL, Part, Scene
 from egosearch.searchers.policies import OraclePolicy, RandomPolicy
-from egosearch.sim.agent import AgentSpec, wrap_angle
+from egosearch.sim.body import AgentSpec, wrap_angle
 from egosearch.sim.env import SearchEnv
 from egosearch.sim.navgrid import LOWER_BOUND_SLACK, MAX_PENETRATION, NavGrid, lower_bound_holds
 from egosearch.sim.scenarios import (

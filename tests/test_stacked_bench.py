@@ -94,7 +94,7 @@ def test_train_help_names_the_option(option, capsys):
 
 
 def test_bench_stacked_times_both_ways_at_small_sizes():
-    from egosearch.rl.bench import bench_stacked
+    from egosearch.rl.bench_learner import bench_stacked
 
     small = {"encoder_num_filters": 8, "encoder_latent_dim": 32, "actor_hidden_dim": 64,
              "critic_hidden_dim": 64, "batch_size": 16}

@@ -70,8 +70,8 @@ def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
 
 
 def test_a_resolved_variant_is_the_training_run_the_gpu_check_reads():
-    """rl/bench.py names what it reads of a resolved variant (TrainingRun) instead of importing the layer above."""
-    from egosearch.rl.bench import TrainingRun
+    """rl/bench_learner.py names what it reads of a resolved variant (TrainingRun), not importing the layer above."""
+    from egosearch.rl.bench_learner import TrainingRun
     from egosearch.variants import resolve_variant
 
     run = resolve_variant("head_on", "smoke")

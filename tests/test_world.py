@@ -7,7 +7,7 @@ import pytest
 
 from egosearch.scene.geometry import deepest_penetration
 from egosearch.scene.parts import TAG_OBSTACLE, TAG_WALL, Part, Scene
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.navgrid import MAX_PENETRATION, NavGrid
 from egosearch.sim.world import PENETRATION_TOLERANCE, SWEEP_TOLERANCE, World, random_free_pose
 

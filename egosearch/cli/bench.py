@@ -12,9 +12,9 @@ from egosearch.cli.checks import at_least
 from egosearch.core.gpu_share import SIDE_BY_SIDE, side_by_side_record
 from egosearch.core.machine import with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
-from egosearch.rl.bench import bench_learner, bench_stacked, gpu_check
+from egosearch.rl.bench_learner import bench_learner, bench_stacked, gpu_check
 from egosearch.scene.layouts import get_scene
-from egosearch.sim import bench
+from egosearch.sim import bench_env as bench
 from egosearch.variants import resolve_variant
 
 GPU_CHECK_VARIANT = "head_on"

@@ -9,7 +9,7 @@ from __future__ import annotations
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
 from egosearch.searchers import registry as searchers
-from egosearch.sim.agent import EVAL_HEIGHTS, HEIGHT_RANGE
+from egosearch.sim.body import EVAL_HEIGHTS, HEIGHT_RANGE
 
 LAYOUTS = (f"{', '.join(LAYOUT_NAMES)} (the paper's homes), {', '.join(EASY_LAYOUTS)} (a small home for tests) "
            "or home<seed> (a generated home)")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from egosearch.cli.checks import at_least, check_npz_files, check_text_files
 from egosearch.core.outputs import check_outputs, check_overwrites
-from egosearch.report import cli as report
+from egosearch.report import commands as report
 from egosearch.report.behaviour import behaviour_report, check_pairs, parse_pair, parse_trace_path
 from egosearch.report.budget import budget_figure, budget_frame
 from egosearch.report.data import parse_eval_path
@@ -305,7 +305,7 @@ def _check_failures(args) -> None:
     # local: the simulator's body sizes are plain data, but its package is the CLI's to load
     from egosearch.report.failures import check_trace_file
     from egosearch.report.tables import PLACEMENT_LABELS
-    from egosearch.sim.agent import HEIGHT_RANGE
+    from egosearch.sim.body import HEIGHT_RANGE
 
     seen, profiles = {}, {}
     for path in args.files:
@@ -356,7 +356,7 @@ def success_radius() -> float:
     """Distance (m) from a target's centre to the body's axis within which success is possible: success is
     measured from the body's surface (egosearch.sim.scenarios.SUCCESS_DISTANCE), so the body's radius adds."""
     # local: the simulator's modules load trimesh (~2 s); only the path-length reports need the body's size
-    from egosearch.sim.agent import AgentSpec
+    from egosearch.sim.body import AgentSpec
     from egosearch.sim.scenarios import SUCCESS_DISTANCE
 
     return SUCCESS_DISTANCE + AgentSpec().body_radius

@@ -8,7 +8,7 @@ from egosearch.cli.checks import check_seed
 from egosearch.cli.parsers import MAX_HOMES, MAX_SCENARIOS
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.scene.layouts import get_scene
-from egosearch.sim.agent import check_height
+from egosearch.sim.body import check_height
 from egosearch.sim.scenarios import generate_scenarios, write_scenarios
 
 

@@ -286,6 +286,6 @@ def side_by_side_result(alone: dict, side: list[dict], *, all_env_steps: int, al
 
 
 def side_by_side_record(recorded: dict) -> dict:
-    """``egosearch.sim.bench.recorded``'s record (command, date, commit, machine, load, ``result``) as the
+    """``egosearch.sim.bench_env.recorded``'s record (command, date, commit, machine, load, ``result``) as the
     stored side-by-side record: the measurement's fields at the top, beside the machine's."""
     return {**{k: v for k, v in recorded.items() if k != "result"}, **recorded["result"]}

@@ -32,7 +32,7 @@ def calibrate() -> tuple[float, float | None]:
     meanwhile (as ``egosearch bench learner`` records it; None where the system does not say). The
     training's own lines (its evaluations, its config) are held back: the estimate is the answer."""
     # local: loads torch and the simulator, which an estimate from a given --rate never needs
-    from egosearch.rl.bench import cpu_profile_run_steps, training_throughput
+    from egosearch.rl.bench_learner import cpu_profile_run_steps, training_throughput
 
     busy0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
     with contextlib.redirect_stdout(io.StringIO()):

@@ -1,7 +1,7 @@
 """One interface for motion generators (MG of paper section 5, Algorithm 1 line 8).
 
 ``MotionGenerator.generate(plan, m, start)`` takes the abstract plan s_0..s_T (one
-:class:`~egosearch.sim.agent.AgentState` per env step of :data:`~egosearch.sim.agent.STEP_SECONDS`) and
+:class:`~egosearch.sim.body.AgentState` per env step of :data:`~egosearch.sim.body.STEP_SECONDS`) and
 returns the ``m`` full-body poses that follow ``start`` (the character's current pose, taken at
 the time of s_0), i.e. the poses at the times of s_1..s_m. ``start=None`` starts the character
 standing at s_0. Each generator moves with its own limits, so its poses deviate from the plan.
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from egosearch.sim.agent import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
+from egosearch.sim.body import STEP_SECONDS, AgentSpec, AgentState, wrap_angle
 from egosearch.sim.world import PENETRATION_TOLERANCE
 
 #: Integration sub-steps per env step (0.03 s each, the rate of the mocap clips).

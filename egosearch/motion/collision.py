@@ -15,7 +15,7 @@ from egosearch.motion.base import FullBodyPose
 from egosearch.motion.fetch import FetchBody
 from egosearch.motion.humanoid import HumanoidBody
 from egosearch.scene.parts import Scene
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.bullet import connect, pybullet
 from egosearch.sim.world import add_static_part
 

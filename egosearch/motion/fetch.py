@@ -25,7 +25,7 @@ from egosearch.motion.base import (
     Limits,
     MotionGenerator,
 )
-from egosearch.sim.agent import AgentState, wrap_angle
+from egosearch.sim.body import AgentState, wrap_angle
 from egosearch.sim.bullet import pybullet
 
 FETCH_CAMERA_HEIGHT = 1.05

@@ -28,7 +28,7 @@ from egosearch.motion.skeleton import (
     shape_segments,
     standing_root_height,
 )
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.bullet import pybullet, quiet_native_output
 
 HUMANOID_SCALE = 0.2735

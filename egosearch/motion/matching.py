@@ -36,7 +36,7 @@ from egosearch.motion.base import (
 )
 from egosearch.motion.humanoid import HUMANOID_LIMITS, HUMANOID_SCALE, eye_height, stand_pose
 from egosearch.motion.skeleton import REVOLUTE, SPHERICAL
-from egosearch.sim.agent import AgentState, wrap_angle
+from egosearch.sim.body import AgentState, wrap_angle
 
 #: Future trajectory samples (sub-steps ahead): 0.3, 0.6, 0.9 s.
 FUTURE_FRAMES = (10, 20, 30)

@@ -30,7 +30,7 @@ from egosearch.motion.base import (
 )
 from egosearch.motion.humanoid import HUMANOID_LIMITS, HUMANOID_SCALE, eye_height, stand_pose
 from egosearch.motion.skeleton import REVOLUTE, SPHERICAL
-from egosearch.sim.agent import STEP_SECONDS, AgentState, wrap_angle
+from egosearch.sim.body import STEP_SECONDS, AgentState, wrap_angle
 
 #: Effective foot radius (m) for the stepping that turning on the spot needs.
 TURN_STEP_RADIUS = 0.2

@@ -46,7 +46,7 @@ from egosearch.motion.matching import MatchingMG
 from egosearch.motion.phase import PhaseMG
 from egosearch.runs.evaluate import make_env
 from egosearch.runs.metrics import episode_spl
-from egosearch.sim.agent import AgentState
+from egosearch.sim.body import AgentState
 from egosearch.sim.env import FRAME_HISTORY, target_distance
 from egosearch.sim.scenarios import MAX_STEPS, SUCCESS_DISTANCE, Scenario
 

@@ -5,7 +5,7 @@ forward kinematics here agrees with pybullet's for the same joint values (checke
 
 Frames: the URDF is y-up (the model stands along +y, faces +x, its right side is +z). Our world
 is z-up; a model placed with base orientation ``quat.Y_UP_TO_Z_UP`` stands along +z, faces +x
-and has its left side at +y, the convention of :class:`egosearch.sim.agent.AgentState` (theta = 0
+and has its left side at +y, the convention of :class:`egosearch.sim.body.AgentState` (theta = 0
 faces +x).
 """
 

@@ -31,7 +31,7 @@ from egosearch.motion.humanoid import HUMANOID_SCALE, limb_shapes
 from egosearch.motion.replan import make_motion_generator, run_fullbody_episode
 from egosearch.runs.evaluate import make_env
 from egosearch.scene.meshes import part_mesh
-from egosearch.sim.agent import STEP_SECONDS  # noqa: E402
+from egosearch.sim.body import STEP_SECONDS  # noqa: E402
 from egosearch.sim.env import target_distance
 from egosearch.sim.render import depth_to_colormap, look_at_pose, upscale
 from egosearch.sim.scenarios import MAX_STEPS

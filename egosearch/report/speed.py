@@ -1,7 +1,7 @@
 """The docs' speed figures, generated from stored benchmark records and training curves.
 
 ``egosearch bench env|learner --out results/<profile>/bench/{env,learner}.json`` stores a benchmark's
-result with its command, date, commit, CPU and the machine's load (:func:`egosearch.sim.bench.recorded`);
+result with its command, date, commit, CPU and the machine's load (:func:`egosearch.sim.bench_env.recorded`);
 :func:`block_speed` renders them, and the env steps per core-second of the stored trainings from
 their ``curve.csv``, so that no speed figure in the docs is typed. CSV and JSON in, Markdown out.
 """

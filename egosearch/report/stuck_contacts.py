@@ -37,7 +37,7 @@ RUN_GAP = 2
 CONTACT_M = 0.06
 """How far (m) the body's surface may be from a part for the part to count as touched at a touching step."""
 BODY_RADIUS = 0.2
-"""The abstract body's radius (egosearch.sim.agent.AgentConfig.body_radius)."""
+"""The abstract body's radius (egosearch.sim.body.AgentConfig.body_radius)."""
 HALF_VERTICAL_FOV = math.radians(45.0)
 """Half the camera's vertical field of view (90 degrees)."""
 PRE_FRAMES = 5

@@ -14,12 +14,12 @@ and the CLI.
 - :mod:`egosearch.rl.registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``),
   the settings class of each and the actor file formats they write (``actor_loader``); adding a learner
   is one module (and its settings') and one ``register`` line there;
-- :mod:`egosearch.rl.agent`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,
+- :mod:`egosearch.rl.learner`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,
   and ``AgentBase``, its optional hooks' defaults; the actor file's contract (``ActorFile``,
   ``ActorArch``, ``ActorFileNet``);
 - :mod:`egosearch.rl.common`: what every learner builds from (actor head, layers, crops,
   observation tensors, update metrics, actor weights);
-- :mod:`egosearch.rl.base`: what the pooled-depth learners share (``PooledConvEncoder``,
+- :mod:`egosearch.rl.pooled`: what the pooled-depth learners share (``PooledConvEncoder``,
   ``pool_depth``, ``drq_arch``, ``act_with``, SAC-DrQ's actor file, ``PooledAgent``,
   ``SacDrqBase``) and ``SacMixin`` (SAC's temperature and actor step);
 - :mod:`egosearch.rl.sac_curl`: ``SacCurlAgent`` and its networks (the paper's learner);
@@ -46,7 +46,7 @@ and the CLI.
 - :mod:`egosearch.rl.actor`: ``ActorPolicy`` (loads any learner's ``actor.pt``) and ``AgentPolicy``
   (a live agent behind the policy interface);
 - :mod:`egosearch.rl.cuda_graph`: ``GraphedUpdate`` (an update recorded as CUDA graphs);
-- :mod:`egosearch.rl.bench`: ``bench_learner()`` and ``gpu_check()``.
+- :mod:`egosearch.rl.bench_learner`: ``bench_learner()`` and ``gpu_check()``.
 
 Nothing is imported here, so ``import egosearch.rl`` does not load torch.
 """

@@ -2,9 +2,9 @@
 ``format``) behind the project's policy interface, ``reset(seed)`` and ``act(obs)``;
 :class:`AgentPolicy` puts a live agent behind the same interface (the training loop's evaluations).
 
-What an actor file holds and how its network is called is written down in :mod:`egosearch.rl.agent`
-(:class:`~egosearch.rl.agent.ActorFile`, :class:`~egosearch.rl.agent.ActorArch`,
-:class:`~egosearch.rl.agent.ActorFileNet`); :func:`check_actor_file` holds a file to it on loading.
+What an actor file holds and how its network is called is written down in :mod:`egosearch.rl.learner`
+(:class:`~egosearch.rl.learner.ActorFile`, :class:`~egosearch.rl.learner.ActorArch`,
+:class:`~egosearch.rl.learner.ActorFileNet`); :func:`check_actor_file` holds a file to it on loading.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ import numpy as np
 import torch
 
 from egosearch.envs import ALL_ENV_IDS, env_space_dims, observation_kwargs
-from egosearch.rl.agent import ActorFileNet, Agent
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
+from egosearch.rl.learner import ActorFileNet, Agent
 from egosearch.rl.registry import actor_loader
-from egosearch.sim.agent import IMAGE_SIZE
+from egosearch.sim.body import IMAGE_SIZE
 
 
 class AgentPolicy:
@@ -37,22 +37,22 @@ class AgentPolicy:
 
 def check_actor_file(state: dict) -> None:
     """Raise :class:`AgentStateError` (one line) unless the actor file ``state``'s ``arch`` holds what
-    :class:`ActorPolicy` reads (:class:`egosearch.rl.agent.ActorArch`) and the actor was trained on
+    :class:`ActorPolicy` reads (:class:`egosearch.rl.learner.ActorArch`) and the actor was trained on
     frames of the env's size (its ``arch["image_size"]``, else its recorded config's, where either is
     written): an actor on other frames would otherwise crop or pool them to the wrong size in silence."""
     arch = state.get("arch")
     if not isinstance(arch, dict):
-        raise AgentStateError("the actor file has no arch (a dict of its sizes: egosearch.rl.agent.ActorArch)")
+        raise AgentStateError("the actor file has no arch (a dict of its sizes: egosearch.rl.learner.ActorArch)")
     for key in ("action_dim", "extra_dim") + tuple(k for k in ("crop_size", "mask_dim", "proprio_dim") if k in arch):
         if not isinstance(arch.get(key), int) or isinstance(arch[key], bool) or arch[key] < 1:
             raise AgentStateError(f"the actor file's arch has {key}={arch.get(key)!r}; it needs an integer >= 1 "
-                                  "(egosearch.rl.agent.ActorArch)")
+                                  "(egosearch.rl.learner.ActorArch)")
     config = (state.get("metadata") or {}).get("config") or {}
     side = arch.get("image_size", config.get("image_size"))
     if side is not None and side != IMAGE_SIZE:
         where = "arch" if "image_size" in arch else "recorded config"
         raise AgentStateError(f"this actor was trained on {side}x{side} depth frames (its {where}'s image_size); "
-                              f"the envs render {IMAGE_SIZE}x{IMAGE_SIZE} (egosearch.sim.agent.IMAGE_SIZE)")
+                              f"the envs render {IMAGE_SIZE}x{IMAGE_SIZE} (egosearch.sim.body.IMAGE_SIZE)")
 
 
 def load_any_actor_net(state: dict, device) -> ActorFileNet:

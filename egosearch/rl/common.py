@@ -3,8 +3,8 @@ devices, layers, the actor head and its tanh-Gaussian sample, the crops, observa
 the metric dict an ``update`` returns, agent-state checks and the actor files' weights.
 
 What the pooled-depth learners share above these (their encoder and actor, SAC's set-up and steps)
-is in :mod:`egosearch.rl.base`; the interface the training loop drives is
-:class:`egosearch.rl.agent.Agent`. A learner module keeps only what makes it that learner (its
+is in :mod:`egosearch.rl.pooled`; the interface the training loop drives is
+:class:`egosearch.rl.learner.Agent`. A learner module keeps only what makes it that learner (its
 critic, losses and update).
 The module and attribute names below are part of every checkpoint's and actor file's state_dict
 keys (``head.proj.fc.weight``, ``head.trunk.0.bias``...): renaming one breaks stored runs.

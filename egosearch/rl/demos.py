@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 from egosearch.envs import observed_env_id
-from egosearch.rl.base import pool_depth, pooled_side
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.pooled import pool_depth, pooled_side
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.run_files import atomic_json
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
@@ -63,7 +63,7 @@ MATCHED = ("variant", "env_id", "env_kwargs", "teacher", "seed", "episodes", "fr
 
 def replay_downsample(cfg) -> int:
     """How the depth frames are pooled where the learner's replay stores them: ``obs_downsample`` for a
-    learner whose replay pools them (SAC-DrQ, its recurrent form, PPO: ``egosearch.rl.base.PooledAgent``), 1
+    learner whose replay pools them (SAC-DrQ, its recurrent form, PPO: ``egosearch.rl.pooled.PooledAgent``), 1
     for one that stores the env's frames (SAC+CURL, the smoke and paper profiles' learner, has no such field)."""
     return int(getattr(cfg, "obs_downsample", 1))
 

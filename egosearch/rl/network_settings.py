@@ -2,7 +2,7 @@
 SAC's temperature and target networks, and the pooled depth input of the SAC-DrQ family.
 
 Each learner's own settings class (:mod:`egosearch.rl.sac_curl_settings` and its siblings) is a
-dataclass made of these, as its agent class is made of :mod:`egosearch.rl.base`'s pieces; a learner has
+dataclass made of these, as its agent class is made of :mod:`egosearch.rl.pooled`'s pieces; a learner has
 exactly the fields it reads. Each class's :meth:`own_checks` checks its own fields' ranges (and their
 rules with the run settings), and ``LearnerConfig.validate`` calls those of every class a config is made of.
 """
@@ -145,7 +145,7 @@ class SacSettings(NetworkSettings):
 
 @dataclass
 class PooledSettings:
-    """The pooled depth input of the SAC-DrQ family (``egosearch.rl.base.PooledConvEncoder``): depth
+    """The pooled depth input of the SAC-DrQ family (``egosearch.rl.pooled.PooledConvEncoder``): depth
     average-pooled, then convs of which the first few have stride 2."""
 
     obs_downsample: int = 1

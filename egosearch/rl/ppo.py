@@ -6,8 +6,8 @@ A lever for the searcher's ceiling: SAC replays each transition many times (the 
 habitat-baselines trains PointNav / ObjectNav (DD-PPO, Wijmans et al. 2020). An on-policy
 learner CHANGES THE ALGORITHM (the paper's is SAC + CURL).
 
-- The actor is SAC-DrQ's, unchanged (:class:`egosearch.rl.base.PooledAgent`):
-  :class:`egosearch.rl.base.PooledConvEncoder` on the pooled depth + the common
+- The actor is SAC-DrQ's, unchanged (:class:`egosearch.rl.pooled.PooledAgent`):
+  :class:`egosearch.rl.pooled.PooledConvEncoder` on the pooled depth + the common
   :class:`egosearch.rl.common.ActorHead` (mu, log_std) and its tanh-squashed Gaussian. Its actor
   file IS a SAC-DrQ actor file (same format, arch and keys), so evaluation runs it as tanh(mu)
   with no change.
@@ -40,7 +40,6 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.base import PooledAgent, pooled_encoder
 from egosearch.rl.common import (
     LOG_2PI,
     Projection,
@@ -54,6 +53,7 @@ from egosearch.rl.common import (
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.pooled import PooledAgent, pooled_encoder
 from egosearch.rl.replay import MultiReplay
 
 AGENT_FORMAT = "egosearch-ppo-agent-v1"
@@ -112,7 +112,7 @@ class ValueNet(nn.Module):
 class PpoAgent(PooledAgent):
     """PPO with SAC-DrQ's actor and a separate value network (module docstring). Driven by
     :mod:`egosearch.rl.train` like the SAC learners; ``sample_batch`` picks its rollout. Its actor
-    file is SAC-DrQ's (:data:`egosearch.rl.base.DRQ_ACTOR_FORMAT`): evaluation loads it as any other."""
+    file is SAC-DrQ's (:data:`egosearch.rl.pooled.DRQ_ACTOR_FORMAT`): evaluation loads it as any other."""
 
     agent_format = AGENT_FORMAT
     MODULES = ("encoder", "actor", "value")

@@ -3,11 +3,11 @@
 
 :data:`LEARNERS` holds one :class:`Learner` per algorithm name; :data:`ALGORITHMS` (its live names)
 is what ``LearnerConfig.validate`` accepts. Adding a learner is one module with its agent class (an
-:class:`egosearch.rl.agent.Agent`, most simply a subclass of :class:`egosearch.rl.agent.AgentBase`)
+:class:`egosearch.rl.learner.Agent`, most simply a subclass of :class:`egosearch.rl.learner.AgentBase`)
 and one :func:`register` line below, which also names the dataclass of its own settings (most simply
 built from :mod:`egosearch.rl.network_settings`'s pieces). Agents, loaders and settings may be named
 ``"module:attribute"``, imported on first use: this module imports neither torch nor a learner, nor the
-config (:mod:`egosearch.rl.config` imports it); it types configs as :class:`egosearch.rl.agent.LearnerSettings`.
+config (:mod:`egosearch.rl.config` imports it); it types configs as :class:`egosearch.rl.learner.LearnerSettings`.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 from egosearch.core.registry import Registry, resolve
 
 if TYPE_CHECKING:
-    from egosearch.rl.agent import ActorFileNet, Agent, LearnerSettings
+    from egosearch.rl.learner import ActorFileNet, Agent, LearnerSettings
 
 
 @dataclass(frozen=True)
@@ -31,7 +31,7 @@ class Learner:
     ``agent(cfg, action_dim, mask_dim, proprio_dim, device=device[, state_dim=state_dim])``;
     ``actor_formats``: the ``format`` of each actor file it writes -> the function
     ``(state, device) -> net`` (or ``"module:function"``) that loads that file's network, an
-    :class:`egosearch.rl.agent.ActorFileNet`;
+    :class:`egosearch.rl.learner.ActorFileNet`;
     ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size);
     ``settings``: the dataclass of its own settings (or ``"module:Class"``), which
     :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone;
@@ -117,11 +117,11 @@ register("sac_curl", "SAC+CURL", "egosearch.rl.sac_curl:SacCurlAgent",
          {"egosearch-sac-curl-actor-v1": "egosearch.rl.sac_curl:load_actor_net"}, takes_state_dim=False,
          settings="egosearch.rl.sac_curl_settings:SacCurlSettings", stacked=True)
 register("sac_drq", "SAC-DrQ", "egosearch.rl.sac_drq:SacDrqAgent",
-         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"},
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.pooled:load_drq_actor_net"},
          settings="egosearch.rl.sac_drq_settings:SacDrqSettings", stacked=True)
 register("sac_drq_recurrent", "recurrent SAC-DrQ", "egosearch.rl.sac_drq_recurrent:SacDrqRecurrentAgent",
          {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"},
          settings="egosearch.rl.sac_drq_recurrent_settings:SacDrqRecurrentSettings")
 register("ppo", "PPO", "egosearch.rl.ppo:PpoAgent",
-         {"egosearch-sac-drq-actor-v1": "egosearch.rl.base:load_drq_actor_net"},
+         {"egosearch-sac-drq-actor-v1": "egosearch.rl.pooled:load_drq_actor_net"},
          settings="egosearch.rl.ppo_settings:PpoSettings")

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
-from egosearch.sim.agent import IMAGE_SIZE  # the env's frames: one source
+from egosearch.sim.body import IMAGE_SIZE  # the env's frames: one source
 
 Complaint = Callable[[str, str], None]
 """``bad(field, allowed)``: raises the one-line ``ValueError`` of a value out of range."""
@@ -56,7 +56,7 @@ class RunSettings:
     # ---- Table 2: observation and data -------------------------------------------------
     image_size: int = IMAGE_SIZE
     """Table 2 "Image Size" 100x100: side (px) of the depth frames the env renders and the
-    replay buffer stores. It must be the env's, ``egosearch.sim.agent.IMAGE_SIZE``: a config that
+    replay buffer stores. It must be the env's, ``egosearch.sim.body.IMAGE_SIZE``: a config that
     differs is one line when it is loaded (``tests/test_rl_sac.py``)."""
     frame_history: int = 5
     """Table 2 "Image History Buffer Size" (K of paper 4.1): depth frames stacked as channels."""
@@ -254,7 +254,7 @@ class RunSettings:
     compile: bool = False
     """Ours, read by SAC+CURL only: ``torch.compile`` its encoders and MLPs. Off: measured on the 2-core CPU it costs
     ~20 s of compilation and gives no speed-up (the convs and GEMMs already run as oneDNN / MKL
-    kernels near the CPU's peak; see ``egosearch.rl.bench``). May help on a GPU."""
+    kernels near the CPU's peak; see ``egosearch.rl.bench_learner``). May help on a GPU."""
     cuda_graph: bool = False
     """Ours: on a GPU, record the SAC+CURL update as CUDA graphs (one per pattern of the update's
     steps) and replay them, instead of launching its hundreds of small kernels from Python one by
@@ -281,7 +281,7 @@ class RunSettings:
                 bad(name, "an integer >= 0")
         if self.image_size != IMAGE_SIZE:
             bad("image_size", f"{IMAGE_SIZE} (the env renders {IMAGE_SIZE} x {IMAGE_SIZE} frames: "
-                "egosearch.sim.agent.IMAGE_SIZE)")
+                "egosearch.sim.body.IMAGE_SIZE)")
         if self.train_distance_reward not in DISTANCE_REWARDS:
             bad("train_distance_reward", ", ".join(DISTANCE_REWARDS))
         if self.critic_privileged_state and not self.privileged_critic:

@@ -32,7 +32,7 @@ Two implementations of one update, selected by ``SacCurlAgent(impl=...)``:
 - ``"reference"``: CURL's ``CurlSacAgent.update`` transcribed line by line (per-sample crops,
   separate forward passes, per-parameter Adam, CURL's two encoder optimisers). It is the
   correctness oracle (tests/test_rl_sac.py: same losses and parameters as the fast path) and
-  the speed baseline (``egosearch.rl.bench``).
+  the speed baseline (``egosearch.rl.bench_learner``).
 """
 
 from __future__ import annotations
@@ -46,8 +46,6 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.agent import AgentBase
-from egosearch.rl.base import SacMixin
 from egosearch.rl.common import (
     ActorHead,
     AgentStateError,
@@ -68,6 +66,8 @@ from egosearch.rl.common import (
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.cuda_graph import GraphedUpdate
+from egosearch.rl.learner import AgentBase
+from egosearch.rl.pooled import SacMixin
 
 AGENT_FORMAT = "egosearch-sac-curl-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-curl-actor-v1"
@@ -159,7 +159,7 @@ _ARCH_FIELDS = ("frame_history", "image_size", "crop_size", "encoder_num_layers"
 # ---- the agent ----------------------------------------------------------------------------
 
 class SacCurlAgent(SacMixin, AgentBase):
-    """SAC + CURL learner, an :class:`egosearch.rl.agent.Agent`: ``act`` for one observation (a batch
+    """SAC + CURL learner, an :class:`egosearch.rl.learner.Agent`: ``act`` for one observation (a batch
     of them acts one by one), ``update`` for one batch of transitions (the replay stores the env's
     observations as they are)."""
 

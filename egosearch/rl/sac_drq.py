@@ -4,7 +4,7 @@ What it keeps from SAC + CURL (:mod:`egosearch.rl.sac_curl`): the soft actor-cri
 twin critics with Polyak targets, the tanh-Gaussian actor, the automatic temperature, the inputs
 (K depth frames + mask feature + proprioception) and every learning rate and beta. The pooled
 encoder, the actor and its file, and SAC's set-up and steps, which the recurrent form and PPO share,
-live in :mod:`egosearch.rl.base` (:class:`egosearch.rl.base.SacDrqBase`); layers, crops and the actor
+live in :mod:`egosearch.rl.pooled` (:class:`egosearch.rl.pooled.SacDrqBase`); layers, crops and the actor
 head in :mod:`egosearch.rl.common`.
 
 What it changes, after DrQ-v2 (Yarats et al. 2021, github.com/facebookresearch/drqv2), to make
@@ -31,7 +31,7 @@ one update several times cheaper:
   a batch's ``demo`` rows (RLPD's half batches) add ``bc_weight_now`` x a behaviour-cloning term to
   the actor's loss (TD3+BC's form), the training loop decaying ``bc_weight_now``.
 
-It is an :class:`egosearch.rl.agent.Agent`, so :mod:`egosearch.rl.train` drives it as any other
+It is an :class:`egosearch.rl.learner.Agent`, so :mod:`egosearch.rl.train` drives it as any other
 learner (registered as "sac_drq" in :mod:`egosearch.rl.registry`).
 """
 
@@ -43,7 +43,6 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.base import DRQ_ACTOR_FORMAT, SacDrqBase
 from egosearch.rl.common import (
     AgentStateError,
     Projection,
@@ -57,6 +56,7 @@ from egosearch.rl.common import (
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.pooled import DRQ_ACTOR_FORMAT, SacDrqBase
 
 AGENT_FORMAT = "egosearch-sac-drq-agent-v1"
 ACTOR_FORMAT = DRQ_ACTOR_FORMAT

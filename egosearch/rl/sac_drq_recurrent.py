@@ -12,12 +12,12 @@ R2D2 (Kapturowski et al. 2019): replay of contiguous sequences, whose first ``bu
 only warm the hidden state up (no gradient) before the ``sequence_length`` steps that carry the
 losses, with zero initial states (R2D2's "zero start state" plus burn-in).
 
-What it keeps from SAC-DrQ: ONE conv encoder (:class:`egosearch.rl.base.PooledConvEncoder`) trained by the critic
+What it keeps from SAC-DrQ: ONE conv encoder (:class:`egosearch.rl.pooled.PooledConvEncoder`) trained by the critic
 loss only, read detached by the actor; random-shift augmentation (one shift per sequence, so
 that the memory sees a steady camera); pooled uint8 frames in the replay; n-step returns;
 twin Q-heads with a Polyak target (here the target also holds a copy of the critic's GRU);
 the optional privileged critic (the state enters the Q-heads, not the GRU). Its set-up, actor and
-temperature step, Polyak step and agent state are SAC-DrQ's (:class:`egosearch.rl.base.SacDrqBase`).
+temperature step, Polyak step and agent state are SAC-DrQ's (:class:`egosearch.rl.pooled.SacDrqBase`).
 
 Per step, a network's GRU reads [projected conv features, mask, proprio] and its head reads
 [GRU output, projected conv features, mask, proprio] (the current observation stays one layer
@@ -44,7 +44,6 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.base import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
 from egosearch.rl.common import (
     Projection,
     check_agent_state,
@@ -56,6 +55,7 @@ from egosearch.rl.common import (
     squashed_sample,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.pooled import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
@@ -262,7 +262,7 @@ def shift_sequences(x: torch.Tensor, pad: int) -> torch.Tensor:
 # ---- the agent ------------------------------------------------------------------------------
 
 class SacDrqRecurrentAgent(SacDrqBase):
-    """Recurrent SAC-DrQ (module docstring). An :class:`egosearch.rl.agent.Agent` with a memory
+    """Recurrent SAC-DrQ (module docstring). An :class:`egosearch.rl.learner.Agent` with a memory
     (``recurrent``): ``sample_batch(replay)`` draws sequences instead of transitions,
     ``reset_state(env_index)`` forgets an env's ended episode and ``reset_policy_state()`` the
     evaluation episode's."""

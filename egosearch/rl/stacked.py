@@ -317,7 +317,7 @@ class StackedAgents:
         return [t for name, t in self.params.items() if name.startswith(prefix)]
 
     def alpha_step(self, log_pi: torch.Tensor, target_entropy: float, out: dict[str, torch.Tensor]) -> None:
-        """SAC's temperature step (:meth:`egosearch.rl.base.SacMixin.actor_and_alpha_step`'s second half)."""
+        """SAC's temperature step (:meth:`egosearch.rl.pooled.SacMixin.actor_and_alpha_step`'s second half)."""
         def alpha_loss(log_alpha: torch.Tensor, lp: torch.Tensor) -> torch.Tensor:
             return (log_alpha.exp() * (-lp - target_entropy).detach()).mean()
 

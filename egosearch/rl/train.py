@@ -58,7 +58,6 @@ from egosearch.core.machine import cpu_model, cpu_vector_unit, gpu_model
 from egosearch.core.staging import CHECKPOINT_NAME, START_ACTOR_NAME
 from egosearch.envs import observation_kwargs, observed_env_id
 from egosearch.rl.actor import AgentPolicy
-from egosearch.rl.agent import Agent
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, resolve_device
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.demos import (
@@ -70,6 +69,7 @@ from egosearch.rl.demos import (
     wanted_summary,
 )
 from egosearch.rl.imitation import clone, dagger_round
+from egosearch.rl.learner import Agent
 from egosearch.rl.registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (

@@ -8,7 +8,7 @@ import gymnasium
 from egosearch.envs import observation_kwargs
 from egosearch.rl.config import LearnerConfig
 from egosearch.scene.layouts import LAYOUT_NAMES
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.home_pool import HomePoolEnv
 
 

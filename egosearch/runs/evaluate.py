@@ -9,7 +9,7 @@ import gymnasium
 import egosearch.envs  # noqa: F401  (registers the ids, the decision envs too)
 from egosearch.core.csvio import write_csv_atomic
 from egosearch.runs.metrics import episode_spl, spl
-from egosearch.sim.agent import EVAL_HEIGHTS
+from egosearch.sim.body import EVAL_HEIGHTS
 from egosearch.sim.scenarios import Scenario, generate_scenarios
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl",

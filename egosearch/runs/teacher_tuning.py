@@ -30,7 +30,7 @@ import numpy as np
 
 from egosearch.core.csvio import write_csv_atomic
 from egosearch.runs.evaluate import EPISODE_COLUMNS, evaluate
-from egosearch.sim.agent import EVAL_HEIGHTS
+from egosearch.sim.body import EVAL_HEIGHTS
 from egosearch.sim.scenarios import PLACEMENT_SCHEMES, Scenario, generate_scenarios
 
 PAPER_HOMES = ("kitchen_living", "bedroom_bath")

@@ -42,7 +42,7 @@ import numpy as np
 from egosearch.scene.layouts import get_scene
 from egosearch.scene.meshes import part_mesh, scene_meshes
 from egosearch.scene.parts import TAG_FLOOR, TAG_WALL
-from egosearch.sim.agent import STEP_SECONDS
+from egosearch.sim.body import STEP_SECONDS
 from egosearch.sim.scenarios import navgrid_for, shortest_path_region
 from egosearch.sim.sensor import camera_axes
 

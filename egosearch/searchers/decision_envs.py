@@ -44,7 +44,7 @@ the searcher's map), with the body id that does."""
 def check_decision_options(env_id: str | None, kwargs: dict) -> None:
     """``kwargs`` of a decision env (``env_id``'s registered ones with the caller's on top; None: the class
     built directly) name no option it does not read, and keep the head its id fixes."""
-    from egosearch.sim.envs import check_flag
+    from egosearch.sim.body_envs import check_flag
 
     where = env_id or "the modular searcher's decision env"
     for name, reader in UNREAD_OPTIONS.items():

@@ -20,7 +20,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from egosearch.sim.agent import wrap_angle
+from egosearch.sim.body import wrap_angle
 from egosearch.sim.floormap import FREE, OCCUPIED, UNKNOWN, FloorMap
 from egosearch.sim.scenarios import SUCCESS_DISTANCE
 from egosearch.sim.sensor import camera_axes

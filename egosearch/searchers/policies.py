@@ -12,7 +12,7 @@ from typing import Protocol
 
 import numpy as np
 
-from egosearch.sim.agent import wrap_angle
+from egosearch.sim.body import wrap_angle
 from egosearch.sim.navgrid import NavGrid
 from egosearch.sim.scenarios import SUCCESS_DISTANCE, navgrid_for, success_region
 

@@ -26,7 +26,7 @@ whether this step's move collided (a bump bit) and the collisions of the last :d
 steps / :data:`CONTACT_WINDOW`. The paper's body feels nothing: a low sofa below the view is invisible
 to it, and the stored students fail pushing into such furniture.
 
-Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.sim.agent.AgentSpec`
+Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.sim.body.AgentSpec`
 (head-off: [dx, dy, dtheta]).
 
 Reward: r = 1.0 r_s + 1.0 r_d + 1.0 r_l + 0.1 r_c with r_s = 10 on success, r_d = minus the
@@ -59,8 +59,8 @@ from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
 from egosearch.scene.placement import sample_target
-from egosearch.sim.agent import IMAGE_SIZE, AgentSpec, AgentState, check_height
-from egosearch.sim.envs import BODY_METADATA, check_flag
+from egosearch.sim.body import IMAGE_SIZE, AgentSpec, AgentState, check_height
+from egosearch.sim.body_envs import BODY_METADATA, check_flag
 from egosearch.sim.floormap import FloorMap
 from egosearch.sim.scenarios import (
     MAX_STEPS,

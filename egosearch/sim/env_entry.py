@@ -1,10 +1,10 @@
 """The body env ids' entry points (``gymnasium.make("EgoSearch-v0", ...)`` calls one): each checks its id's
-options (:func:`egosearch.sim.envs.check_body_options`) before it builds :class:`egosearch.sim.env.SearchEnv`.
+options (:func:`egosearch.sim.body_envs.check_body_options`) before it builds :class:`egosearch.sim.env.SearchEnv`.
 A module of their own, named by the registrations as a string, so that registering the ids
-(:mod:`egosearch.sim.envs`) loads neither the physics nor this module."""
+(:mod:`egosearch.sim.body_envs`) loads neither the physics nor this module."""
 
+from egosearch.sim.body_envs import BODY_METADATA, ENV_IDS, check_body_options
 from egosearch.sim.env import SearchEnv
-from egosearch.sim.envs import BODY_METADATA, ENV_IDS, check_body_options
 
 
 def _entry_point(env_id: str):

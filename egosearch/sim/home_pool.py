@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import gymnasium
 
-import egosearch.sim.envs  # noqa: F401  (registers the ids this env builds)
+import egosearch.sim.body_envs  # noqa: F401  (registers the ids this env builds)
 from egosearch.scene.layouts import HELDOUT_HOME_SEEDS
 
 GENERATED = "generated"

@@ -26,7 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from egosearch.scene.parts import Part, Scene
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 
 _MOVES = [(1, 0), (0, 1), (1, 1), (1, -1), (2, 1), (1, 2), (2, -1), (1, -2)]
 #: Grid cell size (m): a tenth of the body diameter.

@@ -19,7 +19,7 @@ from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import TAG_LOW_CABINET_INTERIOR, Part
 from egosearch.scene.placement import PLACEMENT_SCHEMES, rests_on_support, sample_target
 from egosearch.scene.topdown import plot_topdown
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.render import SceneRenderer, depth_to_colormap
 from egosearch.sim.scenarios import navgrid_for, visible_from
 from egosearch.sim.sensor import DepthMaskSensor

@@ -27,7 +27,7 @@ from egosearch.scene.meshes import scene_meshes
 from egosearch.scene.objects import TARGET_OBJECTS, get_object, target_part
 from egosearch.scene.parts import Part, Scene
 from egosearch.scene.placement import PLACEMENT_SCHEMES, sample_target
-from egosearch.sim.agent import AgentSpec, check_height
+from egosearch.sim.body import AgentSpec, check_height
 from egosearch.sim.navgrid import DEFAULT_RESOLUTION as NAVGRID_RESOLUTION
 from egosearch.sim.navgrid import NavGrid
 

@@ -75,7 +75,7 @@ import numpy as np
 from egosearch.scene.meshes import part_mesh, scene_meshes
 from egosearch.scene.parts import Part, Scene
 from egosearch.sim import rasterbuild
-from egosearch.sim.agent import IMAGE_SIZE
+from egosearch.sim.body import IMAGE_SIZE
 
 DEFAULT_WIDTH = IMAGE_SIZE
 DEFAULT_HEIGHT = IMAGE_SIZE

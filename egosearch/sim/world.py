@@ -3,7 +3,7 @@
 The body is a cylinder on a planar (x, y, yaw) joint chain; each env step sets a target
 configuration and pybullet's position control tracks it, so walls and furniture stop the body
 instead of being teleported through. The camera joints need no physics: they are clamped
-angles in :class:`egosearch.sim.agent.AgentState`.
+angles in :class:`egosearch.sim.body.AgentState`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from egosearch.scene.parts import Part, Scene
-from egosearch.sim.agent import AgentSpec
+from egosearch.sim.body import AgentSpec
 from egosearch.sim.bullet import connect, pybullet
 
 #: Physics sub-steps per env step. Enough that the body (moving <= 0.25 m per env step)

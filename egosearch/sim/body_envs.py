@@ -1,4 +1,4 @@
-"""The body env's gymnasium ids (``import egosearch.sim.envs`` registers them; ``import egosearch.envs``
+"""The body env's gymnasium ids (``import egosearch.sim.body_envs`` registers them; ``import egosearch.envs``
 registers every id, the modular searcher's too, and resolves the env options).
 
 One env, :class:`egosearch.sim.env.SearchEnv`; its observation is chosen by keyword options:

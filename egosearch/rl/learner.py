@@ -191,7 +191,7 @@ class ActorArch(TypedDict):
     beside depth, ``[mask, proprio]``. Read when present: ``mask_dim`` and ``proprio_dim`` (both, to
     tell apart envs whose sums agree); ``crop_size``, the side of the centre crop of the depth
     frames the network reads (without it, the whole frame); ``image_size``, the side of the frames
-    it was trained on, which must be the env's (:data:`egosearch.sim.agent.IMAGE_SIZE`)."""
+    it was trained on, which must be the env's (:data:`egosearch.sim.body.IMAGE_SIZE`)."""
 
     action_dim: int
     extra_dim: int

@@ -6,7 +6,7 @@
 - SAC-DrQ's actor: :data:`DRQ_ARCH_FIELDS` and :func:`drq_arch` (its arch dict), :func:`act_with`
   (acting), :class:`DrqActorNet`, :data:`DRQ_ACTOR_FORMAT` and :func:`load_drq_actor_net` (its
   actor file, which SAC-DrQ and PPO both write);
-- :class:`PooledAgent`: an :class:`egosearch.rl.agent.AgentBase` whose replay holds pooled depth and
+- :class:`PooledAgent`: an :class:`egosearch.rl.learner.AgentBase` whose replay holds pooled depth and
   whose actor is SAC-DrQ's (input sizes, acting, arch, agent state and actor file);
 - :class:`SacMixin`: SAC's temperature and its actor + temperature step (SAC + CURL uses it too);
 - :class:`SacDrqBase`: a :class:`PooledAgent` with SAC's parts (the networks' set-up, the target
@@ -31,7 +31,6 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from egosearch.rl.agent import AgentBase
 from egosearch.rl.common import (
     ActorHead,
     activation,
@@ -46,6 +45,7 @@ from egosearch.rl.common import (
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.learner import AgentBase
 
 DRQ_ACTOR_FORMAT = "egosearch-sac-drq-actor-v1"
 """The actor file of SAC-DrQ's actor (pooled conv encoder + :class:`ActorHead`): SAC-DrQ's and PPO's."""

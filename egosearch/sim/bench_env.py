@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-import egosearch.sim.envs  # noqa: F401  (registers the ids)
+import egosearch.sim.body_envs  # noqa: F401  (registers the ids)
 from egosearch.core.machine import cpu_seconds_all, measured_on, own_cpu_seconds
 from egosearch.scene.layouts import get_scene
 from egosearch.scene.meshes import triangle_count

@@ -286,7 +286,7 @@ def _avx2_limited_cpu_profile(quick: bool, cpu_profile_run: bool) -> dict | None
     """:func:`cpu_profile_rows` in a child process whose oneDNN may use AVX2 at most
     (``ONEDNN_MAX_CPU_ISA=AVX2``): what the same update costs on a CPU without AVX-512. None if the
     child fails (its error is printed)."""
-    code = ("import json, sys; from egosearch.rl.bench import cpu_profile_rows; "
+    code = ("import json, sys; from egosearch.rl.bench_learner import cpu_profile_rows; "
             f"print(json.dumps(cpu_profile_rows({quick!r}, {cpu_profile_run!r})))")
     child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                            env={**os.environ, "ONEDNN_MAX_CPU_ISA": "AVX2"})
