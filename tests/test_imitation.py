@@ -238,4 +238,26 @@ def test_figure6_marks_where_a_trainings_imitation_ends(tmp_path):
     assert phases(demo_episodes=10, bc_updates=5, critic_warmup_updates=2500, demo_batch_fraction=0.5,
                   bc_weight=0.4, bc_decay_steps=100_000) == [14_000, 100_000]
     assert phases(demo_episodes=10, bc_updates=5, critic_warmup_updates=10**6) == []  # imitation alone: never ends
+    floored = dict(demo_episodes=10, bc_updates=5, critic_warmup_updates=2500, demo_batch_fraction=0.5,
+                   bc_weight=0.4, bc_decay_steps=100_000, bc_weight_floor=0.1)
+    cfg = load_config("cpu", {**load_variant("head_on_from_scratch").config, **floored}).to_dict()
+    (tmp_path / "config.json").write_text(json.dumps({"config": cfg}))
+    assert imitation_phases(tmp_path / "curve.csv")[-1] == (100_000, "cloning term reaches 0.1")
     assert imitation_phases(tmp_path / "elsewhere" / "curve.csv") == []
+
+
+def test_the_cloning_term_decays_linearly_to_its_floor_and_stays_there():
+    """bc_weight 0.4 over 100k env steps: 0.4 at step 0, 0.2 at 50k, 0 from 100k on; with a floor of 0.1 the
+    weight is 0.4 * (1 - 80k/100k) = 0.08 -> 0.1 at 80k, and 0.1 for ever after. A floor above the weight is one
+    line."""
+    from egosearch.rl.train import cloning_weight
+
+    base = {"demo_episodes": 10, "demo_batch_fraction": 0.5, "bc_weight": 0.4, "bc_decay_steps": 100_000}
+    plain = load_config("cpu", base)
+    assert [cloning_weight(plain, s) for s in (0, 50_000, 100_000, 150_000)] == pytest.approx([0.4, 0.2, 0.0, 0.0])
+    floored = load_config("cpu", {**base, "bc_weight_floor": 0.1})
+    assert [cloning_weight(floored, s) for s in (0, 50_000, 80_000, 100_000, 190_000)] == pytest.approx(
+        [0.4, 0.2, 0.1, 0.1, 0.1])
+    assert cloning_weight(load_config("cpu", {"bc_weight": 0.0, "demo_batch_fraction": 0.0}), 10) == 0.0
+    with pytest.raises(ValueError, match=r"bc_weight_floor=0.5 is out of range; allowed: \[0, bc_weight=0.4\]"):
+        load_config("cpu", {**base, "bc_weight_floor": 0.5})

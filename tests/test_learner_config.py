@@ -29,7 +29,7 @@ OWN_FIELD_COUNTS = {"sac_curl": 35, "sac_drq": 33, "sac_drq_recurrent": 33, "ppo
 
 
 def test_the_run_settings_and_each_learners_own_fields_are_counted():
-    assert len(SHARED) == 40
+    assert len(SHARED) == 41
     assert {name: len(own_settings(name)) for name in OWN_FIELD_COUNTS} == OWN_FIELD_COUNTS
     # every field belongs to the run settings or to some learner, and none to both
     assert SHARED | {f for name in LEARNERS for f in own_settings(name)} == set(field_defaults()) == set(FIELD_ORDER)

@@ -235,7 +235,8 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
     """Where a training's learning from the teacher changes phase, read from the ``config.json`` beside its
     ``curve.csv``: (env step, label) for the first RL step of the actor after behaviour cloning (after the
     warm-up and the critic's warm-up: ``bc_updates``, ``critic_warmup_updates``), and for the end of the
-    decaying cloning term (``bc_decay_steps``). Empty for a training without a teacher (or no config)."""
+    decaying cloning term (``bc_decay_steps``, where it reaches 0 or its ``bc_weight_floor``). Empty for a
+    training without a teacher (or no config)."""
     try:
         cfg = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))["config"]
     except (OSError, ValueError, KeyError):
@@ -248,7 +249,8 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
         if start <= cfg["total_env_steps"]:
             phases.append((start, "imitation ends: RL steps the actor"))
     if cfg.get("bc_weight") and cfg.get("bc_decay_steps", 0) <= cfg["total_env_steps"]:
-        phases.append((int(cfg["bc_decay_steps"]), "cloning term reaches 0"))
+        floor = cfg.get("bc_weight_floor", 0.0)
+        phases.append((int(cfg["bc_decay_steps"]), f"cloning term reaches {floor:g}"))
     return phases
 
 

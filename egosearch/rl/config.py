@@ -73,7 +73,7 @@ FIELD_ORDER = (
     "ppo_init_std", "train_height_min",
     # learning from the classical searcher
     "demo_episodes", "demo_teacher", "bc_updates", "dagger_rounds", "dagger_episodes", "critic_warmup_updates",
-    "demo_batch_fraction", "bc_weight", "bc_decay_steps",
+    "demo_batch_fraction", "bc_weight", "bc_decay_steps", "bc_weight_floor",
     # training loop; implementation
     "init_steps", "update_every", "updates_per_step", "eval_every", "eval_episodes", "log_every",
     "checkpoint_every", "seed", "device", "num_threads", "share_encoder_forward", "channels_last", "compile",

@@ -219,8 +219,14 @@ class RunSettings:
     0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none. The ``cpu``
     profile: 0.4."""
     bc_decay_steps: int = 0
-    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0. The ``cpu``
-    profile: 100k, half its run."""
+    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0 (to
+    ``bc_weight_floor``, when set). The ``cpu`` profile: 100k, half its run."""
+    bc_weight_floor: float = 0.0
+    """Ours (with ``bc_weight``), 0: the behaviour-cloning term decays to nothing, so after ``bc_decay_steps``
+    RL alone moves the student (the ``cpu`` profile, whose curve stops rising there). > 0: the weight never
+    falls below this, so the teacher's detours around furniture keep pulling on the actor for the whole run
+    (a lever of the stuck-student issue, ``ablations/head_on_cloning_floor.yaml``; RLPD and TD3+BC keep a
+    constant weight). At most ``bc_weight``."""
 
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
@@ -341,6 +347,8 @@ class RunSettings:
             bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
         if self.bc_weight > 0 and self.bc_decay_steps == 0:
             bad("bc_decay_steps", ">= 1 with bc_weight > 0 (the env steps over which the term decays)")
+        if not 0.0 <= self.bc_weight_floor <= self.bc_weight:
+            bad("bc_weight_floor", f"[0, bc_weight={self.bc_weight}] (the weight the cloning term decays to)")
         if self.modular_searcher and self.target_memory:
             bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
         if self.modular_searcher and self.contact_signal:

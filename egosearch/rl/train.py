@@ -122,6 +122,15 @@ class _Mean:
 # ---- policies -----------------------------------------------------------------------------
 
 
+def cloning_weight(cfg: LearnerConfig, step: int) -> float:
+    """The behaviour-cloning term's weight at env step ``step``: ``bc_weight`` falling linearly over
+    ``bc_decay_steps`` to ``bc_weight_floor`` (0 by default), then held there."""
+    if not cfg.bc_weight:
+        return 0.0
+    decayed = cfg.bc_weight * max(0.0, 1.0 - step / cfg.bc_decay_steps)
+    return max(decayed, cfg.bc_weight_floor)
+
+
 # ---- evaluation ---------------------------------------------------------------------------
 
 def default_evaluator(env_id: str, env_kwargs: dict, episodes: int) -> Callable[[Any], dict]:
@@ -543,7 +552,7 @@ class LiveRun:
             return 0
         first_due = max(before, cfg.init_steps - 1)
         if cfg.bc_weight:
-            self.agent.bc_weight_now = cfg.bc_weight * max(0.0, 1.0 - self.step / cfg.bc_decay_steps)
+            self.agent.bc_weight_now = cloning_weight(cfg, self.step)
         return (self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step
 
     def record(self, metrics: dict[str, float]) -> None:
