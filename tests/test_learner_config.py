@@ -100,3 +100,37 @@ def test_a_learner_registered_without_settings_has_the_run_settings_alone():
             load_config("smoke", {"algorithm": "toy_settingless", "actor_lr": 1e-3})
     finally:
         del LEARNERS["toy_settingless"]
+
+
+def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_file(capsys):
+    """What a reader opens one learner's config with: each field once, its value and where it comes from (the
+    field's default, the profile, the variant), the class and file that declare it."""
+    import importlib
+    import inspect
+
+    from egosearch.cli import main
+    from egosearch.rl.config import config_sources
+
+    rows = {r["field"]: r for r in config_sources("sac_drq", "cpu")}
+    assert set(rows) == set(LearnerConfig(algorithm="sac_drq").to_dict())
+    assert (rows["total_env_steps"]["value"], rows["total_env_steps"]["source"], rows["total_env_steps"]["paper"]) == (
+        "200000", "profile cpu", "750000")
+    assert (rows["gamma"]["value"], rows["gamma"]["source"]) == ("0.99", "default")
+    assert rows["algorithm"]["declared_in"] == "egosearch.rl.run_settings.RunSettings"
+    for row in rows.values():  # the named class's own source declares the field
+        module, klass = row["declared_in"].rsplit(".", 1)
+        assert f"    {row['field']}:" in inspect.getsource(getattr(importlib.import_module(module), klass)), row
+    paper = {r["field"]: r for r in config_sources("sac_drq", "paper")}
+    assert (paper["total_env_steps"]["value"], paper["total_env_steps"]["source"]) == ("750000", "default")
+    varied = {r["field"]: r
+              for r in config_sources("sac_drq", "cpu", {"contact_signal": True}, "head_on_contact_signal")}
+    assert (varied["contact_signal"]["value"], varied["contact_signal"]["source"]) == (
+        "True", "variant head_on_contact_signal")
+
+    main(["config", "show", "sac_drq", "--variant", "head_on_contact_signal"])
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("sac_drq at profile cpu with variant head_on_contact_signal: 74 fields, declared in ")
+    assert len(out) == 2 + 74 and sum(line.startswith("contact_signal ") for line in out) == 1
+    assert main(["config", "show", "sac_curl", "--variant", "head_on_ppo"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("--variant head_on_ppo trains algorithm ppo, not sac_curl: show that one")

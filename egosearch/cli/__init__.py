@@ -17,8 +17,8 @@ from pathlib import Path
 from egosearch.cli import parsers
 from egosearch.sim import rasterbuild
 
-COMMANDS = ("scenarios", "evaluate", "train", "demos", "tune", "variant", "fullbody", "bench", "estimate", "video",
-            "report", "pictures")
+COMMANDS = ("scenarios", "evaluate", "train", "demos", "tune", "variant", "config", "fullbody", "bench", "estimate",
+            "video", "report", "pictures")
 """In the order ``egosearch --help`` lists them; each has ``parsers.add_<command>`` and a module."""
 
 

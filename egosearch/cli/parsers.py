@@ -6,6 +6,8 @@ body lives in ``egosearch/cli/<command>.py``, imported only when that command ru
 
 from __future__ import annotations
 
+from egosearch.rl.profiles import PROFILES
+from egosearch.rl.registry import LEARNERS as REGISTERED_LEARNERS
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
 from egosearch.searchers import registry as searchers
@@ -127,6 +129,17 @@ def add_demos(sub) -> None:
     p.add_argument("--out", required=True, metavar="FILE.replay.npz",
                    help="the transitions (git-ignored); a summary goes beside it as FILE.json")
     add_force(p)
+
+
+def add_config(sub) -> None:
+    about = "a learner's whole config: every field, its value, where the value comes from, the file declaring it"
+    p = sub.add_parser("config", help=about, description=about)
+    actions = p.add_subparsers(dest="action", required=True)
+    show = actions.add_parser("show", help=about, description=about)
+    show.add_argument("algorithm", choices=list(REGISTERED_LEARNERS), help="the learner (LearnerConfig.algorithm)")
+    show.add_argument("--profile", default="cpu", choices=list(PROFILES),
+                      help="learner profile: smoke, cpu or paper (default: cpu)")
+    show.add_argument("--variant", help="a file stem in ablations/ whose config overrides are shown on top")
 
 
 def add_tune(sub) -> None:

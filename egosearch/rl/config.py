@@ -336,11 +336,47 @@ def departure_rows(cfg: LearnerConfig) -> list[tuple[str, str, str, str]]:
     return rows
 
 
+def declaring_class(name: str, klass: type) -> type:
+    """The settings class whose body declares field ``name`` among ``klass``'s bases (the file to read it in);
+    a composed config only restates ``algorithm``'s default, so the search starts below it."""
+    for base in klass.__mro__:
+        if base not in _ALGORITHM_OF and name in vars(base).get("__annotations__", {}):
+            return base
+    raise ValueError(f"{name!r} is no field of {klass.__name__}")
+
+
+def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, Any] | None = None,
+                   variant: str = "") -> list[dict[str, str]]:
+    """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top), in
+    :data:`FIELD_ORDER`: its value, where the value comes from (the field's default, the profile, the
+    variant), the paper's value, the settings class and module that declare it, and its docstring's first
+    sentence. What ``egosearch config show`` prints."""
+    overrides = {**(variant_overrides or {}), "algorithm": algorithm}
+    cfg = load_config(profile, overrides)
+    base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
+    rows = []
+    for name in sorted((f.name for f in fields(cfg)), key=FIELD_ORDER.index):
+        owner = declaring_class(name, type(cfg))
+        if name in (variant_overrides or {}):
+            source = f"variant {variant}".strip()
+        elif name == "algorithm":
+            source = "asked"
+        elif name in base:
+            source = f"profile {profile}"
+        else:
+            source = "default"
+        doc = docs.get(name, "")
+        first = doc.split(". ")[0].rstrip(".") + "." if doc else ""
+        rows.append({"field": name, "value": repr(getattr(cfg, name)), "source": source,
+                     "paper": repr(paper[name]), "declared_in": f"{owner.__module__}.{owner.__name__}", "doc": first})
+    return rows
+
+
 TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(LearnerConfig()))
 """Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
 
 __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "CURRICULUM_START_RADIUS",
            "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "FIELD_ORDER", "HOUSEKEEPING_FIELDS", "PROFILES",
-           "LearnerConfig", "TABLE2_PAPER", "config_class", "cpu_profile", "departure_rows", "field_defaults",
-           "field_docs", "field_types", "load_config", "own_settings", "paper_profile", "refuse_foreign_fields",
-           "settings_classes", "smoke_profile", "table2_rows"]
+           "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
+           "departure_rows", "field_defaults", "field_docs", "field_types", "load_config", "own_settings",
+           "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]

@@ -1,0 +1,29 @@
+"""``egosearch config show ALGORITHM``: a learner's whole config in one place, each field with its value,
+where the value comes from and the file that declares it."""
+
+from __future__ import annotations
+
+from egosearch.rl.config import config_sources
+
+
+def run(args) -> None:
+    overrides, name = {}, ""
+    if args.variant:
+        # local: reading a variant file checks it against the learner fields (one line for a bad one)
+        from egosearch.variants import load_variant
+
+        variant = load_variant(args.variant)
+        overrides, name = {k: v for k, v in variant.config.items() if k != "algorithm"}, variant.name
+        if variant.config.get("algorithm", args.algorithm) != args.algorithm:
+            raise ValueError(f"--variant {args.variant} trains algorithm {variant.config['algorithm']}, not "
+                             f"{args.algorithm}: show that one")
+    rows = config_sources(args.algorithm, args.profile, overrides, name)
+    files = sorted({row["declared_in"].rsplit(".", 1)[0] for row in rows})
+    print(f"{args.algorithm} at profile {args.profile}{f' with variant {name}' if name else ''}: {len(rows)} fields, "
+          f"declared in {', '.join(f.replace('.', '/') + '.py' for f in files)}")
+    widths = {key: max(len(key), *(len(row[key]) for row in rows)) for key in ("field", "value", "source", "paper")}
+    head = "  ".join(key.ljust(widths[key]) for key in widths) + "  declared in: what it is"
+    print(head)
+    for row in rows:
+        cells = "  ".join(row[key].ljust(widths[key]) for key in widths)
+        print(f"{cells}  {row['declared_in'].rsplit('.', 1)[1]}: {row['doc']}")
