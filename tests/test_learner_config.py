@@ -10,10 +10,10 @@ import pickle
 import pytest
 
 from egosearch.rl.config import (
-    FIELD_ORDER,
     LearnerConfig,
     config_class,
     field_defaults,
+    field_order,
     load_config,
     own_settings,
 )
@@ -32,7 +32,7 @@ def test_the_run_settings_and_each_learners_own_fields_are_counted():
     assert len(SHARED) == 41
     assert {name: len(own_settings(name)) for name in OWN_FIELD_COUNTS} == OWN_FIELD_COUNTS
     # every field belongs to the run settings or to some learner, and none to both
-    assert SHARED | {f for name in LEARNERS for f in own_settings(name)} == set(field_defaults()) == set(FIELD_ORDER)
+    assert SHARED | {f for name in LEARNERS for f in own_settings(name)} == set(field_defaults()) == set(field_order())
     assert not SHARED & {f for name in LEARNERS for f in own_settings(name)}
 
 

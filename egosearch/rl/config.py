@@ -54,33 +54,14 @@ _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "
 _BUILDING_BLOCKS = (NetworkSettings, SacSettings, PooledSettings, RandomShiftSettings)
 """The settings classes the learners' own are made of (their fields are documented there)."""
 
-FIELD_ORDER = (
-    # Table 2: observation and data; temperature; actor; critic; encoder
-    "image_size", "crop_size", "frame_history", "head_history", "replay_capacity", "gamma", "total_env_steps",
-    "batch_size", "init_temperature", "alpha_lr", "alpha_beta1", "alpha_beta2", "actor_lr", "actor_beta1",
-    "actor_beta2", "actor_num_layers", "actor_hidden_dim", "actor_activation", "actor_log_std_min",
-    "actor_log_std_max", "critic_lr", "critic_tau", "critic_beta1", "critic_beta2", "critic_num_layers",
-    "critic_hidden_dim", "critic_activation", "critic_layer_norm", "encoder_lr", "encoder_tau",
-    "encoder_num_layers", "encoder_num_filters", "encoder_latent_dim", "encoder_activation", "encoder_beta1",
-    "encoder_beta2", "encoder_tanh",
-    # CURL (not in Table 2)
-    "curl_latent", "curl_double_encoder_step", "actor_update_freq", "critic_target_update_freq", "curl_update_freq",
-    # the learner and its training-only aids (the cpu profile's departures)
-    "algorithm", "num_envs", "n_step", "obs_downsample", "target_memory", "contact_signal", "modular_searcher",
-    "encoder_stride2_layers", "aug_pad", "train_distance_reward", "curriculum_steps", "critic_privileged_state",
-    "encoder_aux_loss", "encoder_aux_weight", "recurrent_hidden_dim", "sequence_length", "burn_in",
-    "ppo_epochs", "ppo_minibatches", "ppo_clip", "gae_lambda", "value_coef", "entropy_coef", "max_grad_norm",
-    "ppo_init_std", "train_height_min",
-    # learning from the classical searcher
-    "demo_episodes", "demo_teacher", "bc_updates", "dagger_rounds", "dagger_episodes", "critic_warmup_updates",
-    "demo_batch_fraction", "bc_weight", "bc_decay_steps", "bc_weight_floor",
-    # training loop; implementation
-    "init_steps", "update_every", "updates_per_step", "eval_every", "eval_episodes", "log_every",
-    "checkpoint_every", "seed", "device", "num_threads", "share_encoder_forward", "channels_last", "compile",
-    "cuda_graph", "keep_checkpoint",
-)
-"""The order fields are shown in (the departures from the paper, in the generated Table 2 pages): Table 2's,
-then the learners' knobs, then the loop's. A new field is added here too (``tests/test_rl_sac.py``)."""
+def field_order() -> tuple[str, ...]:
+    """The order fields are shown in (the departures from the paper in the generated Table 2 pages,
+    ``egosearch config show``): the run settings' as declared (Table 2's observation and data first), then
+    each building block's and each registered learner's own, as declared. A new field has its place where it
+    is written; no list to keep."""
+    names = [f.name for klass in settings_classes() for f in fields(klass) if klass is RunSettings or
+             f.name not in {g.name for g in fields(RunSettings)}]
+    return tuple(dict.fromkeys(names))
 
 
 @dataclass
@@ -171,9 +152,9 @@ def config_class(algorithm: str) -> type[LearnerConfig]:
 
 
 def own_settings(algorithm: str) -> tuple[str, ...]:
-    """The fields of ``algorithm``'s own settings (not the run settings), in :data:`FIELD_ORDER`."""
+    """The fields of ``algorithm``'s own settings (not the run settings), in :func:`field_order`."""
     shared = {f.name for f in fields(RunSettings)}
-    return tuple(n for n in FIELD_ORDER if n in {f.name for f in fields(config_class(algorithm))} - shared)
+    return tuple(n for n in field_order() if n in {f.name for f in fields(config_class(algorithm))} - shared)
 
 
 def settings_classes() -> list[type]:
@@ -328,7 +309,7 @@ def departure_rows(cfg: LearnerConfig) -> list[tuple[str, str, str, str]]:
     The paper's value of a field is its default (the ``paper`` profile sets housekeeping alone)."""
     paper, docs = field_defaults(), field_docs()
     rows = []
-    for name in sorted((f.name for f in fields(cfg)), key=FIELD_ORDER.index):
+    for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         mine, theirs = getattr(cfg, name), paper[name]
         if name in HOUSEKEEPING_FIELDS or mine == theirs:
             continue
@@ -348,14 +329,14 @@ def declaring_class(name: str, klass: type) -> type:
 def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, Any] | None = None,
                    variant: str = "") -> list[dict[str, str]]:
     """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top), in
-    :data:`FIELD_ORDER`: its value, where the value comes from (the field's default, the profile, the
+    :func:`field_order`: its value, where the value comes from (the field's default, the profile, the
     variant), the paper's value, the settings class and module that declare it, and its docstring's first
     sentence. What ``egosearch config show`` prints."""
     overrides = {**(variant_overrides or {}), "algorithm": algorithm}
     cfg = load_config(profile, overrides)
     base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
     rows = []
-    for name in sorted((f.name for f in fields(cfg)), key=FIELD_ORDER.index):
+    for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
         if name in (variant_overrides or {}):
             source = f"variant {variant}".strip()
@@ -376,7 +357,7 @@ TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(LearnerConfig()))
 """Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
 
 __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "CURRICULUM_START_RADIUS",
-           "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "FIELD_ORDER", "HOUSEKEEPING_FIELDS", "PROFILES",
+           "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PROFILES",
            "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
-           "departure_rows", "field_defaults", "field_docs", "field_types", "load_config", "own_settings",
-           "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]
+           "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "load_config",
+           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]
