@@ -60,13 +60,27 @@ def _cli_line(capsys, *argv) -> tuple[int, str]:
     return code, "\n".join(lines) if code else captured.out
 
 
-def test_the_registered_searchers_are_todays_and_agree_with_their_envs():
-    assert registry.names() == ("random", "oracle", "frontier", "frontier_head_off", "frontier_tuned",
-                                "frontier_tuned_head_off", "modular_random", "modular_random_head_off")
+SHIPPED = ("random", "oracle", "frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off",
+           "modular_random", "modular_random_head_off")
+"""The searchers the package ships, in registration order. A user's own, registered after them, may join
+(these tests read the registry, not this list, for everything else)."""
+
+
+def _in_order(shipped: tuple[str, ...], listed: tuple[str, ...]) -> tuple[str, ...]:
+    """``listed`` as far as it names shipped searchers: what a user's own registration must not reorder."""
+    return tuple(name for name in listed if name in shipped)
+
+
+def test_the_shipped_searchers_are_registered_and_agree_with_their_envs():
+    assert _in_order(SHIPPED, registry.names()) == SHIPPED
     # Table 1's rows, in order: the floor, the classical searchers (the untuned, then the tuned), the ceiling
-    assert registry.bounds() == ("random", "frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off",
-                                 "oracle")
-    assert registry.classical() == ("frontier", "frontier_head_off", "frontier_tuned", "frontier_tuned_head_off")
+    bounds = registry.bounds()
+    assert _in_order(SHIPPED, bounds) == ("random", "frontier", "frontier_head_off", "frontier_tuned",
+                                          "frontier_tuned_head_off", "oracle")
+    rows = [registry.get(name).table_row for name in bounds]
+    assert rows == sorted(rows, key=registry.TABLE_ROWS.index)  # every floor first, every ceiling last
+    assert _in_order(SHIPPED, registry.classical()) == ("frontier", "frontier_head_off", "frontier_tuned",
+                                                        "frontier_tuned_head_off")
     assert registry.modular_floors() == {"EgoSearchModular-v0": "modular_random",
                                          "EgoSearchNoHeadModular-v0": "modular_random_head_off"}
     for searcher in registry.SEARCHERS.values():
@@ -74,8 +88,11 @@ def test_the_registered_searchers_are_todays_and_agree_with_their_envs():
         assert searcher.head in (None, ENV_IDS[searcher.env_id]["head"]), searcher
         assert callable(searcher.policy_factory()), searcher
         assert searcher.label and searcher.what, searcher
-        if searcher.bound:
-            assert searcher.path_style, searcher
+    # a bound without a line style of its own is drawn in the path-length figure's default one
+    from egosearch.report.pathlength import DEFAULT_STYLE, searcher_style
+
+    assert searcher_style("frontier") == registry.get("frontier").path_style
+    assert searcher_style("modular_random") == DEFAULT_STYLE
 
 
 def test_a_name_is_registered_once_and_never_as_actor(toy):
@@ -114,6 +131,16 @@ def test_a_registered_searcher_is_evaluated_by_the_cli_and_tabled_as_a_bound(toy
     oracle = out.parents[4] / "oracle" / "seed0" / home / placement / out.name
     oracle.parent.mkdir(parents=True)
     episodes.assign(success=1, spl=1.0).to_csv(oracle, index=False)
+    # before it has run, the bound changes no table: no columns, no row, and the same bytes as without it
+    before = cmd_table1([ours], tmp_path / "before" / "table1", variant="head_on", bounds=[oracle])
+    assert not [c for c in before.columns if c.startswith(TOY)]
+    registry.unregister(TOY)
+    cmd_table1([ours], tmp_path / "without" / "table1", variant="head_on", bounds=[oracle])
+    for suffix in ("csv", "md", "tex"):
+        assert ((tmp_path / "before" / f"table1.{suffix}").read_bytes()
+                == (tmp_path / "without" / f"table1.{suffix}").read_bytes()), suffix
+    registry.register(TOY, AlwaysTurns, env_id="EgoSearchNoHead-v0", head=False, label=TOY_LABEL, what=TOY_WHAT,
+                      help="a toy", bound=True)
     df = cmd_table1([ours], tmp_path / "figs" / "table1", variant="head_on", bounds=[out, oracle])
     assert df.loc[0, f"{TOY}_n_episodes"] == 2
     assert df.loc[0, f"{TOY}_success_rate"] == episodes["success"].mean()

@@ -162,7 +162,8 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
 
     ``bounds`` (``{"random" | "oracle": {(seed, height, placement): paths}}``, either side possibly
     empty) adds :func:`bound_columns`: the bound searchers' pooled success rate, Wilson interval and
-    SPL on each cell (NaN and 0 episodes where a bound was not run). A bound runs one seed, each
+    SPL on each cell (NaN and 0 episodes where a bound was not run; a bound beside the policy with no files
+    at all has no columns, so registering one leaves a stored table as it is until it runs). A bound runs one seed, each
     scenario once, so its episodes are independent and the Wilson interval is right for it. They
     must have run on the policy's scenario sets: a cell the policy lacks is an error.
     """
@@ -178,6 +179,7 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
         extra = set(bound_cells[bound]) - set(cells)
         if extra:
             raise ValueError(f"table1: the {bound} files have cells the policy has not: {sorted(extra)}")
+    shown = [b for b in all_bounds if _always_shown(b) or len(bound_cells.get(b, {})) > 0]
     rows = []
     for home, h, pl in _sorted_home_cells(cells):
         df = cells[(home, h, pl)]
@@ -192,9 +194,9 @@ def table1_frame(episode_files: Mapping, confidence: float = 0.95, n_resamples: 
                      "spl_high": spl_hi, "stuck_share": stuck_share(df),
                      "paper_success_rate": PAPER_TABLE1.get((round(h, 2), pl), math.nan)})
         if bounds is not None:
-            for bound in all_bounds:
+            for bound in shown:
                 rows[-1].update(_bound_row(bound_cells.get(bound, {}).get((home, h, pl)), bound, confidence))
-    columns = list(TABLE1_COLUMNS) + (list(bound_columns(all_bounds)) if bounds is not None else [])
+    columns = list(TABLE1_COLUMNS) + (list(bound_columns(shown)) if bounds is not None else [])
     return pd.DataFrame(rows, columns=columns)
 
 
@@ -234,7 +236,8 @@ def _table1_section(df: pd.DataFrame, title: str, variant: str | None, with_boun
     heights, placements = _table1_grid(df)
     heads = [PLACEMENT_LABELS.get(p, p) for p in placements]
     ours = f"ours ({variant})" if variant else "ours"
-    present = [b for b in bound_names() if with_bounds and (_always_shown(b) or df[f"{b}_n_episodes"].any())]
+    present = [b for b in bound_names() if with_bounds and f"{b}_n_episodes" in df
+               and (_always_shown(b) or df[f"{b}_n_episodes"].any())]
     place = {b: searchers.get(b).table_row for b in present}
     rows = ([(b, searcher_label(b)) for b in present if place[b] == searchers.FLOOR] + [("ours", ours)]
             + [(b, searcher_label(b)) for b in present if place[b] == searchers.BESIDE]
@@ -322,7 +325,7 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
         if not i:
             if with_bounds:
                 bound_eps = {b: "/".join(str(int(n)) for n in sorted(set(part[f"{b}_n_episodes"])) if n) or "0"
-                             for b in bound_names()}
+                             for b in bound_names() if f"{b}_n_episodes" in part}
                 shown = [b for b in bound_eps if _always_shown(b) or bound_eps[b] != "0"]
                 notes = " ".join(
                     f"{searcher_label(b)[0].upper() + searcher_label(b)[1:]}: {searchers.get(b).what}, "
