@@ -53,7 +53,8 @@ class Searcher:
     (:data:`FLOOR`, :data:`BESIDE` or :data:`CEILING`); ``classical``: config ``claims_pairs`` may name
     it (traced by the ``trace_bound`` rule); ``floor_of``: the decision env (``*Modular-v0``) whose
     trained high level is read against it (the ``decisions_floor`` rule); ``path_style``: its line in
-    the path-length figure, (colour, line style, marker); ``fig6_level``: a horizontal line in
+    the path-length figure, (colour, line style, marker), None for its default line; ``fig6_level``: a
+    horizontal line in
     Figure 6, (label, line style, colour), None for none."""
 
     name: str
