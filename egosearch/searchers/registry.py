@@ -54,8 +54,7 @@ class Searcher:
     it (traced by the ``trace_bound`` rule); ``floor_of``: the decision env (``*Modular-v0``) whose
     trained high level is read against it (the ``decisions_floor`` rule); ``path_style``: its line in
     the path-length figure, (colour, line style, marker), None for its default line; ``fig6_level``: a
-    horizontal line in
-    Figure 6, (label, line style, colour), None for none."""
+    horizontal line in Figure 6, (label, line style, colour), None for none."""
 
     name: str
     factory: str | Callable[..., Any]
