@@ -35,7 +35,9 @@ class Learner:
     ``takes_state_dim``: whether ``agent`` takes ``state_dim`` (the privileged state's size);
     ``settings``: the dataclass of its own settings (or ``"module:Class"``), which
     :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone;
-    ``stacked``: its seeds can train in one process, their updates vmapped (:mod:`egosearch.rl.stacked`)."""
+    ``stacked``: its seeds can train in one process, their updates vmapped (:mod:`egosearch.rl.stacked`);
+    ``smoke_overrides``: config fields on top of the ``smoke`` profile that make its networks test-sized (the
+    tests build every registered learner with them)."""
 
     name: str
     display_name: str
@@ -44,6 +46,7 @@ class Learner:
     takes_state_dim: bool = True
     settings: str | type | None = None
     stacked: bool = False
+    smoke_overrides: Mapping[str, object] = field(default_factory=dict)
 
     def settings_class(self) -> type | None:
         return None if self.settings is None else resolve(self.settings)
@@ -69,10 +72,11 @@ ALGORITHMS = LEARNERS.keys()
 def register(name: str, display_name: str, agent: str | Callable[..., Agent],
              actor_formats: Mapping[str, str | Callable[..., ActorFileNet]] | None = None, *,
              takes_state_dim: bool = True, settings: str | type | None = None, stacked: bool = False,
-             replace: bool = False) -> Learner:
+             smoke_overrides: Mapping[str, object] | None = None, replace: bool = False) -> Learner:
     """Register a learner under algorithm ``name`` (see :class:`Learner` for the arguments); a name
     already taken needs ``replace``, and an actor format another learner loads differently is refused."""
-    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim, settings, stacked)
+    learner = Learner(name, display_name, agent, dict(actor_formats or {}), takes_state_dim, settings, stacked,
+                      dict(smoke_overrides or {}))
     if name in LEARNERS and not replace:
         _REGISTRY.add(name, learner)  # the registry's one line: the name is taken
     for other in LEARNERS.values():
@@ -118,10 +122,15 @@ register("sac_curl", "SAC+CURL", "egosearch.rl.sac_curl:SacCurlAgent",
          settings="egosearch.rl.sac_curl_settings:SacCurlSettings", stacked=True)
 register("sac_drq", "SAC-DrQ", "egosearch.rl.sac_drq:SacDrqAgent",
          {"egosearch-sac-drq-actor-v1": "egosearch.rl.pooled:load_drq_actor_net"},
-         settings="egosearch.rl.sac_drq_settings:SacDrqSettings", stacked=True)
+         settings="egosearch.rl.sac_drq_settings:SacDrqSettings", stacked=True,
+         smoke_overrides={"obs_downsample": 4, "encoder_stride2_layers": 2})
 register("sac_drq_recurrent", "recurrent SAC-DrQ", "egosearch.rl.sac_drq_recurrent:SacDrqRecurrentAgent",
          {"egosearch-sac-drq-recurrent-actor-v1": "egosearch.rl.sac_drq_recurrent:load_recurrent_actor_net"},
-         settings="egosearch.rl.sac_drq_recurrent_settings:SacDrqRecurrentSettings")
+         settings="egosearch.rl.sac_drq_recurrent_settings:SacDrqRecurrentSettings",
+         smoke_overrides={"obs_downsample": 4, "encoder_stride2_layers": 2, "recurrent_hidden_dim": 8,
+                          "sequence_length": 2, "burn_in": 1})
 register("ppo", "PPO", "egosearch.rl.ppo:PpoAgent",
          {"egosearch-sac-drq-actor-v1": "egosearch.rl.pooled:load_drq_actor_net"},
-         settings="egosearch.rl.ppo_settings:PpoSettings")
+         settings="egosearch.rl.ppo_settings:PpoSettings",
+         smoke_overrides={"obs_downsample": 4, "encoder_stride2_layers": 2, "init_steps": 0, "update_every": 32,
+                          "replay_capacity": 64})
