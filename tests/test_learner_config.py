@@ -71,11 +71,14 @@ def test_a_field_no_learner_has_names_the_nearest():
 
 
 def test_a_profile_sets_the_fields_a_learner_has_and_leaves_the_others():
+    # PPO's own rules only: the cpu profile's demonstration fields never reach a learner that does not read them
     cfg = load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "n_step": 1, "update_every": 16,
-                              "replay_capacity": 1000, "critic_privileged_state": False, "demo_episodes": 0,
-                              "bc_updates": 0, "critic_warmup_updates": 0, "demo_batch_fraction": 0.0,
-                              "bc_weight": 0.0, "bc_decay_steps": 0})
+                              "replay_capacity": 1000})
     assert cfg.obs_downsample == CPU["obs_downsample"] and not hasattr(cfg, "aug_pad")
+    assert (cfg.demo_episodes, cfg.bc_weight, cfg.critic_warmup_updates) == (0, 0.0, 0)  # their defaults
+    assert cfg.critic_privileged_state == CPU["critic_privileged_state"]  # PPO's value network reads it
+    with pytest.raises(ValueError, match=r"demo_episodes=10 is out of range; allowed: 0 for algorithm ppo"):
+        load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "update_every": 16, "demo_episodes": 10})
     assert not hasattr(cfg, "alpha_lr")  # the cpu profile's temperature rate: PPO has no temperature
     for profile in PROFILES:
         assert set(load_config(profile).to_dict()) <= set(field_defaults())
@@ -96,6 +99,9 @@ def test_a_learner_registered_without_settings_has_the_run_settings_alone():
     try:
         cfg = load_config("smoke", {"algorithm": "toy_settingless"})
         assert set(cfg.to_dict()) == SHARED
+        # at the cpu profile too, with nothing pinned: the profile's demonstrations and privileged critic are
+        # for the learners that read them
+        assert not load_config("cpu", {"algorithm": "toy_settingless"}).critic_privileged_state
         with pytest.raises(ValueError, match="has no field 'actor_lr'"):
             load_config("smoke", {"algorithm": "toy_settingless", "actor_lr": 1e-3})
     finally:
@@ -120,6 +126,8 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
     for row in rows.values():  # the named class's own source declares the field
         module, klass = row["declared_in"].rsplit(".", 1)
         assert f"    {row['field']}:" in inspect.getsource(getattr(importlib.import_module(module), klass)), row
+    ppo = {r["field"]: r for r in config_sources("ppo", "cpu", {"init_steps": 0, "update_every": 16, "n_step": 1})}
+    assert (ppo["demo_episodes"]["value"], ppo["demo_episodes"]["source"]) == ("0", "default (unread)")
     paper = {r["field"]: r for r in config_sources("sac_drq", "paper")}
     assert (paper["total_env_steps"]["value"], paper["total_env_steps"]["source"]) == ("750000", "default")
     varied = {r["field"]: r

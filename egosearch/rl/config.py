@@ -202,8 +202,10 @@ def _refuse_foreign(klass: type[LearnerConfig], values: dict[str, Any]) -> None:
 def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> LearnerConfig:
     """The config of ``profile`` with ``overrides`` on top, validated.
 
-    A profile is for every learner: the learner takes the profile's values of the fields it has. An
-    override of a field the learner does not have, an unknown profile or field name and an out-of-range
+    A profile is for every learner: the learner takes the profile's values of the fields it reads (the
+    demonstration fields only where it ``learns_from_demonstrations``, ``critic_privileged_state`` only where
+    it has a ``privileged_critic``; the others keep their defaults, so a learner pins nothing it does not use).
+    An override of a field the learner does not have, an unknown profile or field name and an out-of-range
     value are one-line ``ValueError``s.
     """
     if profile not in PROFILES:
@@ -211,8 +213,15 @@ def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None)
     base, overrides = PROFILES[profile](), dict(overrides or {})
     klass = config_class(overrides.get("algorithm", base.get("algorithm", "sac_curl")))
     _refuse_foreign(klass, overrides)
-    own = {f.name for f in fields(klass)}
+    own = {f.name for f in fields(klass)} - set(unread_settings(klass))
     return klass(**{**{k: v for k, v in base.items() if k in own}, **overrides}).validate()
+
+
+def unread_settings(klass: type) -> tuple[str, ...]:
+    """The run settings a learner's config class has but never reads: the demonstration fields without
+    ``learns_from_demonstrations``, ``critic_privileged_state`` without a ``privileged_critic``."""
+    unread = () if klass.learns_from_demonstrations else RunSettings.DEMONSTRATION_FIELDS
+    return unread + (() if klass.privileged_critic else ("critic_privileged_state",))
 
 
 # ---- Table 2 --------------------------------------------------------------------------------
@@ -335,6 +344,7 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
     overrides = {**(variant_overrides or {}), "algorithm": algorithm}
     cfg = load_config(profile, overrides)
     base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
+    unread = set(unread_settings(type(cfg)))
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
@@ -342,6 +352,8 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
             source = f"variant {variant}".strip()
         elif name == "algorithm":
             source = "asked"
+        elif name in unread:
+            source = "default (unread)"
         elif name in base:
             source = f"profile {profile}"
         else:
@@ -360,4 +372,5 @@ __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "
            "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PROFILES",
            "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
            "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "load_config",
-           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]
+           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows",
+           "unread_settings"]

@@ -52,6 +52,11 @@ class RunSettings:
     """Whether the learner's critic may read the env's hidden state (``critic_privileged_state``)."""
     learns_from_demonstrations: ClassVar[bool] = False
     """Whether the learner's update knows demonstrations (``demo_episodes`` and the imitation phase)."""
+    DEMONSTRATION_FIELDS: ClassVar[tuple[str, ...]] = (
+        "demo_episodes", "demo_teacher", "bc_updates", "dagger_rounds", "dagger_episodes", "critic_warmup_updates",
+        "demo_batch_fraction", "bc_weight", "bc_decay_steps", "bc_weight_floor")
+    """The fields only a learner that ``learns_from_demonstrations`` reads: a profile's values of them reach
+    only such a learner (a variant that sets one for another learner is refused)."""
 
     # ---- Table 2: observation and data -------------------------------------------------
     image_size: int = IMAGE_SIZE
