@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from egosearch.envs import ALL_ENV_IDS, env_space_dims, observation_kwargs
+from egosearch.envs import ALL_ENV_IDS, env_options, env_space_dims, observation_kwargs
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.learner import ActorFileNet, Agent
 from egosearch.rl.registry import actor_loader
@@ -123,7 +123,8 @@ class ActorPolicy:
         whose sizes it fits (None when no single id does)."""
         if self.env_id:
             return self.env_id
-        fitting = [env_id for env_id in ALL_ENV_IDS if not (self.env_kwargs and env_id.endswith("Modular-v0"))
+        # a decision env reads no observation option, so an actor trained with one fits none of them
+        fitting = [env_id for env_id in ALL_ENV_IDS if not (self.env_kwargs and env_options(env_id).modular)
                    and self.fits(env_id)]
         return fitting[0] if len(fitting) == 1 else None
 
