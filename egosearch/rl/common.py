@@ -171,6 +171,34 @@ def actor_head(conv_dim: int, arch: dict[str, Any]) -> ActorHead:
                      arch["actor_log_std_min"], arch["actor_log_std_max"], arch["encoder_tanh"])
 
 
+# ---- the networks an update's arithmetic calls ------------------------------------------------
+
+def submodule(owner: Any, path: str) -> nn.Module:
+    """``owner.critic.convs`` for ``"critic.convs"`` (agents are not modules themselves)."""
+    obj = owner
+    for part in path.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+class ModuleNets:
+    """A learner's own networks, called by path: ``nets("critic", h, extra, a)`` is ``agent.critic(h, extra, a)``.
+
+    A learner writes its update's arithmetic once, as functions of such a ``nets``: its plain update passes
+    this, the stacked update of several seeds (:mod:`egosearch.rl.stacked`) passes each seed's slice of the
+    stacked parameters under ``torch.func.vmap``, so that the two cannot compute different things."""
+
+    def __init__(self, owner: Any):
+        self.owner = owner
+
+    def __call__(self, path: str, *args: torch.Tensor) -> Any:
+        return submodule(self.owner, path)(*args)
+
+    def tensor(self, name: str) -> torch.Tensor:
+        """A loose parameter of the learner (CURL's ``W``), by attribute name."""
+        return getattr(self.owner, name)
+
+
 def squashed_sample(mu: torch.Tensor, log_std: torch.Tensor, noise: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     """CURL's reparameterised tanh-Gaussian sample: (tanh(mu + std * noise), log pi)."""
     pi = mu + noise * log_std.exp()

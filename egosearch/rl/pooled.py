@@ -280,6 +280,13 @@ class SacMixin:
         temperature's step; the losses go into ``out`` (``actor_loss`` is SAC's alone)."""
         actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
         total = actor_loss if penalty is None else actor_loss + penalty
+        self.actor_and_alpha_steps_on(total, log_pi, out)
+        out["actor_loss"] = actor_loss
+
+    def actor_and_alpha_steps_on(self, total: torch.Tensor, log_pi: torch.Tensor,
+                                 out: dict[str, torch.Tensor]) -> None:
+        """SAC's actor step on the loss ``total`` already computed (gradients to the actor's parameters
+        only), then the temperature's step on ``log_pi``; ``alpha_loss`` goes into ``out``."""
         self.actor_opt.zero_grad(set_to_none=True)
         actor_params = [p for g in self.actor_opt.param_groups for p in g["params"]]
         for p, g in zip(actor_params, torch.autograd.grad(total, actor_params)):
@@ -288,7 +295,7 @@ class SacMixin:
         alpha_loss = (self.log_alpha.exp() * (-log_pi - self.target_entropy).detach()).mean()
         self.log_alpha.grad = torch.autograd.grad(alpha_loss, [self.log_alpha])[0]
         self.alpha_opt.step()
-        out["actor_loss"], out["alpha_loss"] = actor_loss, alpha_loss
+        out["alpha_loss"] = alpha_loss
 
 
 class SacDrqBase(SacMixin, PooledAgent):

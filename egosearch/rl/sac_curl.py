@@ -49,6 +49,7 @@ from torch import nn
 from egosearch.rl.common import (
     ActorHead,
     AgentStateError,
+    ModuleNets,
     Projection,
     activation,
     actor_head,
@@ -88,6 +89,70 @@ def crop_offsets(batch: int, image_size: int, crop_size: int,
 
 
 # ---- networks -----------------------------------------------------------------------------
+
+# ---- the fast update's arithmetic, written once ------------------------------------------------
+# One learner's losses from ``nets`` (a callable ``nets("critic.convs", x)``, with ``nets.tensor("W")``):
+# SacCurlAgent._update_fast passes its own modules (egosearch.rl.common.ModuleNets), the stacked update
+# (egosearch.rl.stacked) each seed's slice of the stacked parameters under vmap. The random numbers (crops,
+# the policy's noise) come in as arguments, drawn by the caller in CURL's order.
+
+def curl_key(nets, x: torch.Tensor) -> torch.Tensor:
+    """The key (momentum) encoder's embedding: the target critic's convs and projection."""
+    return nets("critic_target.proj", nets("critic_target.convs", x))
+
+
+def curl_target(nets, nxt, pos, next_extra, reward, not_done, noise, alpha, *, gamma: float, early_key: bool):
+    """(the critic's target, the positives' key embedding or None). The actor samples on next_obs through
+    the online convs; with ``early_key`` the key encoder embeds [next_obs; positive] in one pass (its
+    weights are the same for both). The caller runs it without autograd."""
+    mu, log_std = nets("actor", nets("critic.convs", nxt), next_extra)
+    next_pi, next_log_pi = squashed_sample(mu, log_std, noise)
+    z_pos = None
+    if early_key:
+        z = curl_key(nets, torch.cat([nxt, pos]))
+        z_next, z_pos = z[: nxt.shape[0]], z[nxt.shape[0]:]
+    else:
+        z_next = curl_key(nets, nxt)
+    x = torch.cat([torch.cat([z_next, next_extra], dim=-1), next_pi], dim=-1)
+    tq1, tq2 = nets("critic_target.q1", x), nets("critic_target.q2", x)
+    return reward + not_done * gamma * (torch.min(tq1, tq2) - alpha * next_log_pi), z_pos
+
+
+def curl_critic_loss(nets, anchor, extra, action, target_q):
+    """(critic loss, mean Q1, the anchor's conv features, their projection)."""
+    h = nets("critic.convs", anchor)
+    z = nets("critic.proj", h)
+    x = torch.cat([torch.cat([z, extra], dim=-1), action], dim=-1)
+    q1, q2 = nets("critic.q1", x), nets("critic.q2", x)
+    return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean(), h, z
+
+
+def curl_features(nets, anchor):
+    """The anchor's conv features and their projection (after the critic step: CURL's order)."""
+    h = nets("critic.convs", anchor)
+    return h, nets("critic.proj", h)
+
+
+def curl_actor_loss(nets, h_post, z_post, extra, noise, alpha, *, z_given: bool):
+    """(SAC's actor loss, log pi, the entropy) on the detached features ``h_post``. The critic's state is
+    ``z_post`` when ``z_given`` (CURL's projection, just computed), else the projection of ``h_post``."""
+    h_actor = h_post.detach()
+    with torch.no_grad():
+        z_state = z_post.detach() if z_given else nets("critic.proj", h_actor)
+        state = torch.cat([z_state, extra], dim=-1)
+    mu, log_std = nets("actor", h_actor, extra)
+    pi, log_pi = squashed_sample(mu, log_std, noise)
+    x = torch.cat([state, pi], dim=-1)
+    aq1, aq2 = nets("critic.q1", x), nets("critic.q2", x)
+    return (alpha * log_pi - torch.min(aq1, aq2)).mean(), log_pi, gaussian_entropy(log_std)
+
+
+def curl_contrastive_loss(nets, z_anchor, z_pos) -> torch.Tensor:
+    """CURL's InfoNCE with the bilinear ``W``: logits q W k^T (B, B), the diagonal the positives."""
+    logits = z_anchor @ (nets.tensor("W") @ z_pos.T)
+    logits = logits - logits.max(dim=1, keepdim=True)[0]
+    return F.cross_entropy(logits, torch.arange(logits.shape[0], device=logits.device))
+
 
 class ConvEncoder(nn.Module):
     """The conv layers of CURL's pixel encoder: uint8 or float pixels -> flat features."""
@@ -304,7 +369,7 @@ class SacCurlAgent(SacMixin, AgentBase):
         ``share_encoder_forward`` additionally reuses the PRE-step anchor features (one conv
         forward less; the actor and CURL losses then lag the critic step by one update).
         """
-        cfg, critic, target, step = self.cfg, self.critic, self.critic_target, self.num_updates
+        cfg, step, nets = self.cfg, self.num_updates, ModuleNets(self)
         share = cfg.share_encoder_forward
         do_curl = step % cfg.curl_update_freq == 0
         do_actor = step % cfg.actor_update_freq == 0
@@ -312,33 +377,24 @@ class SacCurlAgent(SacMixin, AgentBase):
         early_key = do_curl and (share or not do_polyak)  # key encoder weights = those of the target pass
         extra, next_extra, action, reward, not_done = self._batch_parts(batch)
         anchor_u8, next_u8, pos_u8 = self._crops(batch)
-        anchor, nxt = self._to_float(anchor_u8), self._to_float(next_u8)
+        anchor, nxt, pos = self._to_float(anchor_u8), self._to_float(next_u8), self._to_float(pos_u8)
+        noise_next = torch.randn((anchor.shape[0], self.action_dim), device=self.device)
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
 
         # -- critic target (no grad): actor on next_obs (online convs), target critic ----------
         with torch.no_grad():
-            mu, log_std = self.actor(critic.convs(nxt), next_extra)
-            next_pi, next_log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            if early_key:
-                z = target.proj(target.convs(torch.cat([nxt, self._to_float(pos_u8)])))
-                z_next, z_pos = z[: nxt.shape[0]], z[nxt.shape[0]:]
-            else:
-                z_next = target.proj(target.convs(nxt))
-            tq1, tq2 = target.q(torch.cat([z_next, next_extra], dim=-1), next_pi)
-            target_q = reward + not_done * cfg.gamma * (torch.min(tq1, tq2) - alpha * next_log_pi)
+            target_q, z_pos = curl_target(nets, nxt, pos, next_extra, reward, not_done, noise_next, alpha,
+                                          gamma=cfg.gamma, early_key=early_key)
 
         # -- critic ------------------------------------------------------------------------------
-        h = critic.convs(anchor)
-        z_anchor = critic.proj(h)
-        q1, q2 = critic.q(torch.cat([z_anchor, extra], dim=-1), action)
-        critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
-        out["critic_loss"], out["q_mean"] = critic_loss, q1.mean()
+        critic_loss, out["q_mean"], h, z_anchor = curl_critic_loss(nets, anchor, extra, action, target_q)
+        out["critic_loss"] = critic_loss
         critic_params = [p for g in self.critic_opt.param_groups for p in g["params"]]
         curl_params = [p for g in self.curl_opt.param_groups for p in g["params"]]
         curl_grads = None
         if share and do_curl:
-            curl_loss = self._curl_loss(z_anchor, z_pos)
+            curl_loss = curl_contrastive_loss(nets, z_anchor, z_pos)
             out["curl_loss"] = curl_loss
             grads = torch.autograd.grad(critic_loss, critic_params, retain_graph=True)
             curl_grads = torch.autograd.grad(curl_loss, curl_params)
@@ -354,23 +410,18 @@ class SacCurlAgent(SacMixin, AgentBase):
         if share:
             h_post = h.detach()
         elif do_curl:
-            h_post = critic.convs(anchor)
-            z_post = critic.proj(h_post)
+            h_post, z_post = curl_features(nets, anchor)
         elif do_actor:
             with torch.no_grad():
-                h_post = critic.convs(anchor)
+                h_post = nets("critic.convs", anchor)
 
         # -- actor and temperature (conv features detached: the actor never trains the convs) --
         if do_actor:
-            h_actor = h_post.detach()
-            with torch.no_grad():
-                z_state = z_post.detach() if z_post is not None else critic.proj(h_actor)
-                state = torch.cat([z_state, extra], dim=-1)
-            mu, log_std = self.actor(h_actor, extra)
-            pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            aq1, aq2 = critic.q(state, pi)
-            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out)
-            out["entropy"] = gaussian_entropy(log_std)
+            noise_pi = torch.randn((anchor.shape[0], self.action_dim), device=self.device)
+            actor_loss, log_pi, out["entropy"] = curl_actor_loss(
+                nets, h_post, h_post if z_post is None else z_post, extra, noise_pi, alpha, z_given=z_post is not None)
+            self.actor_and_alpha_steps_on(actor_loss, log_pi, out)
+            out["actor_loss"] = actor_loss
 
         # -- Polyak averaging of the target critic and key encoder --------------------------
         if do_polyak:
@@ -381,8 +432,8 @@ class SacCurlAgent(SacMixin, AgentBase):
             if curl_grads is None:
                 if not early_key:  # the key encoder just moved: CURL uses the new one
                     with torch.no_grad():
-                        z_pos = target.proj(target.convs(self._to_float(pos_u8)))
-                curl_loss = self._curl_loss(z_post, z_pos)
+                        z_pos = curl_key(nets, pos)
+                curl_loss = curl_contrastive_loss(nets, z_post, z_pos)
                 out["curl_loss"] = curl_loss
                 curl_grads = torch.autograd.grad(curl_loss, curl_params)
             for p, g in zip(curl_params, curl_grads):
@@ -392,10 +443,7 @@ class SacCurlAgent(SacMixin, AgentBase):
         return out
 
     def _curl_loss(self, z_anchor: torch.Tensor, z_pos: torch.Tensor) -> torch.Tensor:
-        logits = z_anchor @ (self.W @ z_pos.T)  # (B, B): q W k^T
-        logits = logits - logits.max(dim=1, keepdim=True)[0]
-        labels = torch.arange(logits.shape[0], device=logits.device)
-        return F.cross_entropy(logits, labels)
+        return curl_contrastive_loss(ModuleNets(self), z_anchor, z_pos)
 
     def curl_update(self, anchor_u8: torch.Tensor, pos_u8: torch.Tensor) -> float:
         """One contrastive step alone on given (B, K, S, S) uint8 crops: query = online

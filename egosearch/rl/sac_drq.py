@@ -45,6 +45,7 @@ from torch import nn
 
 from egosearch.rl.common import (
     AgentStateError,
+    ModuleNets,
     Projection,
     actor_head,
     adam,
@@ -72,6 +73,63 @@ def random_shift(x: torch.Tensor, pad: int) -> torch.Tensor:
     oy = torch.randint(0, 2 * pad + 1, (b,), device=x.device)
     ox = torch.randint(0, 2 * pad + 1, (b,), device=x.device)
     return crop_at(padded, oy, ox, h)
+
+
+# ---- the update's arithmetic, written once ----------------------------------------------------
+# One learner's losses from ``nets`` (a callable ``nets("critic", *inputs)``): SacDrqAgent.update passes its
+# own modules (egosearch.rl.common.ModuleNets), the stacked update (egosearch.rl.stacked) each seed's slice of
+# the stacked parameters under vmap. The random numbers come in as arguments, drawn by the caller in one order.
+
+def drq_inputs(batch: dict[str, torch.Tensor], state_dim: int, gamma: float):
+    """(extra, next_extra, critic_extra, next_critic_extra, discount) of a (plain or stacked) batch: the
+    actor's inputs besides the frames (mask, proprio), the critic's (the same plus the privileged ``state``
+    when it reads one) and the n-step discount column (gamma when the batch has none)."""
+    extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
+    next_extra = torch.cat([batch["next_mask"], batch["next_proprio"]], dim=-1)
+    critic_extra, next_critic_extra = extra, next_extra
+    if state_dim:
+        critic_extra = torch.cat([extra, batch["state"]], dim=-1)
+        next_critic_extra = torch.cat([next_extra, batch["next_state"]], dim=-1)
+    discount = batch.get("discount")
+    if discount is None:
+        discount = torch.full_like(batch["reward"], gamma)
+    return extra, next_extra, critic_extra, next_critic_extra, discount
+
+
+def drq_target(nets, nxt, next_extra, next_critic_extra, reward, not_done, discount, noise, alpha) -> torch.Tensor:
+    """The critic's target: the online encoder on next_obs (DrQ-v2), the actor's sample there (``noise``),
+    the target critic's smaller Q less the entropy term. The caller runs it without autograd."""
+    h_next = nets("encoder", nxt)
+    mu, log_std = nets("actor", h_next, next_extra)
+    next_pi, next_log_pi = squashed_sample(mu, log_std, noise)
+    tq1, tq2 = nets("critic_target", h_next, next_critic_extra, next_pi)
+    return reward + not_done * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
+
+
+def drq_critic_loss(nets, obs, critic_extra, action, target_q, *, warming_up: bool):
+    """(critic loss, mean Q1, the conv features of ``obs``). During the critic warm-up the encoder gets no
+    gradient (PIRLNav: the cloned encoder stays as it is)."""
+    with torch.set_grad_enabled(not warming_up and torch.is_grad_enabled()):
+        h = nets("encoder", obs)
+    q1, q2 = nets("critic", h, critic_extra, action)
+    return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean(), h
+
+
+def drq_actor_loss(nets, h, extra, critic_extra, action, demo, noise, alpha, *, bc_weight: float):
+    """(the actor's whole loss, SAC's part of it, log pi, the entropy, the cloning loss) on the detached
+    features ``h``. With ``bc_weight`` > 0, TD3+BC's term on the ``demo`` rows (a (B, 1) 0/1 column): the
+    squared error to the batch's action, scaled by the critic's magnitude; the cloning loss is 0 without."""
+    h_actor = h.detach()
+    mu, log_std = nets("actor", h_actor, extra)
+    pi, log_pi = squashed_sample(mu, log_std, noise)
+    aq1, aq2 = nets("critic", h_actor, critic_extra, pi)
+    actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
+    total, bc_loss = actor_loss, torch.zeros_like(actor_loss)
+    if bc_weight > 0:
+        error = ((torch.tanh(mu) - action).pow(2).sum(-1, keepdim=True) * demo).sum()
+        bc_loss = error / demo.sum().clamp(min=1.0)
+        total = actor_loss + bc_weight * torch.min(aq1, aq2).abs().mean().detach() * bc_loss
+    return total, actor_loss, log_pi, gaussian_entropy(log_std), bc_loss
 
 
 class DrqCritic(nn.Module):
@@ -143,35 +201,22 @@ class SacDrqAgent(SacDrqBase):
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
         cfg = self.cfg
         self.num_updates += 1
-        extra = torch.cat([batch["mask"], batch["proprio"]], dim=-1)
-        next_extra = torch.cat([batch["next_mask"], batch["next_proprio"]], dim=-1)
-        # what the critic reads besides the conv features: the actor's inputs, plus the state
-        critic_extra, next_critic_extra = extra, next_extra
-        if self.state_dim:
-            critic_extra = torch.cat([extra, batch["state"]], dim=-1)
-            next_critic_extra = torch.cat([next_extra, batch["next_state"]], dim=-1)
-        discount = batch.get("discount")
-        if discount is None:
-            discount = torch.full_like(batch["reward"], cfg.gamma)
-        # the replay holds pooled frames (see ``replay_obs``)
+        nets = ModuleNets(self)
+        extra, next_extra, critic_extra, next_critic_extra, discount = drq_inputs(batch, self.state_dim, cfg.gamma)
+        # the replay holds pooled frames (see ``replay_obs``); the draws in the stacked update's order
         obs = random_shift(batch["obs_depth"].float(), cfg.aug_pad)
         nxt = random_shift(batch["next_obs_depth"].float(), cfg.aug_pad)
+        noise_next = torch.randn((obs.shape[0], self.action_dim), device=self.device)
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
         # PIRLNav's critic warm-up: the cloned encoder and actor stay as they are
         warming_up = self.num_updates <= cfg.critic_warmup_updates
 
         with torch.no_grad():
-            h_next = self.encoder(nxt)
-            mu, log_std = self.actor(h_next, next_extra)
-            next_pi, next_log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            tq1, tq2 = self.critic_target(h_next, next_critic_extra, next_pi)
-            target_q = batch["reward"] + batch["not_done"] * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
-
-        with torch.set_grad_enabled(not warming_up):
-            h = self.encoder(obs)
-        q1, q2 = self.critic(h, critic_extra, batch["action"])
-        critic_loss = F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q)
+            target_q = drq_target(nets, nxt, next_extra, next_critic_extra, batch["reward"], batch["not_done"],
+                                  discount, noise_next, alpha)
+        critic_loss, out["q_mean"], h = drq_critic_loss(nets, obs, critic_extra, batch["action"], target_q,
+                                                        warming_up=warming_up)
         loss = critic_loss
         if self.decoder is not None:
             # the newest frame as the encoder saw it (pooled, shifted), in its input scale
@@ -184,22 +229,17 @@ class SacDrqAgent(SacDrqBase):
         self.critic_opt.step()
         if self.decoder is not None:
             self.optimisers["decoder"].step()
-        out["critic_loss"], out["q_mean"] = critic_loss, q1.mean()
+        out["critic_loss"] = critic_loss
 
         if self.num_updates % cfg.actor_update_freq == 0 and not warming_up:
-            h_actor = h.detach()
-            mu, log_std = self.actor(h_actor, extra)
-            pi, log_pi = squashed_sample(mu, log_std, torch.randn_like(mu))
-            aq1, aq2 = self.critic(h_actor, critic_extra, pi)
-            penalty = None
-            if self.bc_weight_now > 0 and "demo" in batch:
-                # TD3+BC: the squared error to the teacher, scaled by the critic's magnitude
-                demo = batch["demo"]
-                error = ((torch.tanh(mu) - batch["action"]).pow(2).sum(-1, keepdim=True) * demo).sum()
-                out["bc_loss"] = error / demo.sum().clamp(min=1.0)
-                penalty = self.bc_weight_now * torch.min(aq1, aq2).abs().mean().detach() * out["bc_loss"]
-            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out, penalty)
-            out["entropy"] = gaussian_entropy(log_std)
+            noise_pi = torch.randn((obs.shape[0], self.action_dim), device=self.device)
+            bc_weight = self.bc_weight_now if "demo" in batch else 0.0
+            demo = batch["demo"] if bc_weight > 0 else torch.zeros_like(batch["reward"])
+            total, out["actor_loss"], log_pi, out["entropy"], bc_loss = drq_actor_loss(
+                nets, h, extra, critic_extra, batch["action"], demo, noise_pi, alpha, bc_weight=bc_weight)
+            if bc_weight > 0:
+                out["bc_loss"] = bc_loss
+            self.actor_and_alpha_steps_on(total, log_pi, out)
 
         return self.finish_update(out)
 

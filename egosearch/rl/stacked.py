@@ -23,8 +23,11 @@ The member agents stay ordinary learners (:class:`egosearch.rl.sac_curl.SacCurlA
 :class:`egosearch.rl.sac_drq.SacDrqAgent`): their parameters are made views of the stacked tensors,
 so they act, write their actor files and their agent states exactly as separate runs do (after
 :meth:`StackedAgents.sync_members`, which copies the stacked optimiser states back into theirs).
-The arithmetic of each learner's update is written here a second time, in stacked form; the
-equality test is what keeps the two from drifting apart.
+The arithmetic of each learner's update is written once, in the learner's module, as functions of
+a ``nets`` callable (:func:`egosearch.rl.sac_drq.drq_critic_loss`, :func:`egosearch.rl.sac_curl.curl_target`...):
+the learner's plain update calls them on its own modules (:class:`egosearch.rl.common.ModuleNets`),
+this module vmaps them over the stacked parameters (:class:`Nets`). What is left here is the order of
+the steps, the stacked optimisers and the draws.
 
 What is stacked: SAC + CURL's fast update (not ``share_encoder_forward``, not ``compile``) and
 SAC-DrQ's update (its privileged critic, n-step discounts, critic warm-up and behaviour-cloning term
@@ -38,6 +41,7 @@ import copy
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
@@ -46,11 +50,20 @@ import torch.nn.functional as F
 from torch import nn
 from torch.func import functional_call, vmap
 
-from egosearch.rl.common import METRIC_KEYS, crop_at, gaussian_entropy, squashed_sample
+from egosearch.rl.common import METRIC_KEYS, crop_at, submodule
 from egosearch.rl.cuda_graph import GraphedUpdate
 from egosearch.rl.registry import stacked_algorithms
-from egosearch.rl.sac_curl import SacCurlAgent, crop_offsets
-from egosearch.rl.sac_drq import SacDrqAgent
+from egosearch.rl.sac_curl import (
+    SacCurlAgent,
+    crop_offsets,
+    curl_actor_loss,
+    curl_contrastive_loss,
+    curl_critic_loss,
+    curl_features,
+    curl_key,
+    curl_target,
+)
+from egosearch.rl.sac_drq import SacDrqAgent, drq_actor_loss, drq_critic_loss, drq_inputs, drq_target
 
 
 class StackingError(ValueError):
@@ -156,6 +169,10 @@ class Nets:
         own = {k[len(prefix):]: v for k, v in self.params.items() if k.startswith(prefix)}
         return functional_call(self.templates[path], own, args)
 
+    def tensor(self, name: str) -> torch.Tensor:
+        """A loose parameter's slice (CURL's ``W``), as :meth:`egosearch.rl.common.ModuleNets.tensor`."""
+        return self.params[name]
+
 
 class StackedAgents:
     """N agents of one learner and one architecture (seeds of one variant) updated as one stacked
@@ -187,7 +204,7 @@ class StackedAgents:
         self.cfg, self.device, self.n = first.cfg, first.device, len(members)
         self.num_updates = first.num_updates
         # the structure vmap calls with each seed's tensors (built before the members' tensors become views)
-        self.templates = {path: copy.deepcopy(_submodule(first, path)).to("meta") for path in self.paths}
+        self.templates = {path: copy.deepcopy(submodule(first, path)).to("meta") for path in self.paths}
         named = [member_tensors(m, self.parts) for m in members]
         # the stacked leaves, then each member's tensors made views of its slice (so acting, actor files
         # and agent states read the stacked values with no copy)
@@ -328,14 +345,6 @@ class StackedAgents:
         out["alpha_loss"] = loss
 
 
-def _submodule(agent: Any, path: str) -> nn.Module:
-    """``agent.critic.convs`` for ``"critic.convs"`` (agents are not modules themselves)."""
-    obj = agent
-    for part in path.split("."):
-        obj = getattr(obj, part)
-    return obj
-
-
 def stack_crop(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -> torch.Tensor:
     """Crop stacked frames (N, B, C, H, W) at offsets (N, B): each sample as the member crops it."""
     n, b = x.shape[:2]
@@ -347,7 +356,7 @@ def stack_crop(x: torch.Tensor, oy: torch.Tensor, ox: torch.Tensor, size: int) -
 
 class StackedSacCurl(StackedAgents):
     """Seeds of :class:`egosearch.rl.sac_curl.SacCurlAgent` (``impl="fast"``) stacked: its
-    ``_update_fast`` with ``share_encoder_forward`` off, step for step."""
+    ``_update_fast`` with ``share_encoder_forward`` off, step for step, on the same loss functions."""
 
     parts = StackedParts(("critic", "critic_target", "actor"), ("W", "log_alpha"))
     member_type = SacCurlAgent
@@ -389,58 +398,31 @@ class StackedSacCurl(StackedAgents):
         extra = torch.cat([inputs["mask"], inputs["proprio"]], dim=-1)
         next_extra = torch.cat([inputs["next_mask"], inputs["next_proprio"]], dim=-1)
         alpha = self.params["log_alpha"].detach().exp()
-        gamma, out = cfg.gamma, {}
+        out: dict[str, torch.Tensor] = {}
 
-        def target(nets, nxt, pos, next_extra, reward, not_done, noise, alpha):
-            mu, log_std = nets("actor", nets("critic.convs", nxt), next_extra)
-            next_pi, next_log_pi = squashed_sample(mu, log_std, noise)
-            if early_key:
-                z = nets("critic_target.proj", nets("critic_target.convs", torch.cat([nxt, pos])))
-                z_next, z_pos = z[: nxt.shape[0]], z[nxt.shape[0]:]
-            else:
-                z_next = z_pos = nets("critic_target.proj", nets("critic_target.convs", nxt))
-            x = torch.cat([torch.cat([z_next, next_extra], dim=-1), next_pi], dim=-1)
-            tq1, tq2 = nets("critic_target.q1", x), nets("critic_target.q2", x)
-            return reward + not_done * gamma * (torch.min(tq1, tq2) - alpha * next_log_pi), z_pos
+        # vmap returns no None: without the early key the target's z_pos is not returned
+        def target(nets, *args):
+            target_q, z_pos = curl_target(nets, *args, gamma=cfg.gamma, early_key=early_key)
+            return (target_q, z_pos) if early_key else (target_q,)
 
-        target_q, z_pos = self.seeds(target, nxt, pos, next_extra, inputs["reward"], inputs["not_done"],
-                                     inputs["noise_next"], alpha, grad=False)
-
-        def critic(nets, anchor, extra, action, target_q):
-            z = nets("critic.proj", nets("critic.convs", anchor))
-            x = torch.cat([torch.cat([z, extra], dim=-1), action], dim=-1)
-            q1, q2 = nets("critic.q1", x), nets("critic.q2", x)
-            return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean()
-
-        critic_loss, out["q_mean"] = self.seeds(critic, anchor, extra, inputs["action"], target_q)
+        target_out = self.seeds(target, nxt, pos, next_extra, inputs["reward"], inputs["not_done"],
+                                inputs["noise_next"], alpha, grad=False)
+        target_q, z_pos = target_out[0], target_out[1] if early_key else None
+        critic_loss, out["q_mean"], _, _ = self.seeds(curl_critic_loss, anchor, extra, inputs["action"], target_q)
         self.step_with("critic", critic_loss)
         out["critic_loss"] = critic_loss
 
         # the anchor's features after the critic step (CURL's order), shared by the actor and CURL
-        def features(nets, anchor):
-            h = nets("critic.convs", anchor)
-            return h, nets("critic.proj", h)
-
         z_post = None
         if do_curl:
-            h_post, z_post = self.seeds(features, anchor)
+            h_post, z_post = self.seeds(curl_features, anchor)
         elif do_actor:
             h_post = self.seeds(lambda nets, a: nets("critic.convs", a), anchor, grad=False)
 
         if do_actor:
-            def actor(nets, h_post, z_post, extra, noise, alpha):
-                h_actor = h_post.detach()
-                with torch.no_grad():
-                    z_state = z_post.detach() if do_curl else nets("critic.proj", h_actor)
-                    state = torch.cat([z_state, extra], dim=-1)
-                mu, log_std = nets("actor", h_actor, extra)
-                pi, log_pi = squashed_sample(mu, log_std, noise)
-                x = torch.cat([state, pi], dim=-1)
-                aq1, aq2 = nets("critic.q1", x), nets("critic.q2", x)
-                return (alpha * log_pi - torch.min(aq1, aq2)).mean(), log_pi, gaussian_entropy(log_std)
-
-            actor_loss, log_pi, out["entropy"] = self.seeds(actor, h_post, h_post if z_post is None else z_post,
-                                                            extra, inputs["noise_pi"], alpha)
+            actor_loss, log_pi, out["entropy"] = self.seeds(
+                partial(curl_actor_loss, z_given=z_post is not None), h_post, h_post if z_post is None else z_post,
+                extra, inputs["noise_pi"], alpha)
             self.step_with("actor", actor_loss)
             out["actor_loss"] = actor_loss
             self.alpha_step(log_pi, self.target_entropy, out)
@@ -454,16 +436,8 @@ class StackedSacCurl(StackedAgents):
 
         if do_curl:
             if not early_key:  # the key encoder just moved: CURL uses the new one
-                z_pos = self.seeds(lambda nets, p: nets("critic_target.proj", nets("critic_target.convs", p)),
-                                   pos, grad=False)
-
-            def curl(nets, z_anchor, z_pos):
-                w = nets.params["W"]
-                logits = z_anchor @ (w @ z_pos.T)
-                logits = logits - logits.max(dim=1, keepdim=True)[0]
-                return F.cross_entropy(logits, torch.arange(logits.shape[0], device=logits.device))
-
-            curl_loss = self.seeds(curl, z_post, z_pos)
+                z_pos = self.seeds(curl_key, pos, grad=False)
+            curl_loss = self.seeds(curl_contrastive_loss, z_post, z_pos)
             self.step_with("curl", curl_loss)
             out["curl_loss"] = curl_loss
         out["alpha"] = self.params["log_alpha"].detach().exp()
@@ -474,7 +448,7 @@ class StackedSacCurl(StackedAgents):
 
 class StackedSacDrq(StackedAgents):
     """Seeds of :class:`egosearch.rl.sac_drq.SacDrqAgent` stacked: its ``update`` and
-    ``finish_update``, step for step."""
+    ``finish_update``, step for step, on the same loss functions."""
 
     parts = StackedParts(("encoder", "critic", "critic_target", "actor"), ("log_alpha",))
     member_type = SacDrqAgent
@@ -519,64 +493,29 @@ class StackedSacDrq(StackedAgents):
     def update_tensors(self, inputs: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
         cfg = self.cfg
         warming_up, do_actor = self.warming_up(), self.actor_due()
-        extra = torch.cat([inputs["mask"], inputs["proprio"]], dim=-1)
-        next_extra = torch.cat([inputs["next_mask"], inputs["next_proprio"]], dim=-1)
-        critic_extra, next_critic_extra = extra, next_extra
-        if "state" in inputs and self.members[0].state_dim:
-            critic_extra = torch.cat([extra, inputs["state"]], dim=-1)
-            next_critic_extra = torch.cat([next_extra, inputs["next_state"]], dim=-1)
-        discount = inputs.get("discount")
-        if discount is None:
-            discount = torch.full_like(inputs["reward"], cfg.gamma)
+        extra, next_extra, critic_extra, next_critic_extra, discount = drq_inputs(
+            inputs, self.members[0].state_dim, cfg.gamma)
         obs = self.shift(inputs["obs_depth"].float(), inputs["obs_oy"], inputs["obs_ox"])
         nxt = self.shift(inputs["next_obs_depth"].float(), inputs["next_oy"], inputs["next_ox"])
         alpha = self.params["log_alpha"].detach().exp()
         out: dict[str, torch.Tensor] = {}
 
-        def target(nets, nxt, next_extra, next_critic_extra, reward, not_done, discount, noise, alpha):
-            h_next = nets("encoder", nxt)
-            mu, log_std = nets("actor", h_next, next_extra)
-            next_pi, next_log_pi = squashed_sample(mu, log_std, noise)
-            tq1, tq2 = nets("critic_target", h_next, next_critic_extra, next_pi)
-            return reward + not_done * discount * (torch.min(tq1, tq2) - alpha * next_log_pi)
-
-        target_q = self.seeds(target, nxt, next_extra, next_critic_extra, inputs["reward"], inputs["not_done"],
+        target_q = self.seeds(drq_target, nxt, next_extra, next_critic_extra, inputs["reward"], inputs["not_done"],
                               discount, inputs["noise_next"], alpha, grad=False)
-
-        def critic(nets, obs, critic_extra, action, target_q):
-            with torch.set_grad_enabled(not warming_up):  # PIRLNav's critic warm-up: the encoder stays
-                h = nets("encoder", obs)
-            q1, q2 = nets("critic", h, critic_extra, action)
-            return F.mse_loss(q1, target_q) + F.mse_loss(q2, target_q), q1.mean(), h
-
-        critic_loss, out["q_mean"], h = self.seeds(critic, obs, critic_extra, inputs["action"], target_q)
+        critic_loss, out["q_mean"], h = self.seeds(partial(drq_critic_loss, warming_up=warming_up), obs,
+                                                   critic_extra, inputs["action"], target_q)
         self.step_with("critic", critic_loss, allow_unused=warming_up)
         out["critic_loss"] = critic_loss
 
         if do_actor:
-            bc_weight = self.members[0].bc_weight_now
-            with_bc = bc_weight > 0 and "demo" in inputs
-            demo = inputs["demo"] if with_bc else torch.zeros_like(inputs["reward"])
-
-            def actor(nets, h, extra, critic_extra, action, demo, noise, alpha):
-                h_actor = h.detach()
-                mu, log_std = nets("actor", h_actor, extra)
-                pi, log_pi = squashed_sample(mu, log_std, noise)
-                aq1, aq2 = nets("critic", h_actor, critic_extra, pi)
-                actor_loss = (alpha * log_pi - torch.min(aq1, aq2)).mean()
-                total, bc_loss = actor_loss, torch.zeros_like(actor_loss)
-                if with_bc:  # TD3+BC's term, as SacDrqAgent.update adds it
-                    error = ((torch.tanh(mu) - action).pow(2).sum(-1, keepdim=True) * demo).sum()
-                    bc_loss = error / demo.sum().clamp(min=1.0)
-                    total = actor_loss + bc_weight * torch.min(aq1, aq2).abs().mean().detach() * bc_loss
-                return total, actor_loss, log_pi, gaussian_entropy(log_std), bc_loss
-
-            total, actor_loss, log_pi, out["entropy"], bc_loss = self.seeds(
-                actor, h, extra, critic_extra, inputs["action"], demo, inputs["noise_pi"], alpha)
-            if with_bc:
+            bc_weight = self.members[0].bc_weight_now if "demo" in inputs else 0.0
+            demo = inputs["demo"] if bc_weight > 0 else torch.zeros_like(inputs["reward"])
+            total, out["actor_loss"], log_pi, out["entropy"], bc_loss = self.seeds(
+                partial(drq_actor_loss, bc_weight=bc_weight), h, extra, critic_extra, inputs["action"], demo,
+                inputs["noise_pi"], alpha)
+            if bc_weight > 0:
                 out["bc_loss"] = bc_loss
             self.step_with("actor", total)
-            out["actor_loss"] = actor_loss
             self.alpha_step(log_pi, self.target_entropy, out)
 
         if self.num_updates % cfg.critic_target_update_freq == 0:
