@@ -410,8 +410,9 @@ def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_g
 
     asked = []
 
-    def fake_time_updates(profile="paper", overrides=None, impl="fast", threads=None, warmup=3, updates=10, **_):
-        asked.append((profile, dict(overrides or {}), impl))
+    def fake_time_updates(profile="paper", overrides=None, agent_options=None, threads=None, warmup=3, updates=10,
+                          **_):
+        asked.append((profile, dict(overrides or {}), (agent_options or {}).get("impl", "fast")))
         return {"median_s": 0.1, "best_s": 0.1}
 
     monkeypatch.setattr(bench, "time_updates", fake_time_updates)

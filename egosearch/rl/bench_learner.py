@@ -49,7 +49,6 @@ from egosearch.rl.common import resolve_device
 from egosearch.rl.config import DECISIONS, LearnerConfig, load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
-from egosearch.rl.sac_curl import SacCurlAgent
 from egosearch.rl.train import torch_threads, train
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
@@ -92,10 +91,11 @@ def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: in
     return buf
 
 
-def time_updates(profile: str = "paper", overrides: dict | None = None, impl: str = "fast",
+def time_updates(profile: str = "paper", overrides: dict | None = None, agent_options: dict | None = None,
                  threads: int | None = None, warmup: int = 3, updates: int = 10,
                  action_dim: int = 5) -> dict[str, float]:
-    """Median and best seconds per full update (sampling included)."""
+    """Median and best seconds per full update (sampling included); ``agent_options``: keyword arguments
+    of the profile's learner's own constructor (SAC+CURL's ``impl``)."""
     before = torch.get_num_threads()
     if threads:
         torch.set_num_threads(threads)
@@ -104,10 +104,7 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, impl: st
         torch.manual_seed(0)
         device = resolve_device(cfg.device)
         state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
-        if cfg.algorithm == "sac_curl":
-            agent = SacCurlAgent(cfg, action_dim, impl=impl, device=device)
-        else:
-            agent = make_agent(cfg, action_dim, 30, 4, device, state_dim)
+        agent = make_agent(cfg, action_dim, 30, 4, device, state_dim, **(agent_options or {}))
         replay = _filled_replay(action_dim, device, size=agent.replay_image_size, state_dim=state_dim)
         sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
         for _ in range(warmup):
@@ -228,7 +225,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     runs = {
         "table2": time_updates("paper", eager, updates=n),
         "table2_shared": time_updates("paper", {**eager, "share_encoder_forward": True}, updates=n),
-        "naive": time_updates("paper", impl="reference", warmup=2, updates=max(3, n // 2)),
+        "naive": time_updates("paper", agent_options={"impl": "reference"}, warmup=2, updates=max(3, n // 2)),
         "table2_1thread": time_updates("paper", eager, threads=1, updates=max(3, n // 2)),
     }
     if torch.cuda.is_available():  # the captured update: 4 eager warm-up updates and 2 captures first
@@ -308,8 +305,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
     cfg = load_config(profile, {**(overrides or {}), "device": "cuda"})
     torch.manual_seed(0)
     state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
-    agent = (SacCurlAgent(cfg, 5, device="cuda") if cfg.algorithm == "sac_curl"
-             else make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim))
+    agent = make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim)
     replay = _filled_replay(5, torch.device("cuda"), size=agent.replay_image_size, state_dim=state_dim)
     batches = [replay.sample(cfg.batch_size) for _ in range(updates + 6)]
     for batch in batches[:6]:

@@ -48,6 +48,9 @@ from egosearch.rl.run_settings import (
     RunSettings,
 )
 
+DEFAULT_ALGORITHM: str = RunSettings.algorithm
+"""The learner a config that names none gets (``RunSettings.algorithm``'s default: the paper's)."""
+
 _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "gelu": "GELU",
                       "tanh": "Tanh"}
 
@@ -73,7 +76,7 @@ class LearnerConfig(RunSettings):
 
     def __new__(cls, *args: Any, **values: Any) -> LearnerConfig:
         if cls is LearnerConfig:  # the composed class of the learner named (SAC + CURL, the paper's, by default)
-            cls = config_class(values.get("algorithm", "sac_curl"))
+            cls = config_class(values.get("algorithm", DEFAULT_ALGORITHM))
         return super().__new__(cls)
 
     def validate(self) -> LearnerConfig:
@@ -110,7 +113,7 @@ class LearnerConfig(RunSettings):
     def from_dict(cls, values: dict[str, Any]) -> LearnerConfig:
         """Inverse of :meth:`to_dict`; a field the learner ``values["algorithm"]`` does not have is a one-line
         ``ValueError``."""
-        klass = config_class(values.get("algorithm", "sac_curl"))
+        klass = config_class(values.get("algorithm", DEFAULT_ALGORITHM))
         _refuse_foreign(klass, values)
         return klass(**values).validate()
 
@@ -119,7 +122,7 @@ class LearnerConfig(RunSettings):
         """A stored run's recorded config (config.json, done.json, a checkpoint). Runs stored before the
         config was split recorded every learner's fields: those of other learners, which this one never read,
         are left out; a field the run's learner has keeps its recorded value."""
-        klass = config_class(values.get("algorithm", "sac_curl"))
+        klass = config_class(values.get("algorithm", DEFAULT_ALGORITHM))
         own = {f.name for f in fields(klass)}
         return klass(**{k: v for k, v in values.items() if k in own}).validate()
 
@@ -211,7 +214,7 @@ def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None)
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; allowed: {', '.join(PROFILES)}")
     base, overrides = PROFILES[profile](), dict(overrides or {})
-    klass = config_class(overrides.get("algorithm", base.get("algorithm", "sac_curl")))
+    klass = config_class(overrides.get("algorithm", base.get("algorithm", DEFAULT_ALGORITHM)))
     _refuse_foreign(klass, overrides)
     own = {f.name for f in fields(klass)} - set(unread_settings(klass))
     return klass(**{**{k: v for k, v in base.items() if k in own}, **overrides}).validate()
@@ -253,7 +256,7 @@ def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
 
     return [
         ("Image Size", f"{cfg.image_size}x{cfg.image_size}"),
-        ("Augmentation", f"Random Crop ({cfg.crop_size}x{cfg.crop_size})" if cfg.algorithm == "sac_curl" else
+        ("Augmentation", f"Random Crop ({cfg.crop_size}x{cfg.crop_size})" if hasattr(cfg, "crop_size") else
          f"Random Shift (±{getattr(cfg, 'aug_pad', 0)} px at {cfg.image_size // cfg.obs_downsample}x"
          f"{cfg.image_size // cfg.obs_downsample})"),
         ("Image History Buffer Size", str(cfg.frame_history)),
@@ -280,8 +283,8 @@ def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
         ("Critic : Hidden dim", str(cfg.critic_hidden_dim)),
         ("Critic : Activation function", act[cfg.critic_activation]),
         ("Encoder (CNN) : learning rate", num("encoder_lr")),
-        ("Encoder (CNN) : τ (polyak averaging)", _num(cfg.encoder_tau) if cfg.algorithm == "sac_curl" else
-         "none (SAC-DrQ has no target encoder)"),
+        ("Encoder (CNN) : τ (polyak averaging)", num("encoder_tau") if hasattr(cfg, "encoder_tau") else
+         f"none ({learner(cfg.algorithm).display_name} has no target encoder)"),
         ("Encoder (CNN) : Number of layers", plain("encoder_num_layers")),
         ("Encoder (CNN) : Number of filters", plain("encoder_num_filters")),
         ("Encoder (CNN) : Latent dimension", plain("encoder_latent_dim")),

@@ -55,11 +55,12 @@ class Learner:
         return resolve(self.agent)
 
     def make(self, cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
-             state_dim: int = 0) -> Agent:
+             state_dim: int = 0, **options: object) -> Agent:
+        """The agent; ``options``: keyword arguments of this learner's own constructor (SAC+CURL's ``impl``)."""
         factory = self.agent_factory()
         if self.takes_state_dim:
-            return factory(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim)
-        return factory(cfg, action_dim, mask_dim, proprio_dim, device=device)
+            return factory(cfg, action_dim, mask_dim, proprio_dim, device=device, state_dim=state_dim, **options)
+        return factory(cfg, action_dim, mask_dim, proprio_dim, device=device, **options)
 
 
 _REGISTRY: Registry[Learner] = Registry("algorithm", describe=lambda entry: entry.display_name)
@@ -97,10 +98,11 @@ def stacked_algorithms() -> tuple[str, ...]:
 
 
 def make_agent(cfg: LearnerSettings, action_dim: int, mask_dim: int, proprio_dim: int, device,
-               state_dim: int = 0) -> Agent:
+               state_dim: int = 0, **options: object) -> Agent:
     """The agent of the learner ``cfg.algorithm`` names; ``state_dim``: size of the env's privileged
-    state (``critic_privileged_state``), for the learners that take it."""
-    return learner(cfg.algorithm).make(cfg, action_dim, mask_dim, proprio_dim, device, state_dim)
+    state (``critic_privileged_state``), for the learners that take it; ``options``: keyword arguments
+    of that learner's own constructor."""
+    return learner(cfg.algorithm).make(cfg, action_dim, mask_dim, proprio_dim, device, state_dim, **options)
 
 
 def actor_formats() -> dict[str, str | Callable[..., ActorFileNet]]:
