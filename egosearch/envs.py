@@ -18,14 +18,16 @@ from dataclasses import asdict, dataclass
 
 from egosearch.searchers.decision_envs import MODULAR_ENV_IDS, MODULAR_MAP_DIM, decision_env_id, modular_decision_dim
 from egosearch.sim.body_envs import ENV_IDS, body_env_id, body_options
+from egosearch.sim.observation_options import OPTIONS
 
 ALL_ENV_IDS = (*ENV_IDS, *MODULAR_ENV_IDS)
 """Every id a policy may be trained and evaluated in."""
-OBSERVATION_OPTIONS = ("contact_signal",)
+OBSERVATION_OPTIONS = OPTIONS.keys()
 """The body env's keyword options that change what a policy observes with no id of their own (no new id per
-combination of options): a learner config field of the same name sets each, the run's config records it in
-its actor file, and ``egosearch evaluate`` builds the actor's env with the recorded ones
-(:func:`observation_kwargs`; ``--env-option`` overrides them, and an actor that does not fit is refused)."""
+combination of options; a live view of :mod:`egosearch.sim.observation_options`' registry): a learner config
+field of the same name sets each, the run's config records it in its actor file, and ``egosearch evaluate``
+builds the actor's env with the recorded ones (:func:`observation_kwargs`; ``--env-option`` overrides them,
+and an actor that does not fit is refused)."""
 
 
 def observation_kwargs(config: Mapping | None) -> dict[str, bool]:

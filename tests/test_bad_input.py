@@ -18,6 +18,8 @@ from egosearch.workflow.check import ConfigError, check_config, checked_variants
 
 TAKEN = ", ".join(searchers.names())
 """The registered searchers' names, as the error lines list them (a searcher registered later joins them)."""
+BOUNDS = ", ".join(searchers.bounds())
+"""The registered Table 1 bounds, in their table order, as the error lines list them."""
 
 REPO = Path(__file__).resolve().parent.parent
 HEAD = "name: NAME\nenv_id: EgoSearch-v0\ntrain_env: {layout: kitchen_living, placement: everywhere}\n"
@@ -1354,8 +1356,7 @@ ISSUE57_CASES = [
     ("table1_bounds_a_missing_csv", "cryptic",
      ["report", "table1", ev("head_on"), "--bounds", "{t}/missing.csv", "--out-prefix", "{t}/t"],
      "egosearch report: error: --bounds: {t}/missing.csv not found; --bounds takes the evaluation CSV paths of the "
-     "searchers (random, frontier, frontier_head_off, frontier_tuned, frontier_tuned_head_off, oracle): "
-     "results/<profile>/eval/<searcher>/seed<N>/<home>/<placement>/h<height>.csv"),
+     f"searchers ({BOUNDS}): results/<profile>/eval/<searcher>/seed<N>/<home>/<placement>/h<height>.csv"),
 ]
 TPG = "allowed: 'auto' or an integer from 1 to 64"
 ISSUE57_CONFIGS = [

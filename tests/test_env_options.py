@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import egosearch.sim.body_envs  # noqa: F401
-from egosearch.sim.env import CONTACT_WINDOW, MASK_FEATURE_DIM, PROPRIO_DIM, TARGET_MEMORY_DIM
+from egosearch.sim.contact_signal import CONTACT_WINDOW
+from egosearch.sim.env import MASK_FEATURE_DIM, PROPRIO_DIM, TARGET_MEMORY_DIM
 
 
 def _run_until_seen(env, rng, max_episodes=30):

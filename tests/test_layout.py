@@ -245,20 +245,23 @@ def _drawn_tree() -> dict[str, list[str]]:
 
 
 def _registered_modules() -> set[str]:
-    """The modules a registry names (a learner's agent, settings and actor loaders; a searcher's factory):
+    """The modules a registry names (a learner's agent, settings and actor loaders; a searcher's factory; an
+    observation option's classes):
     the registry is their listing, so a plug-in is its file and its registration line, with no drawing or
     docstring to edit."""
     from egosearch.rl.registry import LEARNERS
     from egosearch.searchers.registry import SEARCHERS
+    from egosearch.sim.observation_options import OPTIONS
 
     targets = [t for e in LEARNERS.values() for t in (e.agent, e.settings, *e.actor_formats.values())]
     targets += [e.factory for e in SEARCHERS.values()]
+    targets += [t for e in OPTIONS.values() for t in (e.option, e.settings)]
     return {t.partition(":")[0] for t in targets if isinstance(t, str)}
 
 
 def test_the_registries_name_modules_that_exist():
     registered = _registered_modules()
-    assert {"egosearch.rl.sac_drq", "egosearch.searchers.frontier"} <= registered
+    assert {"egosearch.rl.sac_drq", "egosearch.searchers.frontier", "egosearch.sim.contact_signal"} <= registered
     for module in registered:
         assert (PACKAGE.parent / (module.replace(".", "/") + ".py")).is_file(), module
 

@@ -16,13 +16,15 @@ from egosearch.rl.config import (
     field_order,
     load_config,
     own_settings,
+    shared_fields,
 )
 from egosearch.rl.profiles import CPU, PROFILES
 from egosearch.rl.registry import LEARNERS
 from egosearch.rl.run_settings import RunSettings
 from egosearch.variants import VariantError, load_variant
 
-SHARED = {f.name for f in dataclasses.fields(RunSettings)}
+SHARED = set(shared_fields())
+"""The fields every learner has: the run settings' and the observation options'."""
 
 SHIPPED = list(LEARNERS)
 """The learners registered at import (a test's toy learner comes and goes inside its test)."""
@@ -33,7 +35,8 @@ def test_a_learners_own_fields_are_those_its_settings_class_declares_and_none_is
     for name in SHIPPED:
         declared = {f.name for f in dataclasses.fields(LEARNERS[name].settings_class())}
         assert set(own_settings(name)) == declared, name
-    # every field belongs to the run settings or to some learner, and none to both
+    assert {f.name for f in dataclasses.fields(RunSettings)} < SHARED and "contact_signal" in SHARED
+    # every field belongs to the shared settings or to some learner, and none to both
     assert SHARED | {f for name in LEARNERS for f in own_settings(name)} == set(field_defaults()) == set(field_order())
     assert not SHARED & {f for name in LEARNERS for f in own_settings(name)}
 
@@ -139,8 +142,9 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
 
     main(["config", "show", "sac_drq", "--variant", "head_on_contact_signal"])
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith("sac_drq at profile cpu with variant head_on_contact_signal: 74 fields, declared in ")
-    assert len(out) == 2 + 74 and sum(line.startswith("contact_signal ") for line in out) == 1
+    n = len(dataclasses.fields(config_class("sac_drq")))
+    assert out[0].startswith(f"sac_drq at profile cpu with variant head_on_contact_signal: {n} fields, declared in ")
+    assert len(out) == 2 + n and sum(line.startswith("contact_signal ") for line in out) == 1
     assert main(["config", "show", "sac_curl", "--variant", "head_on_ppo"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith("--variant head_on_ppo trains algorithm ppo, not sac_curl: show that one")

@@ -12,6 +12,7 @@ from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
 from egosearch.searchers import registry as searchers
 from egosearch.sim.body import EVAL_HEIGHTS, HEIGHT_RANGE
+from egosearch.sim.observation_options import option_names
 
 LAYOUTS = (f"{', '.join(LAYOUT_NAMES)} (the paper's homes), {', '.join(EASY_LAYOUTS)} (a small home for tests) "
            "or home<seed> (a generated home)")
@@ -84,8 +85,8 @@ def add_evaluate(sub) -> None:
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help=env_id_help())
     p.add_argument("--env-option", action="append", metavar="KEY=true|false",
-                   help="an observation option of the env (contact_signal), repeatable; default: the ones a trained "
-                        "actor's file records (an actor that does not fit the options given is refused)")
+                   help=f"an observation option of the env ({', '.join(option_names())}), repeatable; default: the "
+                        "ones a trained actor's file records (an actor that does not fit the options given is refused)")
     p.add_argument("--seed", type=int, help=POLICY_SEED + " (not with --curve-of, whose episodes are seeded as the "
                                             "curve's)")
     p.add_argument("--out", required=True, help="the per-episode CSV to write (one row per scenario)")

@@ -47,6 +47,7 @@ from egosearch.rl.run_settings import (
     DISTANCE_REWARDS,
     RunSettings,
 )
+from egosearch.sim.observation_options import OPTIONS
 
 DEFAULT_ALGORITHM: str = RunSettings.algorithm
 """The learner a config that names none gets (``RunSettings.algorithm``'s default: the paper's)."""
@@ -57,11 +58,22 @@ _ACTIVATION_LABELS = {"relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU", "
 _BUILDING_BLOCKS = (NetworkSettings, SacSettings, PooledSettings, RandomShiftSettings)
 """The settings classes the learners' own are made of (their fields are documented there)."""
 
+def option_settings() -> tuple[type, ...]:
+    """The settings classes of the registered observation options (:mod:`egosearch.sim.observation_options`):
+    one bool field each, which every learner's config has beside the run settings."""
+    return tuple(entry.settings_class() for entry in OPTIONS.values())
+
+
+def shared_fields() -> tuple[str, ...]:
+    """The fields every learner's config has: the run settings' and the observation options', as declared."""
+    return tuple(f.name for klass in (RunSettings, *option_settings()) for f in fields(klass))
+
+
 def field_order() -> tuple[str, ...]:
     """The order fields are shown in (the departures from the paper in the generated Table 2 pages,
-    ``egosearch config show``): the run settings' as declared (Table 2's observation and data first), then
-    each building block's and each registered learner's own, as declared. A new field has its place where it
-    is written; no list to keep."""
+    ``egosearch config show``): the run settings' as declared (Table 2's observation and data first), the
+    observation options', then each building block's and each registered learner's own, as declared. A new
+    field has its place where it is written; no list to keep."""
     names = [f.name for klass in settings_classes() for f in fields(klass) if klass is RunSettings or
              f.name not in {g.name for g in fields(RunSettings)}]
     return tuple(dict.fromkeys(names))
@@ -99,6 +111,10 @@ class LearnerConfig(RunSettings):
         if self.algorithm != _ALGORITHM_OF.get(type(self), self.algorithm):
             bad("algorithm", f"{_ALGORITHM_OF[type(self)]} (this is {type(self).__name__})")
         RunSettings.own_checks(self, bad)
+        for name in OPTIONS:
+            if self.modular_searcher and getattr(self, name):
+                bad(name, "False with modular_searcher (the frontier searcher walks the body; the decision env does "
+                          "not read the option)")
         for klass in reversed(type(self).__mro__):
             if klass not in (RunSettings, LearnerConfig) and "own_checks" in vars(klass):
                 vars(klass)["own_checks"](self, bad)
@@ -132,10 +148,11 @@ _ALGORITHM_OF: dict[type, str] = {}
 
 
 @functools.cache
-def _composed(algorithm: str, settings: type | None) -> type[LearnerConfig]:
+def _composed(algorithm: str, settings: type | None, options: tuple[type, ...]) -> type[LearnerConfig]:
     # the learner's own settings first, so that its class variables (privileged_critic, ...) win over the
-    # run settings' defaults; fields still come run settings first (dataclasses collect them base-most first)
-    bases = (LearnerConfig,) if settings is None else (settings, LearnerConfig)
+    # run settings' defaults; fields still come run settings first, then the observation options' (dataclasses
+    # collect them base-most first)
+    bases = (*(() if settings is None else (settings,)), *options, LearnerConfig)
     name = "".join(part.capitalize() for part in algorithm.split("_")) + "Config"
     klass = dataclasses.make_dataclass(name, [("algorithm", "str", dataclasses.field(default=algorithm))],
                                        bases=bases)
@@ -151,19 +168,21 @@ def config_class(algorithm: str) -> type[LearnerConfig]:
     """The config class of the learner registered as ``algorithm``: the run settings and its own."""
     if algorithm not in ALGORITHMS:
         raise ValueError(f"LearnerConfig.algorithm={algorithm!r} is out of range; allowed: {', '.join(ALGORITHMS)}")
-    return _composed(algorithm, learner(algorithm).settings_class())
+    return _composed(algorithm, learner(algorithm).settings_class(), option_settings())
 
 
 def own_settings(algorithm: str) -> tuple[str, ...]:
-    """The fields of ``algorithm``'s own settings (not the run settings), in :func:`field_order`."""
-    shared = {f.name for f in fields(RunSettings)}
+    """The fields of ``algorithm``'s own settings (not the shared ones: the run settings and the observation
+    options'), in :func:`field_order`."""
+    shared = set(shared_fields())
     return tuple(n for n in field_order() if n in {f.name for f in fields(config_class(algorithm))} - shared)
 
 
 def settings_classes() -> list[type]:
-    """Every settings class: the run settings, the building blocks and each registered learner's own."""
+    """Every settings class: the run settings, the observation options', the building blocks and each
+    registered learner's own."""
     own = [entry.settings_class() for entry in LEARNERS.values()]
-    classes = [RunSettings, *_BUILDING_BLOCKS, *(k for k in own if k is not None)]
+    classes = [RunSettings, *option_settings(), *_BUILDING_BLOCKS, *(k for k in own if k is not None)]
     return list(dict.fromkeys(classes))
 
 

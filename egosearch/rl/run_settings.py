@@ -114,15 +114,6 @@ class RunSettings:
     CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
     ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
     profile never."""
-    contact_signal: bool = False
-    """Paper: False (the body feels nothing: its observation is depth, the target mask and the head's
-    pose). True: habitat-lab's ``collisions`` measure given to the policy, after the stuck-student read
-    (``docs/results.md``, "What head_on is stuck against": a fifth of the stuck runs press into furniture
-    whose top is below the view): the env's ``contact_signal`` option, whose ``proprio`` gains a bump bit
-    and the collisions of the last 5 steps / 5 (``egosearch.sim.env``). It keeps the variant's env id (an
-    env keyword option, recorded with the run's config in its actor file, which ``egosearch evaluate``
-    reads back). This CHANGES THE OBSERVATION, for the actor and at evaluation too; no profile sets it
-    (``ablations/head_on_contact_signal.yaml`` screens it)."""
     modular_searcher: bool = False
     """Paper: False (the policy acts at every body step: its steps, turns and head). True: a modular
     searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the stored
@@ -356,9 +347,6 @@ class RunSettings:
             bad("bc_weight_floor", f"[0, bc_weight={self.bc_weight}] (the weight the cloning term decays to)")
         if self.modular_searcher and self.target_memory:
             bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
-        if self.modular_searcher and self.contact_signal:
-            bad("contact_signal", "False with modular_searcher (the frontier searcher walks the body; the decision "
-                                  "env does not read the option)")
         if self.modular_searcher and self.demo_episodes:
             bad("demo_episodes", "0 with modular_searcher (the demonstrations are the frontier searcher's body steps)")
         if (self.demo_episodes or self.critic_warmup_updates) and not self.learns_from_demonstrations:

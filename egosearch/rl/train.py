@@ -88,7 +88,7 @@ from egosearch.rl.run_files import (
     to_tensors,
 )
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
-from egosearch.sim.env import CONTACT_SIGNAL_DIM
+from egosearch.sim.observation_options import extra_dims
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
                  "curl_loss", "alpha", "entropy", "steps_per_s", "updates_per_s", "wall_s")
@@ -177,11 +177,13 @@ def _env_spaces(env, cfg: LearnerConfig) -> tuple[int, int, int]:
     if tuple(depth.shape) != want or depth.dtype != np.uint8:
         raise ValueError(f"env depth is {tuple(depth.shape)} {depth.dtype}; config expects {want} uint8 "
                          "(frame_history, image_size)")
-    # the head's pose and its last changes, then the contact signal's values when the config observes it
-    wanted = 2 * (1 + cfg.head_history) + (CONTACT_SIGNAL_DIM if cfg.contact_signal else 0)
+    # the head's pose and its last changes, then the values of the observation options the config turns on
+    observed = observation_kwargs(cfg.to_dict())
+    wanted = 2 * (1 + cfg.head_history) + extra_dims(observed).get("proprio", 0)
     if proprio.shape[0] != wanted:
-        raise ValueError(f"env proprio has {proprio.shape[0]} values; head_history={cfg.head_history} "
-                         f"and contact_signal={cfg.contact_signal} expect {wanted}")
+        named = "".join(f" and {name}=True" for name in observed)
+        raise ValueError(f"env proprio has {proprio.shape[0]} values; head_history={cfg.head_history}{named} "
+                         f"expect {wanted}")
     act = env.action_space
     if not isinstance(act, gymnasium.spaces.Box) or len(act.shape) != 1:
         raise ValueError(f"action space must be a 1-d Box, got {act}")

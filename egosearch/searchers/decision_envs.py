@@ -35,10 +35,17 @@ def decision_env_id(head: bool) -> str:
     return "EgoSearchModular-v0" if head else "EgoSearchNoHeadModular-v0"
 
 
-UNREAD_OPTIONS = {"target_memory": "EgoSearchMemory-v0", "floor_map": "EgoSearchMap-v0",
-                  "contact_signal": "EgoSearch-v0"}
-"""Body-env options a decision env does not read (its observation is the decision's: the mask's features and
-the searcher's map), with the body id that does."""
+ID_OPTIONS_UNREAD = {"target_memory": "EgoSearchMemory-v0", "floor_map": "EgoSearchMap-v0"}
+"""The body-env options with ids of their own that a decision env does not read, with the body id that does."""
+
+
+def unread_options() -> dict[str, str]:
+    """Body-env options a decision env does not read (its observation is the decision's: the mask's features
+    and the searcher's map), with a body id that does: those above and every observation option
+    (:mod:`egosearch.sim.observation_options`), which any body id reads."""
+    from egosearch.sim.observation_options import option_names
+
+    return {**ID_OPTIONS_UNREAD, **{name: "EgoSearch-v0" for name in option_names()}}
 
 
 def check_decision_options(env_id: str | None, kwargs: dict) -> None:
@@ -47,7 +54,7 @@ def check_decision_options(env_id: str | None, kwargs: dict) -> None:
     from egosearch.sim.body_envs import check_flag
 
     where = env_id or "the modular searcher's decision env"
-    for name, reader in UNREAD_OPTIONS.items():
+    for name, reader in unread_options().items():
         if name in kwargs:
             raise ValueError(f"{name}={kwargs[name]!r}: {where} does not read {name} (its observation is the "
                              f"decision's: the mask's features and the searcher's map); allowed: leave {name} out "

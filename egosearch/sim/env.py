@@ -20,11 +20,10 @@ With ``floor_map=True`` (the ``*Map-v0`` ids, also a CHANGE OF OBSERVATION) it g
 how much of each square's floor it has seen, how much of it is occupied, and whether it has stood
 there (:class:`egosearch.sim.floormap.FloorMap`, built from its own depth frames and pose): the map a
 classical searcher plans on, as a memory of where it has been and what it has not seen.
-With ``contact_signal=True`` (a keyword option, no id of its own; a CHANGE OF OBSERVATION, never the
-paper's, after habitat-lab's ``collisions`` measure) ``proprio`` gains :data:`CONTACT_SIGNAL_DIM` values:
-whether this step's move collided (a bump bit) and the collisions of the last :data:`CONTACT_WINDOW`
-steps / :data:`CONTACT_WINDOW`. The paper's body feels nothing: a low sofa below the view is invisible
-to it, and the stored students fail pushing into such furniture.
+The observation options (:mod:`egosearch.sim.observation_options`: keyword options with no id of their
+own, each a CHANGE OF OBSERVATION, never the paper's) append their values to these vectors, in registration
+order: ``contact_signal=True`` (:mod:`egosearch.sim.contact_signal`, after habitat-lab's ``collisions``
+measure) appends a bump bit and the recent collision count to ``proprio``.
 
 Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.sim.body.AgentSpec`
 (head-off: [dx, dy, dtheta]).
@@ -48,7 +47,6 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections import deque
 from dataclasses import replace
 
 import gymnasium
@@ -59,6 +57,7 @@ from egosearch.scene import layouts as layouts_mod
 from egosearch.scene.objects import TARGET_OBJECTS, get_object
 from egosearch.scene.parts import Part
 from egosearch.scene.placement import sample_target
+from egosearch.sim import observation_options as observation_options_mod
 from egosearch.sim.body import IMAGE_SIZE, AgentSpec, AgentState, check_height
 from egosearch.sim.body_envs import BODY_METADATA, check_flag
 from egosearch.sim.floormap import FloorMap
@@ -95,20 +94,27 @@ FLOOR_MAP_DIM = 3 * FLOOR_MAP_CELLS * FLOOR_MAP_CELLS
 MEMORY_HORIZON = 100
 """Steps since the target was last seen are divided by this (and capped at 1)."""
 PROPRIO_DIM = 4
-CONTACT_WINDOW = 5
-"""Steps over which the ``contact_signal`` option counts the body's collisions."""
-CONTACT_SIGNAL_DIM = 2
-"""Values the ``contact_signal`` option appends to ``proprio``: whether this step's move collided, and the
-collisions of the last :data:`CONTACT_WINDOW` steps / :data:`CONTACT_WINDOW`."""
 
 
 def space_dims(head: bool = True, target_memory: bool = False, floor_map: bool = False,
-               contact_signal: bool = False) -> dict[str, int]:
-    """Sizes of the action and of the observation's vectors for these options, without building an env:
-    what a trained actor must match (``SearchEnv`` builds its spaces from them)."""
+               **observation_options: bool) -> dict[str, int]:
+    """Sizes of the action and of the observation's vectors for these options (the observation options by
+    name, :mod:`egosearch.sim.observation_options`), without building an env: what a trained actor must
+    match (``SearchEnv`` builds its spaces from them)."""
+    check_observation_options(observation_options)
+    extra = observation_options_mod.extra_dims(observation_options)
     mask = MASK_FEATURE_DIM + (TARGET_MEMORY_DIM if target_memory else 0) + (FLOOR_MAP_DIM if floor_map else 0)
-    proprio = PROPRIO_DIM + (CONTACT_SIGNAL_DIM if contact_signal else 0)
-    return {"action": replace(AgentSpec(), head=bool(head)).action_dim, "mask": mask, "proprio": proprio}
+    return {"action": replace(AgentSpec(), head=bool(head)).action_dim, "mask": mask + extra.get("mask", 0),
+            "proprio": PROPRIO_DIM + extra.get("proprio", 0)}
+
+
+def check_observation_options(options: dict) -> None:
+    """One line for a keyword that is no registered observation option, or a value that is no flag."""
+    for name, value in options.items():
+        if name not in observation_options_mod.OPTIONS:
+            known = ", ".join(observation_options_mod.option_names())
+            raise ValueError(f"unknown env option {name!r}; the observation options: {known}")
+        check_flag(name, value)
 
 
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
@@ -170,7 +176,7 @@ class SearchEnv(gymnasium.Env):
                  max_steps: int = MAX_STEPS, objects: tuple[str, ...] | None = None,
                  distance_reward: str = "distance", train_heights: tuple[float, float] | None = None,
                  privileged_state: bool = False, target_memory: bool = False, floor_map: bool = False,
-                 contact_signal: bool = False, coverage_bonus: float = 0.0, render_mode: str | None = None):
+                 coverage_bonus: float = 0.0, render_mode: str | None = None, **observation_options: bool):
         """
         Args:
             layout: a home name (``kitchen_living``, ``bedroom_bath`` or ``home<seed>``).
@@ -189,15 +195,15 @@ class SearchEnv(gymnasium.Env):
             target_memory: append the last-seen target memory to ``mask`` (a change of
                 observation: see the module docstring).
             floor_map: append the egocentric floor map to ``mask`` (a change of observation).
-            contact_signal: append the bump bit and the recent collision count to ``proprio`` (a
-                change of observation: see the module docstring).
             coverage_bonus: training-only reward per step into a floor cell not visited this
                 episode (0: the paper's reward).
             render_mode: ``"rgb_array"`` gives the depth image with the mask in red.
+            observation_options: the observation options turned on, by name (``contact_signal=True``:
+                :mod:`egosearch.sim.observation_options`), each a change of observation.
         """
-        for name, value in (("head", head), ("target_memory", target_memory), ("floor_map", floor_map),
-                            ("contact_signal", contact_signal)):
+        for name, value in (("head", head), ("target_memory", target_memory), ("floor_map", floor_map)):
             check_flag(name, value)
+        check_observation_options(observation_options)
         self.scene = layouts_mod.get_scene(layout)
         self.layout = layout
         self.placement = check_placement(placement)
@@ -236,9 +242,10 @@ class SearchEnv(gymnasium.Env):
         self._rays = pixel_rays_camera(IMAGE_SIZE, IMAGE_SIZE, self.sensor.fov_deg) if self.target_memory else None
         # a coarse map is enough for a 0.6 m summary, and keeps the env step cheap (~1 ms)
         self._floor = FloorMap.for_sensor(self.sensor, pixel_stride=6, free_step=0.15) if floor_map else None
-        self.contact_signal = bool(contact_signal)
-        self._recent_bumps: deque[int] = deque([0] * CONTACT_WINDOW, maxlen=CONTACT_WINDOW)
-        dims = space_dims(head, self.target_memory, floor_map, self.contact_signal)
+        self.observation_options = {name: True for name, on in observation_options.items() if on}
+        """The observation options turned on (name -> True)."""
+        self._options = observation_options_mod.build(self.observation_options)
+        dims = space_dims(head, self.target_memory, floor_map, **self.observation_options)
         observation_spaces = {
             "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
             "mask": spaces.Box(-4.0, 4.0, (dims["mask"],), np.float32),
@@ -279,7 +286,8 @@ class SearchEnv(gymnasium.Env):
         self.collisions = 0
         self.path_length = 0.0
         self._dq = np.zeros(2)
-        self._recent_bumps.extend([0] * CONTACT_WINDOW)
+        for option in self._options:
+            option.reset(self)
         self._memory_point, self._since_seen = None, 0
         self._visited = {self._cell()}
         if self._floor is not None:
@@ -338,7 +346,8 @@ class SearchEnv(gymnasium.Env):
             s.pitch, s.head_yaw = pitch, head_yaw
         s.camera_height = self._camera_height(self.np_random, self.scenario_id < 0)
         self.collisions += int(collided)
-        self._recent_bumps.append(int(collided))
+        for option in self._options:
+            option.moved(self, collided)
         self.steps += 1
         depth, mask = self._sense()
         self._remember(depth, mask)
@@ -405,7 +414,7 @@ class SearchEnv(gymnasium.Env):
         """Everything a later :meth:`restore` needs to continue this episode exactly."""
         return {"state": self.state.copy(), "frames": self._frames.copy(), "steps": self.steps,
                 "collisions": self.collisions, "path_length": self.path_length, "dq": self._dq.copy(),
-                "recent_bumps": tuple(self._recent_bumps), "seen_distance": self._seen_distance,
+                "options": [option.snapshot() for option in self._options], "seen_distance": self._seen_distance,
                 "memory": (None if self._memory_point is None else self._memory_point.copy(), self._since_seen),
                 "visited": set(self._visited),
                 "floor": None if self._floor is None else self._floor.copy_state(),
@@ -417,7 +426,8 @@ class SearchEnv(gymnasium.Env):
         self._frames[:] = snap["frames"]
         self.steps, self.collisions, self.path_length = snap["steps"], snap["collisions"], snap["path_length"]
         self._dq = snap["dq"].copy()
-        self._recent_bumps.extend(snap.get("recent_bumps", (0,) * CONTACT_WINDOW))
+        for option, state in zip(self._options, snap["options"]):
+            option.restore(state)
         self._seen_distance = snap["seen_distance"]
         point, self._since_seen = snap["memory"]
         self._memory_point = None if point is None else point.copy()
@@ -451,17 +461,18 @@ class SearchEnv(gymnasium.Env):
 
     def _observation(self, mask: np.ndarray) -> dict:
         s = self.state
-        proprio = np.zeros(PROPRIO_DIM + (CONTACT_SIGNAL_DIM if self.contact_signal else 0), np.float32)
+        proprio = np.zeros(PROPRIO_DIM, np.float32)
         if self.spec_agent.head:
             proprio[:PROPRIO_DIM] = (s.pitch, s.head_yaw, self._dq[0], self._dq[1])
-        if self.contact_signal:
-            proprio[PROPRIO_DIM:] = (self._recent_bumps[-1], sum(self._recent_bumps) / CONTACT_WINDOW)
         feature = mask_feature(mask).astype(np.float32)
         if self.target_memory:
             feature = np.concatenate([feature, self._memory_feature()])
         if self._floor is not None:
             feature = np.concatenate([feature, self._floor.egocentric(self.state, FLOOR_MAP_CELLS)])
         obs = {"depth": self._frames.copy(), "mask": feature, "proprio": proprio}
+        for option in self._options:
+            for vector, values in option.values(self).items():
+                obs[vector] = np.concatenate([obs[vector], values]).astype(np.float32, copy=False)
         if self.with_state:
             distance = target_distance(s, self.target, self.spec_agent.body_radius)
             obs["state"] = privileged_state(s, self.target, distance, bool(mask.any()))

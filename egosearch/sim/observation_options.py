@@ -1,0 +1,108 @@
+"""The body env's observation options by name: keyword options that change what a policy observes, with no env
+id of their own (no new id per combination of options).
+
+An option is one module with two classes and one :func:`register` line below:
+
+- its option class, a subclass of :class:`ObservationOption`: the values it appends to the observation's
+  vectors (``extra_dims`` and :meth:`ObservationOption.values`), what it keeps over an episode (``reset``,
+  ``moved`` after each step's move, ``snapshot``/``restore`` for the replanner);
+- its settings class, a dataclass with ONE bool field named as the option, its docstring naming the source
+  and saying that it changes the observation (as every config field's does). Every learner's config has the
+  field (:mod:`egosearch.rl.config` composes it with the run settings); a run's config records it in its
+  actor file, and ``egosearch evaluate`` builds the actor's env with it (``--env-option`` overrides it).
+
+``SearchEnv(..., name=True)`` turns an option on; ``egosearch.envs.OBSERVATION_OPTIONS`` lists the names.
+Options and settings are named ``"module:attribute"`` and imported on first use: this module imports nothing
+but the registry helper, so that the config and the workflow can read the names without the simulator."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from egosearch.core.registry import Registry, resolve
+
+
+class ObservationOption:
+    """One option's state in one env. A subclass sets ``extra_dims`` and overrides what it uses; the env
+    calls :meth:`reset` at each reset, :meth:`moved` after each step's move, and appends :meth:`values` to
+    the observation's vectors (in registration order, after the env's own values)."""
+
+    extra_dims: ClassVar[Mapping[str, int]] = {}
+    """Values appended to each observation vector it changes (``{"proprio": 2}``)."""
+
+    def reset(self, env: Any) -> None:
+        """A new episode begins in ``env`` (a :class:`egosearch.sim.env.SearchEnv`)."""
+
+    def moved(self, env: Any, collided: bool) -> None:
+        """``env``'s body has just moved this step; ``collided``: whether the move hit something."""
+
+    def values(self, env: Any) -> Mapping[str, Any]:
+        """The values to append, per vector: ``{"proprio": array of extra_dims["proprio"] float32 values}``."""
+        return {}
+
+    def snapshot(self) -> Any:
+        """What :meth:`restore` needs to continue the episode exactly (the replanner's snapshots)."""
+        return None
+
+    def restore(self, state: Any) -> None:
+        """Back to a :meth:`snapshot`."""
+
+
+@dataclass(frozen=True)
+class RegisteredOption:
+    """One registered option: its ``name`` (the env keyword and the config field), its option class and its
+    settings class (each the class or ``"module:Class"``)."""
+
+    name: str
+    option: str | Callable[[], ObservationOption]
+    settings: str | type
+
+    def option_class(self) -> type[ObservationOption]:
+        return resolve(self.option)
+
+    def settings_class(self) -> type:
+        return resolve(self.settings)
+
+
+_REGISTRY: Registry[RegisteredOption] = Registry("observation option")
+OPTIONS: dict[str, RegisteredOption] = _REGISTRY.entries
+"""Every registered observation option by name, in registration order."""
+
+
+def register(name: str, option: str | Callable[[], ObservationOption], settings: str | type, *,
+             replace: bool = False) -> RegisteredOption:
+    """Register an observation option (see the module docstring); a name already taken needs ``replace``."""
+    return _REGISTRY.add(name, RegisteredOption(name, option, settings), replace=replace)
+
+
+def unregister(name: str) -> RegisteredOption:
+    """Remove a registered option (a test's own, after it)."""
+    return _REGISTRY.remove(name)
+
+
+def option_names() -> tuple[str, ...]:
+    """The registered option names, in registration order."""
+    return _REGISTRY.names()
+
+
+def extra_dims(on: Mapping[str, Any]) -> dict[str, int]:
+    """The values the options turned on in ``on`` (name -> truthy) append, summed per vector."""
+    out: dict[str, int] = {}
+    for name, entry in OPTIONS.items():
+        if on.get(name):
+            for vector, n in entry.option_class().extra_dims.items():
+                out[vector] = out.get(vector, 0) + int(n)
+    return out
+
+
+def build(on: Mapping[str, Any]) -> list[ObservationOption]:
+    """Fresh option states for the options turned on in ``on``, in registration order."""
+    return [entry.option_class()() for name, entry in OPTIONS.items() if on.get(name)]
+
+
+# ---- the options ---------------------------------------------------------------------------------
+
+register("contact_signal", "egosearch.sim.contact_signal:ContactSignal",
+         "egosearch.sim.contact_signal:ContactSignalSettings")
