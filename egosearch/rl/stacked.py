@@ -52,7 +52,7 @@ from torch.func import functional_call, vmap
 
 from egosearch.rl.common import METRIC_KEYS, crop_at, submodule
 from egosearch.rl.cuda_graph import GraphedUpdate
-from egosearch.rl.registry import stacked_algorithms
+from egosearch.rl.registry import learner, stacked_algorithms
 from egosearch.rl.sac_curl import (
     SacCurlAgent,
     crop_offsets,
@@ -132,10 +132,12 @@ def check_stackable(cfg: Any) -> None:
     stackable = stacked_algorithms()
     if cfg.algorithm not in stackable:
         raise StackingError(f"algorithm {cfg.algorithm} is not stacked; stacked: {', '.join(stackable)}")
-    if cfg.algorithm == "sac_curl" and (cfg.share_encoder_forward or cfg.compile):
-        raise StackingError("SAC+CURL with share_encoder_forward or compile is not stacked")
-    if cfg.algorithm == "sac_drq" and cfg.encoder_aux_loss != "none":
-        raise StackingError("SAC-DrQ's reconstruction decoder (encoder_aux_loss) is not stacked")
+    kind = STACKED.get(learner(cfg.algorithm).agent_factory())
+    if kind is None:
+        raise StackingError(f"algorithm {cfg.algorithm} is registered as stacked but has no stacked update here")
+    refusal = kind.refusal(cfg)
+    if refusal:
+        raise StackingError(refusal)
 
 
 # ---- stacked parameters -------------------------------------------------------------------
@@ -188,6 +190,11 @@ class StackedAgents:
     paths: ClassVar[tuple[str, ...]]
     draw_keys: ClassVar[tuple[str, ...]]
     """The keys :meth:`draw` returns (always all of them: a recorded update needs fixed inputs)."""
+
+    @classmethod
+    def refusal(cls, cfg: Any) -> str | None:
+        """Why a config of this learner cannot be stacked (an option the stacked update lacks), or None."""
+        return None
 
     def __init__(self, members: list[Any], streams: SeedStreams):
         if len(members) < 1 or len(streams.states) != len(members):
@@ -364,6 +371,12 @@ class StackedSacCurl(StackedAgents):
              "critic_target.proj", "critic_target.q1", "critic_target.q2", "actor")
     draw_keys = ("anchor_oy", "anchor_ox", "next_oy", "next_ox", "pos_oy", "pos_ox", "noise_next", "noise_pi")
 
+    @classmethod
+    def refusal(cls, cfg: Any) -> str | None:
+        if cfg.share_encoder_forward or cfg.compile:
+            return "SAC+CURL with share_encoder_forward or compile is not stacked"
+        return None
+
     def __init__(self, members: list[SacCurlAgent], streams: SeedStreams):
         if any(getattr(m, "impl", "fast") != "fast" for m in members):
             raise StackingError("only SAC+CURL's fast update is stacked (impl='reference' is its oracle)")
@@ -454,6 +467,12 @@ class StackedSacDrq(StackedAgents):
     member_type = SacDrqAgent
     paths = ("encoder", "critic", "critic_target", "actor")
     draw_keys = ("obs_oy", "obs_ox", "next_oy", "next_ox", "noise_next", "noise_pi")
+
+    @classmethod
+    def refusal(cls, cfg: Any) -> str | None:
+        if cfg.encoder_aux_loss != "none":
+            return "SAC-DrQ's reconstruction decoder (encoder_aux_loss) is not stacked"
+        return None
 
     def __init__(self, members: list[SacDrqAgent], streams: SeedStreams):
         super().__init__(members, streams)
