@@ -14,7 +14,7 @@ import pytest
 import torch
 
 from egosearch.rl.actor import ActorPolicy, AgentPolicy, load_any_actor_net
-from egosearch.rl.common import METRIC_KEYS, AgentStateError
+from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.learner import ActorFileNet, Agent, AgentBase
 from egosearch.rl.registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
@@ -24,78 +24,34 @@ TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
 from test_rl_fake_env import FAKE_ENV_ID, register_fake_envs  # noqa: E402
 
+sys.path.insert(0, str(TESTS / "extensions"))
+from toy_bc import ToyActorNet, ToyBcAgent, load_actor_net  # noqa: E402
+
 register_fake_envs()
 
 TOY_AGENT_FORMAT, TOY_ACTOR_FORMAT = "toy-agent-v1", "toy-actor-v1"
 
 
-class ToyActorNet(torch.nn.Module):
-    """A linear policy on [mask, proprio] (it ignores depth), called as an actor file's network is
-    (``egosearch.rl.learner.ActorFileNet``): ``(depth, extra) -> (mean before the tanh, None)``."""
-
-    def __init__(self, extra_dim: int, action_dim: int):
-        super().__init__()
-        self.fc = torch.nn.Linear(extra_dim, action_dim)
-
-    def forward(self, depth: torch.Tensor | None, extra: torch.Tensor) -> tuple[torch.Tensor, None]:
-        return self.fc(extra), None
-
-
 def load_toy_actor_net(state: dict, device) -> ToyActorNet:
-    net = ToyActorNet(state["arch"]["extra_dim"], state["arch"]["action_dim"])
-    net.load_state_dict(state["state_dict"])
-    return net.to(device).eval()
+    return load_actor_net(state, device)
 
 
-class ToyAgent(AgentBase):
-    """Behaviour cloning of the replay's own actions: the smallest learner the loop can drive."""
+class ToyAgent(ToyBcAgent):
+    """Behaviour cloning of the replay's own actions (the extension test's toy learner, under this test's own
+    formats and name), counting the batches it is given."""
 
-    def __init__(self, cfg, action_dim: int, mask_dim: int, proprio_dim: int, device=None, state_dim: int = 0):
-        self.cfg = cfg.validate()
-        # an ActorArch's sizes and nothing else: no crop_size, so a policy hands it whole frames
-        self.arch = {"action_dim": action_dim, "extra_dim": mask_dim + proprio_dim}
-        self.net = ToyActorNet(mask_dim + proprio_dim, action_dim)
-        self.opt = torch.optim.SGD(self.net.parameters(), lr=0.01)
-        self.num_updates = 0
+    agent_format, actor_format = TOY_AGENT_FORMAT, TOY_ACTOR_FORMAT
+
+    def __init__(self, *args, **kwargs):
         self.batch_sizes: list[int] = []
+        super().__init__(*args, **kwargs)
 
-    @property
-    def alpha(self) -> float:
-        return 0.0
-
-    def act(self, obs: dict, deterministic: bool = False) -> np.ndarray:
-        extra = torch.as_tensor(np.concatenate([obs["mask"], obs["proprio"]]), dtype=torch.float32)
-        with torch.no_grad():
-            a = torch.tanh(self.net(None, extra)[0])
-            if not deterministic:
-                a = (a + 0.3 * torch.randn_like(a)).clamp(-1.0, 1.0)
-        return a.numpy()
+    def learning_rate(self) -> float:
+        return 0.01  # registered without settings of its own
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]:
-        self.num_updates += 1
         self.batch_sizes.append(int(batch["action"].shape[0]))
-        mean, _ = self.net(None, torch.cat([batch["mask"], batch["proprio"]], -1))
-        loss = (torch.tanh(mean) - batch["action"]).pow(2).mean()
-        self.opt.zero_grad()
-        loss.backward()
-        self.opt.step()
-        return {**dict.fromkeys(METRIC_KEYS, float("nan")), "critic_loss": float(loss.detach()), "alpha": 0.0}
-
-    def state_dict(self) -> dict:
-        return {"format": TOY_AGENT_FORMAT, "net": self.net.state_dict(), "opt": self.opt.state_dict(),
-                "num_updates": self.num_updates}
-
-    def load_state_dict(self, state: dict) -> None:
-        if state.get("format") != TOY_AGENT_FORMAT:
-            raise AgentStateError("not a toy agent state")
-        self.net.load_state_dict(state["net"])
-        self.opt.load_state_dict(state["opt"])
-        self.num_updates = int(state["num_updates"])
-
-    def actor_state(self, metadata: dict | None = None) -> dict:
-        weights = {k: v.detach().clone() for k, v in self.net.state_dict().items()}
-        return {"format": TOY_ACTOR_FORMAT, "arch": dict(self.arch), "state_dict": weights,
-                "metadata": dict(metadata or {})}
+        return super().update(batch)
 
 
 TOY = "registry_test_toy"

@@ -44,14 +44,20 @@ def load_actor_net(state: dict, device) -> ToyActorNet:
 
 
 class ToyBcAgent(AgentBase):
-    """The smallest learner the training loop can drive."""
+    """The smallest learner the training loop can drive (tests/test_rl_registry.py's toy is one too)."""
+
+    agent_format, actor_format = AGENT_FORMAT, ACTOR_FORMAT
 
     def __init__(self, cfg, action_dim: int, mask_dim: int, proprio_dim: int, device=None, state_dim: int = 0):
         self.cfg = cfg.validate()
+        # an ActorArch's sizes and nothing else: no crop_size, so a policy hands it whole frames
         self.arch = {"action_dim": action_dim, "extra_dim": mask_dim + proprio_dim}
         self.net = ToyActorNet(mask_dim + proprio_dim, action_dim)
-        self.opt = torch.optim.SGD(self.net.parameters(), lr=cfg.toy_bc_lr)
+        self.opt = torch.optim.SGD(self.net.parameters(), lr=self.learning_rate())
         self.num_updates = 0
+
+    def learning_rate(self) -> float:
+        return self.cfg.toy_bc_lr
 
     @property
     def alpha(self) -> float:
@@ -75,17 +81,17 @@ class ToyBcAgent(AgentBase):
         return {**dict.fromkeys(METRIC_KEYS, float("nan")), "critic_loss": float(loss.detach()), "alpha": 0.0}
 
     def state_dict(self) -> dict:
-        return {"format": AGENT_FORMAT, "net": self.net.state_dict(), "opt": self.opt.state_dict(),
+        return {"format": self.agent_format, "net": self.net.state_dict(), "opt": self.opt.state_dict(),
                 "num_updates": self.num_updates}
 
     def load_state_dict(self, state: dict) -> None:
-        if state.get("format") != AGENT_FORMAT:
-            raise AgentStateError("not a toy-bc agent state")
+        if state.get("format") != self.agent_format:
+            raise AgentStateError(f"not a {self.agent_format} agent state")
         self.net.load_state_dict(state["net"])
         self.opt.load_state_dict(state["opt"])
         self.num_updates = int(state["num_updates"])
 
     def actor_state(self, metadata: dict | None = None) -> dict:
         weights = {k: v.detach().clone() for k, v in self.net.state_dict().items()}
-        return {"format": ACTOR_FORMAT, "arch": dict(self.arch), "state_dict": weights,
+        return {"format": self.actor_format, "arch": dict(self.arch), "state_dict": weights,
                 "metadata": dict(metadata or {})}
