@@ -377,7 +377,8 @@ class SacCurlAgent(SacMixin, AgentBase):
         early_key = do_curl and (share or not do_polyak)  # key encoder weights = those of the target pass
         extra, next_extra, action, reward, not_done = self._batch_parts(batch)
         anchor_u8, next_u8, pos_u8 = self._crops(batch)
-        anchor, nxt, pos = self._to_float(anchor_u8), self._to_float(next_u8), self._to_float(pos_u8)
+        anchor, nxt = self._to_float(anchor_u8), self._to_float(next_u8)
+        pos = self._to_float(pos_u8) if do_curl else None  # only CURL's key reads the positives
         noise_next = torch.randn((anchor.shape[0], self.action_dim), device=self.device)
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
