@@ -80,9 +80,9 @@ def test_a_profile_sets_the_fields_a_learner_has_and_leaves_the_others():
     cfg = load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "n_step": 1, "update_every": 16,
                               "replay_capacity": 1000})
     assert cfg.obs_downsample == CPU["obs_downsample"] and not hasattr(cfg, "aug_pad")
-    assert (cfg.demo_episodes, cfg.bc_weight, cfg.critic_warmup_updates) == (0, 0.0, 0)  # their defaults
+    assert not hasattr(cfg, "demo_episodes") and not hasattr(cfg, "critic_warmup_updates")  # no such aid
     assert cfg.critic_privileged_state == CPU["critic_privileged_state"]  # PPO's value network reads it
-    with pytest.raises(ValueError, match=r"demo_episodes=10 is out of range; allowed: 0 for algorithm ppo"):
+    with pytest.raises(ValueError, match=r"algorithm ppo .* has no field 'demo_episodes' \(a setting of sac_drq\)"):
         load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "update_every": 16, "demo_episodes": 10})
     assert not hasattr(cfg, "alpha_lr")  # the cpu profile's temperature rate: PPO has no temperature
     for profile in PROFILES:
@@ -106,7 +106,7 @@ def test_a_learner_registered_without_settings_has_the_run_settings_alone():
         assert set(cfg.to_dict()) == SHARED
         # at the cpu profile too, with nothing pinned: the profile's demonstrations and privileged critic are
         # for the learners that read them
-        assert not load_config("cpu", {"algorithm": "toy_settingless"}).critic_privileged_state
+        assert not hasattr(load_config("cpu", {"algorithm": "toy_settingless"}), "critic_privileged_state")
         with pytest.raises(ValueError, match="has no field 'actor_lr'"):
             load_config("smoke", {"algorithm": "toy_settingless", "actor_lr": 1e-3})
     finally:
@@ -132,7 +132,8 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
         module, klass = row["declared_in"].rsplit(".", 1)
         assert f"    {row['field']}:" in inspect.getsource(getattr(importlib.import_module(module), klass)), row
     ppo = {r["field"]: r for r in config_sources("ppo", "cpu", {"init_steps": 0, "update_every": 16, "n_step": 1})}
-    assert (ppo["demo_episodes"]["value"], ppo["demo_episodes"]["source"]) == ("0", "default (unread)")
+    # PPO opts into one training aid, not the other
+    assert "demo_episodes" not in ppo and ppo["critic_privileged_state"]["source"] == "profile cpu"
     paper = {r["field"]: r for r in config_sources("sac_drq", "paper")}
     assert (paper["total_env_steps"]["value"], paper["total_env_steps"]["source"]) == ("750000", "default")
     varied = {r["field"]: r
@@ -148,3 +149,53 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
     assert main(["config", "show", "sac_curl", "--variant", "head_on_ppo"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith("--variant head_on_ppo trains algorithm ppo, not sac_curl: show that one")
+
+
+def test_a_training_aid_is_a_piece_its_learners_opt_into_and_is_listed_where_it_always_was():
+    """The demonstrations and the privileged critic (rl/training_aids.py) are fields only of the learners whose
+    settings name them; a variant that turns them off means, for a learner without them, what it already is;
+    one that turns them on is refused there; and their fields are listed after the run setting each names."""
+    from egosearch.rl.training_aids import (
+        TRAINING_AIDS,
+        DemonstrationSettings,
+        PrivilegedCriticSettings,
+        critic_reads_state,
+        demonstration_settings,
+    )
+
+    has = {name: {aid for aid in TRAINING_AIDS if issubclass(config_class(name), aid)} for name in SHIPPED}
+    assert has == {"sac_curl": set(), "sac_drq": set(TRAINING_AIDS), "sac_drq_recurrent": {PrivilegedCriticSettings},
+                   "ppo": {PrivilegedCriticSettings}}
+    aid_fields = {f.name for aid in TRAINING_AIDS for f in dataclasses.fields(aid)}
+    assert not aid_fields & SHARED and not aid_fields & set(own_settings("sac_curl"))
+    # off for a learner without it: accepted and dropped; on: one line naming the learners that have it
+    curl = load_config("cpu", {"algorithm": "sac_curl", "demo_episodes": 0, "critic_privileged_state": False})
+    assert not hasattr(curl, "demo_episodes")
+    assert demonstration_settings(curl) == DemonstrationSettings() and not critic_reads_state(curl)
+    with pytest.raises(ValueError, match="has no field 'critic_privileged_state' \\(a setting of sac_drq, "):
+        load_config("cpu", {"algorithm": "sac_curl", "critic_privileged_state": True})
+    drq = load_config("cpu")
+    assert demonstration_settings(drq) is drq and critic_reads_state(drq)
+    # listed right after the run setting each names, whatever class declares them
+    order, run = field_order(), [f.name for f in dataclasses.fields(RunSettings)]
+    for aid in TRAINING_AIDS:
+        names = [f.name for f in dataclasses.fields(aid)]
+        assert aid.shown_after in run
+        start = order.index(aid.shown_after) + 1
+        assert list(order[start:start + len(names)]) == names, aid.__name__
+
+
+def test_the_config_page_is_what_the_settings_say():
+    """docs/config.md is generated (`egosearch config page`): every learner's fields on one page, so one file
+    reads a learner's whole config; it changes with a field or a docstring, never by hand."""
+    from pathlib import Path
+
+    from egosearch.rl.config_page import CONFIG_PAGE, config_page
+
+    page = config_page()
+    stored = (Path(__file__).resolve().parent.parent / CONFIG_PAGE).read_text(encoding="utf-8")
+    assert stored == page, "docs/config.md is stale: run `egosearch config page`"
+    for name in SHIPPED:  # a learner's section lists exactly its own fields, after the shared ones
+        section = page.split(f"(`algorithm: {name}`)")[1].split("\n## ")[0]
+        assert [line.split("`")[1] for line in section.splitlines() if line.startswith("| `")] == list(
+            own_settings(name))

@@ -19,6 +19,7 @@ from egosearch.rl.config import load_config
 from egosearch.rl.learner import ActorFileNet, Agent, AgentBase
 from egosearch.rl.registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
 from egosearch.rl.train import train
+from egosearch.rl.training_aids import DemonstrationSettings
 
 TESTS = Path(__file__).parent
 sys.path.insert(0, str(TESTS))
@@ -177,7 +178,7 @@ def test_every_registered_learner_is_an_agent_and_writes_a_registered_actor_form
     # behaviour cloning: the hooks of a learner that learns from demonstrations; every other learner refuses
     # them in one line (AgentBase's)
     assert agent.bc_weight_now == 0.0
-    if cfg.learns_from_demonstrations:
+    if isinstance(cfg, DemonstrationSettings):
         assert len(agent.clone_parameters()) > 0
     else:
         with pytest.raises(NotImplementedError, match="does not learn from demonstrations"):

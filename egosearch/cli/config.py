@@ -1,5 +1,6 @@
 """``egosearch config show ALGORITHM``: a learner's whole config in one place, each field with its value,
-where the value comes from and the file that declares it."""
+where the value comes from and the file that declares it. ``egosearch config page``: every learner's, as
+docs/config.md (:mod:`egosearch.rl.config_page`)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,18 @@ from egosearch.rl.config import config_sources
 
 
 def run(args) -> None:
+    if args.action == "page":
+        from pathlib import Path
+
+        from egosearch.cli.checks import check_suffix
+        from egosearch.core.outputs import check_outputs
+        from egosearch.rl.config_page import config_page
+
+        check_suffix("--out", args.out, (".md",), "a Markdown page")
+        check_outputs(files={"--out": args.out})
+        Path(args.out).write_text(config_page(), encoding="utf-8")
+        print(f"wrote {args.out}")
+        return
     overrides, name = {}, ""
     if args.variant:
         # local: reading a variant file checks it against the learner fields (one line for a bad one)

@@ -141,6 +141,9 @@ def add_config(sub) -> None:
     show.add_argument("--profile", default="cpu", choices=list(PROFILES),
                       help="learner profile: smoke, cpu or paper (default: cpu)")
     show.add_argument("--variant", help="a file stem in ablations/ whose config overrides are shown on top")
+    about_page = "write docs/config.md: every learner's fields, paper and cpu values, declaring class and docstring"
+    page = actions.add_parser("page", help=about_page, description=about_page)
+    page.add_argument("--out", default="docs/config.md", metavar="FILE.md", help="where (default: docs/config.md)")
 
 
 def add_tune(sub) -> None:

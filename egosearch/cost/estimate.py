@@ -264,7 +264,7 @@ class _Pricing:
             seconds = steps * per_step if per_step else float("nan")
             where = f"the stored trainings' machines (their CPU time per env step, {config.env_step_unit})"
         teacher = ""
-        if config.demo_episodes:
+        if getattr(config, "demo_episodes", 0):  # a learner without demonstrations has no such field
             # the rates above are the RL phase's: a training that learns from the classical searcher first
             # runs its episodes and clones them (training_time_line adds them the same way)
             extra = teacher_cost_s(config, self.results, self.bench, rate) if rate else None

@@ -50,6 +50,7 @@ from egosearch.rl.config import DECISIONS, LearnerConfig, load_config
 from egosearch.rl.registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.train import torch_threads, train
+from egosearch.rl.training_aids import DemonstrationSettings, critic_reads_state, demonstration_settings
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
 from egosearch.sim.home_pool import curve_homes
@@ -103,7 +104,7 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, agent_op
         cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
         torch.manual_seed(0)
         device = resolve_device(cfg.device)
-        state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+        state_dim = PRIVILEGED_STATE_DIM if critic_reads_state(cfg) else 0
         agent = make_agent(cfg, action_dim, 30, 4, device, state_dim, **(agent_options or {}))
         replay = _filled_replay(action_dim, device, size=agent.replay_image_size, state_dim=state_dim)
         sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
@@ -131,12 +132,14 @@ def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds:
     (``critic_warmup_updates`` 0) so that every update is a whole one, actor and temperature included."""
     from egosearch.rl.stacked import SeedStreams, stack_agents
 
-    cfg = load_config(profile, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
+    cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
+    if isinstance(cfg, DemonstrationSettings):
+        cfg = load_config(profile, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
     before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
     try:
         device = resolve_device(cfg.device)
-        state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+        state_dim = PRIVILEGED_STATE_DIM if critic_reads_state(cfg) else 0
         streams, separate, members, replays = SeedStreams(device), [], [], []
         for seed in range(seeds):
             for agents in (separate, members):
@@ -183,7 +186,7 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
     full = load_config(profile, overrides)
     short = {"total_env_steps": env_steps, "init_steps": overrides.get("init_steps", max(1, env_steps // 10)),
              "eval_every": env_steps, "checkpoint_every": env_steps, "log_every": env_steps}
-    if full.demo_episodes:
+    if demonstration_settings(full).demo_episodes:
         # A profile that learns from the classical searcher first: the stored rates count its RL phase
         # alone (egosearch.cost.rates), so this run does too. A few demonstrations fill the replay's demo
         # half (an update costs the same whatever they hold), the cloning is cut to a token, the critic's
@@ -304,7 +307,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
         return None
     cfg = load_config(profile, {**(overrides or {}), "device": "cuda"})
     torch.manual_seed(0)
-    state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
+    state_dim = PRIVILEGED_STATE_DIM if critic_reads_state(cfg) else 0
     agent = make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim)
     replay = _filled_replay(5, torch.device("cuda"), size=agent.replay_image_size, state_dim=state_dim)
     batches = [replay.sample(cfg.batch_size) for _ in range(updates + 6)]

@@ -2,9 +2,10 @@
 the profiles (smoke, cpu, paper); and Table 2, generated from a config.
 
 A training's config is :class:`LearnerConfig`: the :class:`egosearch.rl.run_settings.RunSettings` (env
-steps, envs, evaluation, checkpoints, device, demonstrations, the observation's options, ...) and the
-settings class registered with its learner in :mod:`egosearch.rl.registry` (SAC + CURL's
-:mod:`egosearch.rl.sac_curl_settings`, SAC-DrQ's :mod:`egosearch.rl.sac_drq_settings`, ...), composed
+steps, envs, evaluation, checkpoints, device, ...), the observation options' fields, and the settings class
+registered with its learner in :mod:`egosearch.rl.registry` (SAC + CURL's
+:mod:`egosearch.rl.sac_curl_settings`, SAC-DrQ's :mod:`egosearch.rl.sac_drq_settings`, ..., with the
+training aids it opts into, :mod:`egosearch.rl.training_aids`), composed
 into one flat dataclass per learner (``LearnerConfig(algorithm="sac_drq")`` is a ``SacDrqConfig``). A
 learner reads its own fields and the shared ones, and has no other: a value for a field its learner does
 not have is one ``ValueError`` naming the field, the learner and the fields it has, raised when the config
@@ -43,10 +44,10 @@ from egosearch.rl.run_settings import (
     CURRICULUM_END_RADIUS,
     CURRICULUM_START_RADIUS,
     DECISIONS,
-    DEMO_TEACHERS,
     DISTANCE_REWARDS,
     RunSettings,
 )
+from egosearch.rl.training_aids import DEMO_TEACHERS, TRAINING_AIDS
 from egosearch.sim.observation_options import OPTIONS
 
 DEFAULT_ALGORITHM: str = RunSettings.algorithm
@@ -71,11 +72,14 @@ def shared_fields() -> tuple[str, ...]:
 
 def field_order() -> tuple[str, ...]:
     """The order fields are shown in (the departures from the paper in the generated Table 2 pages,
-    ``egosearch config show``): the run settings' as declared (Table 2's observation and data first), the
-    observation options', then each building block's and each registered learner's own, as declared. A new
-    field has its place where it is written; no list to keep."""
-    names = [f.name for klass in settings_classes() for f in fields(klass) if klass is RunSettings or
-             f.name not in {g.name for g in fields(RunSettings)}]
+    ``egosearch config show``): the run settings' as declared (Table 2's observation and data first), each
+    training aid's right after the run-settings field it names (its ``shown_after``), the observation
+    options', then each building block's and each registered learner's own, as declared. A new field has its
+    place where it is written; no list to keep."""
+    names = []
+    for name in (f.name for f in fields(RunSettings)):
+        names += [name, *(f.name for aid in TRAINING_AIDS if aid.shown_after == name for f in fields(aid))]
+    names += [f.name for klass in settings_classes() for f in fields(klass)]
     return tuple(dict.fromkeys(names))
 
 
@@ -149,9 +153,8 @@ _ALGORITHM_OF: dict[type, str] = {}
 
 @functools.cache
 def _composed(algorithm: str, settings: type | None, options: tuple[type, ...]) -> type[LearnerConfig]:
-    # the learner's own settings first, so that its class variables (privileged_critic, ...) win over the
-    # run settings' defaults; fields still come run settings first, then the observation options' (dataclasses
-    # collect them base-most first)
+    # fields come run settings first, then the observation options', then the learner's own settings' (with
+    # the training aids it opts into): dataclasses collect them base-most first
     bases = (*(() if settings is None else (settings,)), *options, LearnerConfig)
     name = "".join(part.capitalize() for part in algorithm.split("_")) + "Config"
     klass = dataclasses.make_dataclass(name, [("algorithm", "str", dataclasses.field(default=algorithm))],
@@ -179,10 +182,10 @@ def own_settings(algorithm: str) -> tuple[str, ...]:
 
 
 def settings_classes() -> list[type]:
-    """Every settings class: the run settings, the observation options', the building blocks and each
-    registered learner's own."""
+    """Every settings class: the run settings, the training aids, the observation options', the building blocks
+    and each registered learner's own."""
     own = [entry.settings_class() for entry in LEARNERS.values()]
-    classes = [RunSettings, *option_settings(), *_BUILDING_BLOCKS, *(k for k in own if k is not None)]
+    classes = [RunSettings, *TRAINING_AIDS, *option_settings(), *_BUILDING_BLOCKS, *(k for k in own if k is not None)]
     return list(dict.fromkeys(classes))
 
 
@@ -199,7 +202,17 @@ def field_types() -> dict[str, str]:
 def refuse_foreign_fields(algorithm: str, values: dict[str, Any]) -> None:
     """One line (a ``ValueError``) for the first field of ``values`` that the learner ``algorithm`` does not
     have (a variant file's ``config`` is checked so when it is read)."""
-    _refuse_foreign(config_class(algorithm), values)
+    klass = config_class(algorithm)
+    _refuse_foreign(klass, _without_aids_left_off(klass, values))
+
+
+def _without_aids_left_off(klass: type[LearnerConfig], values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` less the training aids' fields that ``klass``'s learner does not have and that ``values`` set to
+    their defaults (the aid off): a variant that turns the cpu profile's aids off (``head_on_from_scratch``)
+    asks, at a profile whose learner has none (smoke's SAC+CURL), for what that learner already is."""
+    own = {f.name for f in fields(klass)}
+    off = {f.name: f.default for aid in TRAINING_AIDS for f in fields(aid) if f.name not in own}
+    return {k: v for k, v in values.items() if k not in off or v != off[k]}
 
 
 def _refuse_foreign(klass: type[LearnerConfig], values: dict[str, Any]) -> None:
@@ -224,26 +237,20 @@ def _refuse_foreign(klass: type[LearnerConfig], values: dict[str, Any]) -> None:
 def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> LearnerConfig:
     """The config of ``profile`` with ``overrides`` on top, validated.
 
-    A profile is for every learner: the learner takes the profile's values of the fields it reads (the
-    demonstration fields only where it ``learns_from_demonstrations``, ``critic_privileged_state`` only where
-    it has a ``privileged_critic``; the others keep their defaults, so a learner pins nothing it does not use).
-    An override of a field the learner does not have, an unknown profile or field name and an out-of-range
-    value are one-line ``ValueError``s.
+    A profile is for every learner: the learner takes the profile's values of the fields it has (the
+    demonstration fields and ``critic_privileged_state`` only where its settings include those training aids,
+    :mod:`egosearch.rl.training_aids`), so a learner pins nothing it does not use.
+    An override of a field the learner does not have (but a training aid's set to its default, off), an
+    unknown profile or field name and an out-of-range value are one-line ``ValueError``s.
     """
     if profile not in PROFILES:
         raise ValueError(f"unknown profile {profile!r}; allowed: {', '.join(PROFILES)}")
     base, overrides = PROFILES[profile](), dict(overrides or {})
     klass = config_class(overrides.get("algorithm", base.get("algorithm", DEFAULT_ALGORITHM)))
+    overrides = _without_aids_left_off(klass, overrides)
     _refuse_foreign(klass, overrides)
-    own = {f.name for f in fields(klass)} - set(unread_settings(klass))
+    own = {f.name for f in fields(klass)}
     return klass(**{**{k: v for k, v in base.items() if k in own}, **overrides}).validate()
-
-
-def unread_settings(klass: type) -> tuple[str, ...]:
-    """The run settings a learner's config class has but never reads: the demonstration fields without
-    ``learns_from_demonstrations``, ``critic_privileged_state`` without a ``privileged_critic``."""
-    unread = () if klass.learns_from_demonstrations else RunSettings.DEMONSTRATION_FIELDS
-    return unread + (() if klass.privileged_critic else ("critic_privileged_state",))
 
 
 # ---- Table 2 --------------------------------------------------------------------------------
@@ -366,7 +373,6 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
     overrides = {**(variant_overrides or {}), "algorithm": algorithm}
     cfg = load_config(profile, overrides)
     base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
-    unread = set(unread_settings(type(cfg)))
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
@@ -374,8 +380,6 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
             source = f"variant {variant}".strip()
         elif name == "algorithm":
             source = "asked"
-        elif name in unread:
-            source = "default (unread)"
         elif name in base:
             source = f"profile {profile}"
         else:
@@ -394,5 +398,4 @@ __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "
            "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PROFILES",
            "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
            "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "load_config",
-           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows",
-           "unread_settings"]
+           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]

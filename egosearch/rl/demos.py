@@ -39,6 +39,7 @@ from egosearch.rl.pooled import pool_depth, pooled_side
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.run_files import atomic_json
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
 from egosearch.sim.scenarios import MAX_STEPS
@@ -49,7 +50,7 @@ training curve's evaluation episodes (``rl.train.EVAL_SEED_BASE`` + i); Table 1'
 episodes by stored start poses and targets, not by seeds."""
 DEMO_FORMAT = "egosearch-demos-v1"
 TEACHERS = {"frontier": FrontierPolicy, "frontier_tuned": FrontierTunedPolicy}
-"""``LearnerConfig.demo_teacher`` -> the searcher class (``egosearch.rl.config.DEMO_TEACHERS`` names the same)."""
+"""``DemonstrationSettings.demo_teacher`` -> the searcher class (``training_aids.DEMO_TEACHERS`` names the same)."""
 
 
 class DemonstrationsError(ValueError):
@@ -78,9 +79,10 @@ def wanted_summary(env_id: str, cfg: LearnerConfig, env_kwargs: dict, variant: s
     """What the summary of the demonstrations that ``cfg`` collects (a training's: its seed and
     ``demo_episodes`` unless given) in ``env_id`` says, as JSON reads it back: the :data:`MATCHED` entries."""
     wanted = {"env_id": observed_env_id(env_id, cfg.target_memory, cfg.modular_searcher),
-              "env_kwargs": json.loads(json.dumps(train_env_kwargs(cfg, env_kwargs))), "teacher": cfg.demo_teacher,
+              "env_kwargs": json.loads(json.dumps(train_env_kwargs(cfg, env_kwargs))),
+              "teacher": demonstration_settings(cfg).demo_teacher,
               "seed": cfg.seed if seed is None else seed,
-              "episodes": cfg.demo_episodes if episodes is None else episodes,
+              "episodes": demonstration_settings(cfg).demo_episodes if episodes is None else episodes,
               "frame_history": cfg.frame_history, "image_size": stored_side(cfg)}
     return wanted if variant is None else {"variant": variant, **wanted}
 
@@ -145,20 +147,20 @@ def summary_path(replay_path: str | Path) -> Path:
 
 def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, episodes: int, out_path: str | Path,
                            seed: int = 0, progress: bool = True, variant: str | None = None) -> dict[str, Any]:
-    """Run the teacher ``cfg.demo_teacher`` for ``episodes`` training-side episodes of ``env_id`` under
+    """Run the teacher ``demo_teacher`` of ``cfg`` for ``episodes`` training-side episodes of ``env_id`` under
     ``cfg``'s training env settings and the variant's ``env_kwargs``; store its transitions at ``out_path``
     (``*.replay.npz``) and return the summary written beside it (:func:`summary_path`), which names
     ``variant`` when given."""
     if episodes < 1:
         raise ValueError(f"episodes={episodes}; allowed: >= 1")
-    out_path = Path(out_path)
+    out_path, teacher_name = Path(out_path), demonstration_settings(cfg).demo_teacher
     observed = observed_env_id(env_id, cfg.target_memory, cfg.modular_searcher)
     env = make_train_env(observed, train_env_kwargs(cfg, env_kwargs))
     cpu0, wall0 = time.process_time(), time.perf_counter()
     try:
         obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * seed)
         side = stored_side(cfg)
-        state_dim = int(np.asarray(obs["state"]).shape[0]) if cfg.critic_privileged_state else 0
+        state_dim = int(np.asarray(obs["state"]).shape[0]) if critic_reads_state(cfg) else 0
         action_dim = int(env.action_space.shape[0])
         buffer = ReplayBuffer(episodes * MAX_STEPS, side, cfg.frame_history, int(np.asarray(obs["mask"]).shape[0]),
                               int(np.asarray(obs["proprio"]).shape[0]), action_dim, seed=seed, state_dim=state_dim)
@@ -167,7 +169,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
         for episode in range(episodes):
             if episode:
                 obs, _ = env.reset(seed=DEMO_SEED_BASE + 100_000 * seed + episode)
-            teacher = new_teacher(env, cfg.demo_teacher)
+            teacher = new_teacher(env, teacher_name)
             stored = stored_observation(obs, cfg)
             total, steps, terminated, truncated = 0.0, 0, False, False
             while not (terminated or truncated):
@@ -189,7 +191,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
     out_path.parent.mkdir(parents=True, exist_ok=True)
     buffer.save(out_path)
     summary = {
-        "format": DEMO_FORMAT, **({"variant": variant} if variant is not None else {}), "teacher": cfg.demo_teacher,
+        "format": DEMO_FORMAT, **({"variant": variant} if variant is not None else {}), "teacher": teacher_name,
         "teacher_head": bool(teacher.head), "env_id": observed,
         "env_kwargs": train_env_kwargs(cfg, env_kwargs), "seed": seed, "episodes": episodes,
         "transitions": int(sum(lengths)), "teacher_success": round(float(np.mean(successes)), 4),

@@ -26,6 +26,7 @@ from egosearch.rl.config import LearnerConfig
 from egosearch.rl.demos import new_teacher, stored_observation
 from egosearch.rl.replay import MultiReplay
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.scenarios import MAX_STEPS
 
 DAGGER_SEED_BASE = 8_000_000
@@ -77,12 +78,12 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
         for episode in range(episodes):
             obs, _ = env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg.seed + 10_000 * round_index + episode)
             if labelled is None:
-                state_dim = int(np.asarray(obs["state"]).shape[0]) if cfg.critic_privileged_state else 0
+                state_dim = int(np.asarray(obs["state"]).shape[0]) if critic_reads_state(cfg) else 0
                 labelled = MultiReplay(1, episodes * MAX_STEPS, agent.replay_image_size, cfg.frame_history,
                                        int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
                                        state_dim=state_dim)
-            teacher = new_teacher(env, cfg.demo_teacher)
+            teacher = new_teacher(env, demonstration_settings(cfg).demo_teacher)
             stored = stored_observation(obs, cfg)
             terminated = truncated = False
             while not (terminated or truncated):

@@ -46,6 +46,7 @@ from egosearch.rl.common import (
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.learner import AgentBase
+from egosearch.rl.training_aids import critic_reads_state
 
 DRQ_ACTOR_FORMAT = "egosearch-sac-drq-actor-v1"
 """The actor file of SAC-DrQ's actor (pooled conv encoder + :class:`ActorHead`): SAC-DrQ's and PPO's."""
@@ -205,9 +206,9 @@ class PooledAgent(AgentBase):
         cfg = self.cfg
         self.device = resolve_device(cfg.device) if device is None else torch.device(device)
         self.action_dim, self.mask_dim, self.proprio_dim = int(action_dim), int(mask_dim), int(proprio_dim)
-        if cfg.critic_privileged_state and state_dim < 1:
+        if critic_reads_state(cfg) and state_dim < 1:
             raise ValueError("critic_privileged_state needs the env's privileged state (state_dim >= 1)")
-        self.state_dim = int(state_dim) if cfg.critic_privileged_state else 0
+        self.state_dim = int(state_dim) if critic_reads_state(cfg) else 0
 
     # ---- replay --------------------------------------------------------------------------
     @property

@@ -6,17 +6,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
 
 from egosearch.rl.network_settings import NetworkSettings, PooledSettings
 from egosearch.rl.run_settings import Complaint
+from egosearch.rl.training_aids import PrivilegedCriticSettings
 
 
 @dataclass
-class PpoSettings(NetworkSettings, PooledSettings):
-    """The settings PPO reads beyond the run settings."""
-
-    privileged_critic: ClassVar[bool] = True
+class PpoSettings(PrivilegedCriticSettings, NetworkSettings, PooledSettings):
+    """The settings PPO reads beyond the run settings (a privileged value network, not demonstrations)."""
 
     # "ppo" only: PPO is a CHANGE OF ALGORITHM (the paper's learner is SAC + CURL) and no profile uses it.
     # A rollout is the last ``update_every`` env steps (``update_every / num_envs`` per env); an update

@@ -2,12 +2,10 @@
 
 :class:`RunSettings` holds the settings of a training run that every learner's config carries: the
 observation and the data (image size, frame history, replay, discount, env steps, batch), the envs and
-their training-only aids, the demonstrations and the imitation phase, the loop's schedule (warm-up,
-updates, evaluations, checkpoints, logs) and where the run is placed on the machine. Not every learner
-reads all of them: the demonstration, cloning, DAgger and critic warm-up fields only where the learner
-``learns_from_demonstrations``, ``critic_privileged_state`` only where it has a ``privileged_critic``
-(both class flags of its settings; a learner without them refuses the fields), ``cuda_graph`` on a GPU by
-SAC+CURL and the stacked update, ``compile`` by SAC+CURL only. Each learner's own
+their training-only aids, the loop's schedule (warm-up, updates, evaluations, checkpoints, logs) and where
+the run is placed on the machine (``cuda_graph`` is read on a GPU by SAC+CURL and the stacked update,
+``compile`` by SAC+CURL only). The privileged critic and the demonstrations are not here: they are pieces
+a learner's settings opt into (:mod:`egosearch.rl.training_aids`). Each learner's own
 settings (its networks, optimisers and losses) live beside it (:mod:`egosearch.rl.sac_curl_settings`,
 :mod:`egosearch.rl.sac_drq_settings`, :mod:`egosearch.rl.sac_drq_recurrent_settings`,
 :mod:`egosearch.rl.ppo_settings`, built from :mod:`egosearch.rl.network_settings`), and
@@ -20,7 +18,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
 
 from egosearch.sim.body import IMAGE_SIZE  # the env's frames: one source
 
@@ -34,29 +31,13 @@ CURRICULUM_END_RADIUS = 12.0
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; ``tests/test_rl_sac.py``'s
 ``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
-DEMO_TEACHERS = ("frontier", "frontier_tuned")
-"""The classical searchers demonstrations may come from (see ``RunSettings.demo_teacher``;
-``egosearch.rl.demos.TEACHERS`` maps each to its class)."""
-
 DECISIONS, BODY_STEPS = "decisions", "body steps"
 """What one env step of a training counts (:attr:`RunSettings.env_step_unit`)."""
 
 
 @dataclass
 class RunSettings:
-    """The settings every learner and the training loop share. A learner's own settings class says, in
-    its class variables, whether it has a privileged critic and whether it learns from demonstrations:
-    the run settings of those two levers are refused, in one line, for a learner without them."""
-
-    privileged_critic: ClassVar[bool] = False
-    """Whether the learner's critic may read the env's hidden state (``critic_privileged_state``)."""
-    learns_from_demonstrations: ClassVar[bool] = False
-    """Whether the learner's update knows demonstrations (``demo_episodes`` and the imitation phase)."""
-    DEMONSTRATION_FIELDS: ClassVar[tuple[str, ...]] = (
-        "demo_episodes", "demo_teacher", "bc_updates", "dagger_rounds", "dagger_episodes", "critic_warmup_updates",
-        "demo_batch_fraction", "bc_weight", "bc_decay_steps", "bc_weight_floor")
-    """The fields only a learner that ``learns_from_demonstrations`` reads: a profile's values of them reach
-    only such a learner (a variant that sets one for another learner is refused)."""
+    """The settings every learner and the training loop share."""
 
     # ---- Table 2: observation and data -------------------------------------------------
     image_size: int = IMAGE_SIZE
@@ -145,16 +126,6 @@ class RunSettings:
     that, starts are drawn from the whole home as in the paper. TRAINING ONLY: evaluation always
     uses the stored scenarios."""
 
-    critic_privileged_state: bool = False
-    """Paper: False (the critic sees what the actor sees). True ("sac_drq", "sac_drq_recurrent"
-    and "ppo" only; for "ppo" the value network reads it): an asymmetric
-    actor-critic (Pinto et al. 2018): the critic also reads the env's hidden state (the body's
-    and the target's positions, the target in the body's frame, its distance: see
-    ``egosearch.sim.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
-    (history + state, not state alone). The actor, and so every policy and actor file, sees only
-    the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
-    ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""
-
     train_height_min: float = 1.0
     """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
     (plus the per-step noise). Otherwise training heights are drawn from [this, 1.8] m. The
@@ -163,66 +134,6 @@ class RunSettings:
     camera of Table 1, the smaller learner of the cpu profile did not (its searches at 0.45 m
     collided twice as often as at 1.05 m), so the cpu profile trains at every Table 1 height.
     TRAINING ONLY: evaluation uses the stored scenarios' fixed heights."""
-
-    # ---- learning from the classical searcher (the paper has no teacher) -------------------------
-    # Learning from demonstrations, the cpu profile's (see cpu_profile): TRAINING ONLY, each a CHANGE OF
-    # ALGORITHM (a teacher the paper's learner does not have). The actor, its file and every evaluation are
-    # as without them.
-    demo_episodes: int = 0
-    """Paper: 0 (no demonstrations). N > 0: a fresh training first runs the classical frontier searcher
-    (``demo_teacher``: by default ``egosearch.searchers.frontier``, untuned; head moving where the body has a
-    head) for N episodes of its own training envs and keeps their transitions (``egosearch.rl.demos``,
-    seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
-    frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
-    kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time. The
-    ``cpu`` profile: 1,500 (see :func:`cpu_profile`)."""
-    demo_teacher: str = "frontier"
-    """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
-    of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
-    classical row (``egosearch.searchers.frontier``). "frontier_tuned": the same searcher tuned on
-    training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row). Either holds its head
-    fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
-    bc_updates: int = 0
-    """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
-    before the first env step, this many behaviour-cloning steps of the encoder and the actor on
-    ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
-    its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
-    act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy. The
-    ``cpu`` profile: 12,000."""
-    dagger_rounds: int = 0
-    """Paper: 0. DAgger (Ross, Gordon & Bagnell 2011), after ``bc_updates``: this many rounds in which the
-    cloned student drives ``dagger_episodes`` training-side episodes (its mean action), the teacher labels
-    every state it reaches (the frontier searcher's map updates from whatever it sees), the labelled states
-    join the demonstrations for cloning only (their actions are the teacher's, not the ones taken, so RL
-    never samples them), and the student is cloned again for ``bc_updates`` steps on all of them, drawn in
-    proportion to their sizes (``egosearch.rl.imitation``)."""
-    dagger_episodes: int = 0
-    """Ours (with ``dagger_rounds``): episodes the student drives in each DAgger round."""
-    critic_warmup_updates: int = 0
-    """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
-    the first policy steps follow a critic fitted to it): the first this many RL updates train only
-    the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned. The
-    ``cpu`` profile: 2,500."""
-    demo_batch_fraction: float = 0.0
-    """RLPD (Ball et al. 2023: 0.5, "symmetric sampling"): this fraction of every update's batch is
-    drawn from the demonstrations, the rest from the online replay. 0: online only (the paper). The ``cpu``
-    profile: 0.5."""
-    bc_weight: float = 0.0
-    """TD3+BC (Fujimoto & Gu 2021: the actor's loss plus a squared error to the data's action, weighted
-    against the critic's scale; their alpha 2.5 is a weight of 1 / 2.5 = 0.4 here), the optional term of
-    RLPD-style training: the actor's SAC loss plus ``bc_weight`` x mean |Q| x the squared error
-    between its mean action and the teacher's on the batch's demonstration rows. It decays linearly to
-    0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none. The ``cpu``
-    profile: 0.4."""
-    bc_decay_steps: int = 0
-    """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0 (to
-    ``bc_weight_floor``, when set). The ``cpu`` profile: 100k, half its run."""
-    bc_weight_floor: float = 0.0
-    """Ours (with ``bc_weight``), 0: the behaviour-cloning term decays to nothing, so after ``bc_decay_steps``
-    RL alone moves the student (the ``cpu`` profile, whose curve stops rising there). > 0: the weight never
-    falls below this, so the teacher's detours around furniture keep pulling on the actor for the whole run
-    (a lever of the stuck-student issue, ``ablations/head_on_cloning_floor.yaml``; RLPD and TD3+BC keep a
-    constant weight). At most ``bc_weight``."""
 
     # ---- training loop (CURL defaults or ours) ------------------------------------------
     init_steps: int = 1000
@@ -286,12 +197,8 @@ class RunSettings:
                 "egosearch.sim.body.IMAGE_SIZE)")
         if self.train_distance_reward not in DISTANCE_REWARDS:
             bad("train_distance_reward", ", ".join(DISTANCE_REWARDS))
-        if self.critic_privileged_state and not self.privileged_critic:
-            # the cpu profile sets it, so a variant of a learner without one there must say so
-            bad("critic_privileged_state", f"False for algorithm {self.algorithm} (only the sac_drq learners have a "
-                "privileged critic; "
-                "the cpu profile turns it on: add critic_privileged_state: false to the variant)")
-        self._check_demonstrations(bad)
+        if self.modular_searcher and self.target_memory:
+            bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
         if self.num_envs > self.replay_capacity:
             bad("num_envs", f"1..replay_capacity={self.replay_capacity}")
         # Updates fall on the multiples of update_every from the last warm-up step on (train._Run.update):
@@ -309,49 +216,6 @@ class RunSettings:
         if not (self.device == "auto" or self.device == "cpu" or self.device.startswith("cuda")
                 or self.device == "mps"):
             bad("device", "auto, cpu, cuda, cuda:N or mps")
-
-    def _check_demonstrations(self, bad: Complaint) -> None:
-        """The imitation levers read demonstrations, and only a learner whose update knows them may have them."""
-        for name in ("demo_episodes", "bc_updates", "critic_warmup_updates", "bc_decay_steps", "dagger_rounds",
-                     "dagger_episodes"):
-            if getattr(self, name) < 0:
-                bad(name, "an integer >= 0")
-        if not 0.0 <= self.demo_batch_fraction < 1.0:
-            bad("demo_batch_fraction", "[0, 1) (the rest of each batch is online)")
-        if self.bc_weight < 0:
-            bad("bc_weight", ">= 0")
-        if self.demo_teacher not in DEMO_TEACHERS:
-            bad("demo_teacher", ", ".join(DEMO_TEACHERS))
-        if self.demo_teacher != "frontier" and self.demo_episodes == 0:
-            bad("demo_teacher", "frontier (the default) unless demo_episodes >= 1 (no demonstrations, no teacher)")
-        uses = {"bc_updates": self.bc_updates > 0, "demo_batch_fraction": self.demo_batch_fraction > 0,
-                "bc_weight": self.bc_weight > 0}
-        for name, used in uses.items():
-            if used and self.demo_episodes == 0:
-                # the cpu profile sets them all: name every one that needs turning off with the teacher
-                on = [n for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
-                                  "bc_decay_steps") if getattr(self, n)]
-                bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations set "
-                    + ", ".join(f"{n}: 0" for n in on))
-        if self.dagger_rounds and not self.bc_updates:
-            bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
-        if bool(self.dagger_rounds) != bool(self.dagger_episodes):
-            bad("dagger_episodes", "1..10000 with dagger_rounds >= 1, else 0")
-        if self.dagger_episodes > 10_000:
-            bad("dagger_episodes", "1..10000 (a round's episodes stay below the next round's seeds)")
-        if self.bc_weight > 0 and self.demo_batch_fraction == 0:
-            bad("bc_weight", "0 unless demo_batch_fraction > 0 (the term is taken on the batch's demonstrations)")
-        if self.bc_weight > 0 and self.bc_decay_steps == 0:
-            bad("bc_decay_steps", ">= 1 with bc_weight > 0 (the env steps over which the term decays)")
-        if not 0.0 <= self.bc_weight_floor <= self.bc_weight:
-            bad("bc_weight_floor", f"[0, bc_weight={self.bc_weight}] (the weight the cloning term decays to)")
-        if self.modular_searcher and self.target_memory:
-            bad("target_memory", "False with modular_searcher (the frontier searcher remembers the target itself)")
-        if self.modular_searcher and self.demo_episodes:
-            bad("demo_episodes", "0 with modular_searcher (the demonstrations are the frontier searcher's body steps)")
-        if (self.demo_episodes or self.critic_warmup_updates) and not self.learns_from_demonstrations:
-            bad("demo_episodes" if self.demo_episodes else "critic_warmup_updates",
-                f"0 for algorithm {self.algorithm} (only sac_drq learns from demonstrations)")
 
     def start_radius(self, env_steps: int) -> float | None:
         """The curriculum's start radius (m) at ``env_steps``; None once it is over (or off)."""

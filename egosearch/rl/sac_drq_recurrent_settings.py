@@ -5,17 +5,15 @@ networks and SAC settings, and its GRUs and replayed sequences. Registered with 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
 
 from egosearch.rl.network_settings import RandomShiftSettings, SacSettings
 from egosearch.rl.run_settings import Complaint
+from egosearch.rl.training_aids import PrivilegedCriticSettings
 
 
 @dataclass
-class SacDrqRecurrentSettings(SacSettings, RandomShiftSettings):
-    """The settings recurrent SAC-DrQ reads beyond the run settings."""
-
-    privileged_critic: ClassVar[bool] = True
+class SacDrqRecurrentSettings(PrivilegedCriticSettings, SacSettings, RandomShiftSettings):
+    """The settings recurrent SAC-DrQ reads beyond the run settings (a privileged critic, not demonstrations)."""
 
     recurrent_hidden_dim: int = 128
     """Ni et al. 2022 (a separate GRU for the actor and for the critic; 128 units is ours),

@@ -1,27 +1,26 @@
 """SAC-DrQ's own settings (the cpu profile's learner, :mod:`egosearch.rl.sac_drq`): its pooled input and
 random shift, and the two changes of its critic and encoder a lever may make; beside them the networks
-and SAC's settings of :mod:`egosearch.rl.network_settings`. Registered with the learner in
+and SAC's settings of :mod:`egosearch.rl.network_settings` and the training aids of
+:mod:`egosearch.rl.training_aids`. Registered with the learner in
 :mod:`egosearch.rl.registry`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
 
 from egosearch.rl.network_settings import RandomShiftSettings, SacSettings
 from egosearch.rl.run_settings import Complaint
+from egosearch.rl.training_aids import DemonstrationSettings, PrivilegedCriticSettings
 
 ENCODER_AUX_LOSSES = ("none", "reconstruction")
 """Auxiliary losses on the "sac_drq" encoder (see ``LearnerConfig.encoder_aux_loss``)."""
 
 
 @dataclass
-class SacDrqSettings(SacSettings, RandomShiftSettings):
-    """The settings SAC-DrQ reads beyond the run settings. It is the one learner that learns from
-    demonstrations (its update takes the batch's demonstration rows and the cloning term)."""
-
-    privileged_critic: ClassVar[bool] = True
-    learns_from_demonstrations: ClassVar[bool] = True
+class SacDrqSettings(PrivilegedCriticSettings, DemonstrationSettings, SacSettings, RandomShiftSettings):
+    """The settings SAC-DrQ reads beyond the run settings: a privileged critic and the demonstrations
+    (:mod:`egosearch.rl.training_aids`; it is the one learner whose update takes the batch's demonstration
+    rows and the cloning term), the networks, SAC's and the pooled, shifted input's settings, and its own."""
 
     critic_layer_norm: bool = False
     """Paper: False (Table 2's Q-functions are plain MLPs). True ("sac_drq" only): a LayerNorm after

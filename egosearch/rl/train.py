@@ -88,6 +88,7 @@ from egosearch.rl.run_files import (
     to_tensors,
 )
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.observation_options import extra_dims
 
 CURVE_COLUMNS = ("env_steps", "success_rate", "spl", "episode_return", "critic_loss", "actor_loss",
@@ -125,10 +126,11 @@ class _Mean:
 def cloning_weight(cfg: LearnerConfig, step: int) -> float:
     """The behaviour-cloning term's weight at env step ``step``: ``bc_weight`` falling linearly over
     ``bc_decay_steps`` to ``bc_weight_floor`` (0 by default), then held there."""
-    if not cfg.bc_weight:
+    aids = demonstration_settings(cfg)
+    if not aids.bc_weight:
         return 0.0
-    decayed = cfg.bc_weight * max(0.0, 1.0 - step / cfg.bc_decay_steps)
-    return max(decayed, cfg.bc_weight_floor)
+    decayed = aids.bc_weight * max(0.0, 1.0 - step / aids.bc_decay_steps)
+    return max(decayed, aids.bc_weight_floor)
 
 
 # ---- evaluation ---------------------------------------------------------------------------
@@ -263,7 +265,7 @@ def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
     ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if ckpt is not None:
         check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
-        if cfg.demo_episodes:
+        if demonstration_settings(cfg).demo_episodes:
             # the demonstrations it resumes with: the run's own, readable, before any env is built
             demos = demos_path_of(ckpt_path)
             if not demos.exists():
@@ -290,7 +292,7 @@ def _act_batch(agent: Agent, observations: list[dict]) -> list[np.ndarray]:
 
 def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
     """Size of the env's privileged state when the critic reads it (``critic_privileged_state``), else 0."""
-    if not cfg.critic_privileged_state:
+    if not critic_reads_state(cfg):
         return 0
     if "state" not in env.observation_space.spaces:
         raise ValueError(f"critic_privileged_state needs an env whose observations hold a 'state' "
@@ -408,16 +410,16 @@ class LiveRun:
 
     def _demonstrations(self, ckpt: dict | None, progress: bool) -> tuple[MultiReplay | None, dict | None]:
         """The teacher's transitions (``demo_episodes``): collected at a fresh start, read back on resume."""
-        cfg = self.cfg
-        if not cfg.demo_episodes:
+        cfg, aids = self.cfg, demonstration_settings(self.cfg)
+        if not aids.demo_episodes:
             return None, None
         path = self.demos_path
         if ckpt is not None and not path.exists():
             raise CheckpointError(f"{self.ckpt_path} needs the run's demonstrations {path}, which are gone")
         if ckpt is None and not self._own_demonstrations(path):  # kept when a run stopped before its checkpoint
             path.parent.mkdir(parents=True, exist_ok=True)
-            self.say(f"collecting {cfg.demo_episodes} demonstration episodes of {cfg.demo_teacher} -> {path}")
-            collect_demonstrations(self.env_id, cfg, self.env_kwargs, cfg.demo_episodes, path, seed=cfg.seed,
+            self.say(f"collecting {aids.demo_episodes} demonstration episodes of {aids.demo_teacher} -> {path}")
+            collect_demonstrations(self.env_id, cfg, self.env_kwargs, aids.demo_episodes, path, seed=cfg.seed,
                                    progress=progress, variant=self.variant)
         try:
             demos = load_demonstrations(path, cfg, str(self.device), self._wanted_demonstrations())
@@ -502,7 +504,7 @@ class LiveRun:
     def actions(self, live: list) -> list[np.ndarray]:
         """Uniform random actions during the warm-up (the cloned policy's samples after behaviour
         cloning), the agent's samples after it."""
-        if self.step < self.cfg.init_steps and not self.cfg.bc_updates:
+        if self.step < self.cfg.init_steps and not demonstration_settings(self.cfg).bc_updates:
             return [e.action_space.sample() for e in live]
         return _act_batch(self.agent, self.observations[: len(live)])
 
@@ -553,7 +555,7 @@ class LiveRun:
         if self.step < cfg.init_steps:
             return 0
         first_due = max(before, cfg.init_steps - 1)
-        if cfg.bc_weight:
+        if demonstration_settings(cfg).bc_weight:
             self.agent.bc_weight_now = cloning_weight(cfg, self.step)
         return (self.step // cfg.update_every - first_due // cfg.update_every) * cfg.updates_per_step
 
@@ -565,7 +567,7 @@ class LiveRun:
     def sample(self) -> dict:
         """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout);
         with ``demo_batch_fraction`` that share drawn from the demonstrations (marked by ``demo``)."""
-        if self.demos is None or not self.cfg.demo_batch_fraction:
+        if self.demos is None or not demonstration_settings(self.cfg).demo_batch_fraction:
             return self.agent.sample_batch(self.replay)
         demo_rows = self.demo_rows
         from_demos = int(demo_rows.sum())
@@ -578,34 +580,34 @@ class LiveRun:
     def demo_rows(self) -> torch.Tensor:
         """(batch_size, 1): 1 on the rows a batch draws from the demonstrations (the last ones), once per run."""
         size = self.cfg.batch_size
-        from_demos = round(size * self.cfg.demo_batch_fraction)
+        from_demos = round(size * demonstration_settings(self.cfg).demo_batch_fraction)
         return torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
 
     # ---- imitating ------------------------------------------------------------------------
     def imitate(self) -> None:
         """Behaviour cloning on the demonstrations (``bc_updates`` steps), then ``dagger_rounds`` DAgger
         rounds (:mod:`egosearch.rl.imitation`), at a fresh start only."""
-        cfg = self.cfg
-        if not cfg.bc_updates:
+        cfg, aids = self.cfg, demonstration_settings(self.cfg)
+        if not aids.bc_updates:
             return
         cpu0, wall0 = time.process_time(), time.perf_counter()
         optimiser = torch.optim.Adam(self.agent.clone_parameters(), lr=cfg.actor_lr,
                                      betas=(cfg.actor_beta1, cfg.actor_beta2))
         sources = [self.demos]
-        loss = clone(self.agent, sources, cfg.bc_updates, cfg.batch_size, optimiser, self.say)
-        for r in range(cfg.dagger_rounds):
-            labelled, figures = dagger_round(self.agent, self.env_id, cfg, self.env_kwargs, cfg.dagger_episodes, r,
+        loss = clone(self.agent, sources, aids.bc_updates, cfg.batch_size, optimiser, self.say)
+        for r in range(aids.dagger_rounds):
+            labelled, figures = dagger_round(self.agent, self.env_id, cfg, self.env_kwargs, aids.dagger_episodes, r,
                                              self.device)
             self.imitation["dagger"].append(figures)
-            self.say(f"DAgger round {r + 1}/{cfg.dagger_rounds}: the student succeeded in "
+            self.say(f"DAgger round {r + 1}/{aids.dagger_rounds}: the student succeeded in "
                      f"{figures['student_success']:.2f} of {figures['episodes']} episodes; "
                      f"{figures['transitions']} states labelled ({figures['cpu_s']:.0f} CPU-s)")
             sources.append(labelled)
-            loss = clone(self.agent, sources, cfg.bc_updates, cfg.batch_size, optimiser, self.say,
+            loss = clone(self.agent, sources, aids.bc_updates, cfg.batch_size, optimiser, self.say,
                          f"DAgger round {r + 1}: cloning")
         # The learner's own rate (env steps per CPU-second, what the estimates scale) leaves this out.
         self.imitation.update(cpu_s=round(time.process_time() - cpu0, 1), wall_s=round(time.perf_counter() - wall0, 1),
-                              bc_updates=cfg.bc_updates * (1 + cfg.dagger_rounds))
+                              bc_updates=aids.bc_updates * (1 + aids.dagger_rounds))
         self.train_log.write({"env_steps": 0, "episodes": 0, "updates": 0, "bc_loss": loss,
                               "alpha": self.agent.alpha, "wall_s": self.wall()})
 

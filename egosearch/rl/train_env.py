@@ -7,6 +7,7 @@ import gymnasium
 
 from egosearch.envs import observation_kwargs
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.training_aids import critic_reads_state
 from egosearch.scene.layouts import LAYOUT_NAMES
 from egosearch.sim.body import AgentSpec
 from egosearch.sim.home_pool import HomePoolEnv
@@ -34,6 +35,6 @@ def train_env_kwargs(cfg: LearnerConfig, env_kwargs: dict) -> dict:
     paper_low, paper_high = AgentSpec().train_height_range
     if cfg.train_height_min != paper_low:
         aids["train_heights"] = (cfg.train_height_min, paper_high)
-    if cfg.critic_privileged_state:
+    if critic_reads_state(cfg):
         aids["privileged_state"] = True
     return {**aids, **env_kwargs}
