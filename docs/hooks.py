@@ -6,6 +6,10 @@ that they read the same on GitHub as in the built site. mkdocs publishes only wh
 file of the repository to the site at its path in the repository (``paper_figs/cpu/fig6.png``)
 and points the link at it. A link to a file that does not exist, or to a Markdown file, is left
 as written, so that a strict build still fails on it.
+
+It also writes the one page that is generated rather than kept: ``config.md``, every learner's config
+(``egosearch.rl.config_page``), when the nav names it. It is made at each build, so that a new learner or
+field is on it without a file to regenerate by hand.
 """
 
 from __future__ import annotations
@@ -41,6 +45,13 @@ def on_files(files, config):
             rel = _repository_path(page.src_uri, match["target"], config)
             if rel is not None and files.get_file_from_path(rel) is None:
                 files.append(File.generated(config, rel, abs_src_path=str(_root(config) / rel)))
+    if "config.md" in str(config["nav"]):
+        from egosearch.rl.config_page import config_page  # no torch: the settings classes and their docstrings
+
+        kept = files.get_file_from_path("config.md")  # a local `egosearch config page` output
+        if kept is not None:
+            files.remove(kept)
+        files.append(File.generated(config, "config.md", content=config_page()))
     return files
 
 

@@ -270,6 +270,9 @@ def test_mkdocs_builds_the_docs_strictly_with_the_stored_figures(tmp_path):
     assert (tmp_path / "site" / "paper_figs" / "cpu" / "fig6.png").read_bytes() == \
         (REPO / "paper_figs" / "cpu" / "fig6.png").read_bytes()
     assert not (tmp_path / "site" / "hooks.py").exists()
+    # the one generated page: every learner's config, made by the hook at each build, never kept in git
+    config = (tmp_path / "site" / "config" / "index.html").read_text()
+    assert "Shared by every learner" in config and "critic_privileged_state" in config
 
 
 @needs_mkdocs

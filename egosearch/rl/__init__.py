@@ -4,7 +4,7 @@ and the CLI.
 
 - :mod:`egosearch.rl.config`: ``LearnerConfig`` (the run settings and the learner's own, composed: one
   config class per learner), ``load_config(profile, overrides)``, ``table2_rows(cfg)``, ``departure_rows(cfg)``;
-- :mod:`egosearch.rl.config_page`: docs/config.md, every learner's fields on one generated page;
+- :mod:`egosearch.rl.config_page`: the docs site's page of every learner's fields (``egosearch config page``);
 - :mod:`egosearch.rl.run_settings`: ``RunSettings``, what every learner and the training loop share;
 - :mod:`egosearch.rl.training_aids`: the aids a learner's settings opt into (``DemonstrationSettings``,
   ``PrivilegedCriticSettings``) and how the loop reads them for any learner (``demonstration_settings``,
