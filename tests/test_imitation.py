@@ -189,9 +189,13 @@ class StandStill:
     """A student that never moves: the teacher must still label every state it is shown."""
 
     replay_image_size = 50
+    episodes_started = 0
 
     def act(self, obs, deterministic=True):
         return np.zeros(5, np.float32)
+
+    def reset_policy_state(self):  # a student with a memory forgets the last episode here
+        self.episodes_started += 1
 
 
 def test_dagger_labels_each_state_the_student_reaches_with_the_teachers_action(demos):
@@ -200,7 +204,9 @@ def test_dagger_labels_each_state_the_student_reaches_with_the_teachers_action(d
     from egosearch.searchers.frontier import FrontierPolicy
 
     cfg, _ = demos
-    labelled, figures = dagger_round(StandStill(), "EgoSearchMemory-v0", cfg, ENV, 1, round_index=1)
+    student = StandStill()
+    labelled, figures = dagger_round(student, "EgoSearchMemory-v0", cfg, ENV, 1, round_index=1)
+    assert student.episodes_started == 1  # its memory, if it has one, starts empty
     buf = labelled.buffers[0]
     assert figures["episodes"] == 1 and figures["transitions"] == buf.n_added > 0
     # the same episode again: the student stands still, a fresh teacher says what it would do at each state
@@ -261,3 +267,87 @@ def test_the_cloning_term_decays_linearly_to_its_floor_and_stays_there():
     assert cloning_weight(load_config("cpu", {"bc_weight": 0.0, "demo_batch_fraction": 0.0}), 10) == 0.0
     with pytest.raises(ValueError, match=r"bc_weight_floor=0.5 is out of range; allowed: \[0, bc_weight=0.4\]"):
         load_config("cpu", {**base, "bc_weight_floor": 0.5})
+
+
+# ---- the GRU student (sac_drq_recurrent): the same imitation, in sequences --------------------------------
+
+RECURRENT = {**SMALL, "algorithm": "sac_drq_recurrent", "recurrent_hidden_dim": 16, "sequence_length": 4,
+             "burn_in": 2, "batch_size": 32}
+"""Recurrent SAC-DrQ at smoke sizes on the same observation (its replay pools the frames as SAC-DrQ's)."""
+
+
+def new_recurrent(cfg, replay):
+    from egosearch.rl.sac_drq_recurrent import SacDrqRecurrentAgent
+
+    torch.manual_seed(0)
+    batch = replay.sample(2)
+    return SacDrqRecurrentAgent(cfg, 5, batch["mask"].shape[1], batch["proprio"].shape[1], "cpu",
+                                batch["state"].shape[1])
+
+
+def sequence_error(agent, batch: dict) -> float:
+    """The recurrent actor's mean action against the teacher's on every loss step of the batch's sequences."""
+    from egosearch.rl.sac_drq_recurrent import _sequence_memory
+
+    cfg = agent.cfg
+    train_steps = slice(cfg.burn_in, cfg.burn_in + cfg.sequence_length)
+    with torch.no_grad():
+        feats = agent._features(batch["depth"].float())
+        xa = agent.actor.inputs(feats, batch["extra"])
+        mem = _sequence_memory(xa, batch["first"], agent.actor.gru, cfg.burn_in)
+        mu, _ = agent.actor.out(mem[:, train_steps], xa[:, train_steps])
+        return float((torch.tanh(mu) - batch["action"][:, train_steps]).pow(2).sum(-1).mean())
+
+
+def test_the_gru_student_clones_the_teacher_in_sequences_and_leaves_the_critic_alone(demos):
+    _, replay = demos
+    cfg = load_config("smoke", {**RECURRENT, "seed": 2})
+    agent = new_recurrent(cfg, replay)
+    batch = agent.cloning_batch([replay], 32)
+    assert batch["depth"].shape[:2] == (32 // 4, 2 + 4 + 1)  # sequences of burn-in + loss steps + the last next obs
+    held = agent.cloning_batch([replay], 400)
+    before, critic = sequence_error(agent, held), parameters(agent.critic)
+    optimiser = torch.optim.Adam(agent.clone_parameters(), lr=1e-3)
+    for _ in range(150):
+        metrics = agent.clone_update(agent.cloning_batch([replay], 32), optimiser)
+    after = sequence_error(agent, held)
+    assert after < 0.5 * before, (before, after)
+    assert set(metrics) == {"bc_loss"} and same(critic, parameters(agent.critic)) and agent.num_updates == 0
+
+
+def test_the_gru_students_critic_warms_up_and_its_cloning_term_pulls_to_the_teacher(demos):
+    _, replay = demos
+    cfg = load_config("smoke", {**RECURRENT, "seed": 2, "demo_episodes": 3, "critic_warmup_updates": 2})
+    agent = new_recurrent(cfg, replay)
+    encoder, actor, critic = parameters(agent.encoder), parameters(agent.actor), parameters(agent.critic)
+    for _ in range(2):
+        metrics = agent.update(agent.sample_batch(replay))
+        assert metrics["actor_loss"] != metrics["actor_loss"]  # NaN: no actor step
+    assert same(encoder, parameters(agent.encoder)) and same(actor, parameters(agent.actor))
+    assert not same(critic, parameters(agent.critic))
+    agent.update(agent.sample_batch(replay))  # the third: SAC as usual
+    assert not same(actor, parameters(agent.actor))
+    # the term on the demonstration sequences (here the online replay is the teacher's too)
+    held = agent.cloning_batch([replay], 400)
+    errors = {}
+    for weight in (0.0, 50.0):
+        agent = new_recurrent(load_config("smoke", {**RECURRENT, "seed": 2}), replay)
+        agent.bc_weight_now = weight
+        torch.manual_seed(1)
+        for _ in range(60):
+            batch = agent.sample_with_demonstrations(replay, replay, 0.5)
+            metrics = agent.update(batch)
+        assert batch["demo"].squeeze(1).tolist() == [0.0] * 4 + [1.0] * 4
+        errors[weight] = sequence_error(agent, held)
+    assert errors[50.0] < 0.7 * errors[0.0], errors
+    assert metrics["bc_loss"] >= 0
+
+
+def test_a_gru_student_trains_through_imitation_dagger_and_fine_tuning(tmp_path):
+    cfg = load_config("smoke", {**RECURRENT, "seed": 5, "demo_episodes": 2, "bc_updates": 10, "dagger_rounds": 1,
+                                "dagger_episodes": 1, "critic_warmup_updates": 5, "demo_batch_fraction": 0.5,
+                                "bc_weight": 0.4, "bc_decay_steps": 100, "total_env_steps": 150, "init_steps": 100,
+                                "eval_every": 150, "checkpoint_every": 150})
+    done = train("EgoSearch-v0", cfg, tmp_path, ENV, constant_evaluator, progress=False)
+    assert [r["round"] for r in done["dagger"]] == [1] and done["imitation"]["bc_updates"] == 20
+    assert done["updates"] > 5  # past the critic's warm-up

@@ -24,7 +24,7 @@ import torch
 
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.demos import new_teacher, stored_observation
-from egosearch.rl.replay import MultiReplay
+from egosearch.rl.replay import MultiReplay, proportional_counts  # noqa: F401 (read here by the tests)
 from egosearch.rl.train_env import make_train_env, train_env_kwargs
 from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.scenarios import MAX_STEPS
@@ -37,26 +37,13 @@ MAX_DAGGER_EPISODES = 10_000
 """A round's episodes stay below the next round's seeds."""
 
 
-def proportional_counts(sizes: list[int], batch_size: int) -> list[int]:
-    """``batch_size`` split over sources in proportion to ``sizes`` (largest remainders get the rest)."""
-    total = sum(sizes)
-    exact = [batch_size * s / total for s in sizes]
-    counts = [int(x) for x in exact]
-    for i in sorted(range(len(sizes)), key=lambda i: exact[i] - counts[i], reverse=True)[:batch_size - sum(counts)]:
-        counts[i] += 1
-    return counts
-
-
 def clone(agent, sources: list[MultiReplay], steps: int, batch_size: int, optimiser: torch.optim.Optimizer,
           say: Callable[[str], None] = print, what: str = "behaviour cloning") -> float:
     """``steps`` behaviour-cloning steps of ``agent`` (``clone_update``) on batches drawn from ``sources``
     in proportion to their sizes; returns the mean squared error of the last 100 steps."""
-    counts = proportional_counts([len(s) for s in sources], batch_size)
     t0, losses = time.perf_counter(), deque(maxlen=100)
     for i in range(steps):
-        parts = [s.sample(n) for s, n in zip(sources, counts) if n > 0]
-        batch = {k: torch.cat([p[k] for p in parts]) for k in ("obs_depth", "mask", "proprio", "action")}
-        losses.append(agent.clone_update(batch, optimiser)["bc_loss"])
+        losses.append(agent.clone_update(agent.cloning_batch(sources, batch_size), optimiser)["bc_loss"])
         if (i + 1) % max(steps // 10, 1) == 0 or i + 1 == steps:
             say(f"{what} {i + 1}/{steps}: squared error {np.mean(losses):.3f} ({time.perf_counter() - t0:.0f} s)")
     return float(np.mean(losses))
@@ -84,6 +71,7 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
                                        state_dim=state_dim)
             teacher = new_teacher(env, demonstration_settings(cfg).demo_teacher)
+            agent.reset_policy_state()  # a student with a memory starts each episode afresh
             stored = stored_observation(obs, cfg)
             terminated = truncated = False
             while not (terminated or truncated):

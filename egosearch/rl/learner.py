@@ -59,10 +59,12 @@ class Agent(Protocol):
     ``reset_policy_state()`` when an evaluation episode starts.
 
     Demonstrations (configs with ``bc_updates`` or ``bc_weight``): before RL, behaviour cloning
-    builds one optimiser over ``clone_parameters()`` and calls ``clone_update(batch, optimiser)``
-    (a batch of ``obs_depth``, ``mask``, ``proprio`` and the teacher's ``action``) for each step;
-    during RL, with ``bc_weight``, the loop sets ``bc_weight_now`` (the decayed weight of the
-    update's behaviour-cloning term) before each env step's updates.
+    builds one optimiser over ``clone_parameters()`` and calls ``clone_update(batch, optimiser)`` on
+    ``cloning_batch(sources, batch_size)`` (the teacher's transitions, or a recurrent agent's sequences,
+    with the teacher's ``action``) for each step; during RL, with ``demo_batch_fraction``, an update's
+    batch is ``sample_with_demonstrations(replay, demos, fraction)`` (its demonstration rows marked by a
+    (B, 1) ``demo`` column), and with ``bc_weight`` the loop sets ``bc_weight_now`` (the decayed weight of
+    the update's behaviour-cloning term) before each env step's updates.
 
     Persistence: ``state_dict()`` / ``load_state_dict(state)`` (the checkpoint's agent, which
     raises :class:`egosearch.rl.common.AgentStateError` on a mismatch); ``actor_state(metadata)``
@@ -92,6 +94,11 @@ class Agent(Protocol):
     def replay_obs(self, obs: dict) -> dict: ...
 
     def sample_batch(self, replay: MultiReplay) -> dict[str, torch.Tensor]: ...
+
+    def sample_with_demonstrations(self, replay: MultiReplay, demos: MultiReplay,
+                                   fraction: float) -> dict[str, torch.Tensor]: ...
+
+    def cloning_batch(self, sources: list[MultiReplay], batch_size: int) -> dict[str, torch.Tensor]: ...
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, float]: ...
 
@@ -159,6 +166,31 @@ class AgentBase(ABC):
     def sample_batch(self, replay: MultiReplay) -> dict[str, torch.Tensor]:
         """An update's batch: ``batch_size`` transitions drawn uniformly."""
         return replay.sample(self.cfg.batch_size)
+
+    def sample_with_demonstrations(self, replay: MultiReplay, demos: MultiReplay,
+                                   fraction: float) -> dict[str, torch.Tensor]:
+        """An update's batch with ``fraction`` of its ``batch_size`` transitions drawn from the demonstrations
+        (the last rows, marked 1 in the (B, 1) ``demo`` column), the rest from the online replay (RLPD)."""
+        import torch  # a learner's module loads it; this protocol's module does not
+
+        size = self.cfg.batch_size
+        from_demos = round(size * fraction)
+        online, demo = replay.sample(size - from_demos), demos.sample(from_demos)
+        batch = {k: torch.cat([online[k], demo[k]]) for k in online}
+        device = batch["reward"].device
+        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(device)
+        return batch
+
+    def cloning_batch(self, sources: list[MultiReplay], batch_size: int) -> dict[str, torch.Tensor]:
+        """A behaviour-cloning batch: ``batch_size`` transitions drawn from ``sources`` in proportion to
+        their sizes (the demonstrations, then each DAgger round's labelled states)."""
+        import torch
+
+        from egosearch.rl.replay import proportional_counts
+
+        counts = proportional_counts([len(s) for s in sources], batch_size)
+        parts = [s.sample(n) for s, n in zip(sources, counts) if n > 0]
+        return {k: torch.cat([p[k] for p in parts]) for k in ("obs_depth", "mask", "proprio", "action")}
 
     def clone_parameters(self) -> list[torch.nn.Parameter]:
         """What behaviour cloning trains: nothing here, so it is refused."""

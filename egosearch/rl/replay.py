@@ -439,3 +439,13 @@ class MultiReplay:
             raise ValueError(f"replay state does not hold {len(self.buffers)} env rings")
         for b, s in zip(self.buffers, state["buffers"]):
             b.load_state_dict(s)
+
+
+def proportional_counts(sizes: list[int], batch_size: int) -> list[int]:
+    """``batch_size`` split over sources in proportion to ``sizes`` (largest remainders get the rest)."""
+    total = sum(sizes)
+    exact = [batch_size * s / total for s in sizes]
+    counts = [int(x) for x in exact]
+    for i in sorted(range(len(sizes)), key=lambda i: exact[i] - counts[i], reverse=True)[:batch_size - sum(counts)]:
+        counts[i] += 1
+    return counts

@@ -33,6 +33,13 @@ span episode boundaries: the hidden state is zeroed at every episode's first ste
 exactly as acting zeroes it when an env resets, and an n-step target never bootstraps from an
 observation of another episode (a truncated step whose next observation is not in the window is
 left out of the critic loss: ``loss_mask``).
+
+It learns from the classical searcher as SAC-DrQ does (:mod:`egosearch.rl.training_aids`), in sequences:
+behaviour cloning of the encoder and the actor's GRU and head on the teacher's sequences (the burn-in
+warming the memory only), DAgger rounds whose student starts each episode with an empty memory, the
+critic's warm-up (the cloned encoder and actor frozen), a share of each update's sequences drawn from the
+demonstrations and TD3+BC's term on their loss steps. The ``head_on_recurrent_imitation`` lever: the GRU
+student through imitation, then fine-tuning.
 """
 
 from __future__ import annotations
@@ -56,7 +63,8 @@ from egosearch.rl.common import (
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.pooled import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
-from egosearch.rl.replay import MultiReplay, ReplayBuffer
+from egosearch.rl.replay import MultiReplay, ReplayBuffer, proportional_counts
+from egosearch.rl.training_aids import demonstration_settings
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
 ACTOR_FORMAT = "egosearch-sac-drq-recurrent-actor-v1"
@@ -325,9 +333,50 @@ class SacDrqRecurrentAgent(SacDrqBase):
 
     # ---- updating ------------------------------------------------------------------------
     def sample_batch(self, replay: MultiReplay) -> dict[str, torch.Tensor]:
+        return self._sequences([replay], [sequences_per_batch(self.cfg)])
+
+    def _sequences(self, sources: list[MultiReplay], counts: list[int]) -> dict[str, torch.Tensor]:
+        """``counts[i]`` sequences of ``sources[i]`` each, concatenated in that order."""
         cfg = self.cfg
-        return sample_sequences(replay, sequences_per_batch(cfg), cfg.burn_in, cfg.sequence_length, cfg.n_step,
-                                cfg.gamma, self.device)
+        parts = [sample_sequences(source, n, cfg.burn_in, cfg.sequence_length, cfg.n_step, cfg.gamma, self.device)
+                 for source, n in zip(sources, counts) if n > 0]
+        return {k: torch.cat([p[k] for p in parts]) for k in parts[0]}
+
+    def sample_with_demonstrations(self, replay: MultiReplay, demos: MultiReplay,
+                                   fraction: float) -> dict[str, torch.Tensor]:
+        """RLPD's batch in sequences: ``fraction`` of an update's sequences drawn from the demonstrations
+        (the last ones, marked 1 in the (B, 1) ``demo`` column), the rest from the online replay."""
+        size = sequences_per_batch(self.cfg)
+        from_demos = round(size * fraction)
+        batch = self._sequences([replay, demos], [size - from_demos, from_demos])
+        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
+        return batch
+
+    def cloning_batch(self, sources: list[MultiReplay], batch_size: int) -> dict[str, torch.Tensor]:
+        """Behaviour cloning's batch in sequences (as an update's: ``batch_size // sequence_length`` of them,
+        burn-in before each), drawn from ``sources`` in proportion to their sizes."""
+        size = max(1, batch_size // self.cfg.sequence_length)
+        return self._sequences(sources, proportional_counts([len(s) for s in sources], size))
+
+    def clone_parameters(self) -> list[torch.nn.Parameter]:
+        """What behaviour cloning trains: the encoder and the actor (its GRU and head)."""
+        return [*self.encoder.parameters(), *self.actor.parameters()]
+
+    def clone_update(self, batch: dict[str, torch.Tensor], optimiser: torch.optim.Optimizer) -> dict[str, float]:
+        """A behaviour-cloning step on sequences (SAC-DrQ's, :meth:`SacDrqAgent.clone_update`, through the
+        actor's memory): the squared error between the actor's mean action (after its tanh) and the
+        teacher's at every loss step of each sequence, the burn-in warming the GRU only."""
+        cfg = self.cfg
+        train = slice(cfg.burn_in, cfg.burn_in + cfg.sequence_length)
+        feats = self._features(shift_sequences(batch["depth"].float(), cfg.aug_pad))
+        xa = self.actor.inputs(feats, batch["extra"])
+        mem = _sequence_memory(xa, batch["first"], self.actor.gru, cfg.burn_in)
+        mu, _ = self.actor.out(mem[:, train], xa[:, train])
+        loss = (torch.tanh(mu) - batch["action"][:, train]).pow(2).sum(-1).mean()
+        optimiser.zero_grad(set_to_none=True)
+        loss.backward()
+        optimiser.step()
+        return {"bc_loss": float(loss.detach())}
 
     def _features(self, depth: torch.Tensor) -> torch.Tensor:
         """Conv features (B, T, F) of shifted pooled frames; burn-in frames without autograd."""
@@ -355,6 +404,9 @@ class SacDrqRecurrentAgent(SacDrqBase):
         mask = batch["loss_mask"]
         alpha = self.log_alpha.detach().exp()
         out: dict[str, torch.Tensor] = {}
+        # PIRLNav's critic warm-up, as SAC-DrQ's: the cloned encoder and actor stay as they are (the critic's
+        # GRU and Q-heads learn)
+        warming_up = self.num_updates <= demonstration_settings(cfg).critic_warmup_updates
 
         feats = self._features(depth)  # grad only after the burn-in
         feats_d = feats.detach()
@@ -375,7 +427,7 @@ class SacDrqRecurrentAgent(SacDrqBase):
             bootstrap = (batch["not_done"] * batch["discount"]).unsqueeze(-1)
             target_q = batch["reward"].unsqueeze(-1) + bootstrap * (torch.min(tq1, tq2) - alpha * next_log_pi)
 
-        xc = self.critic.inputs(feats, extra)
+        xc = self.critic.inputs(feats_d if warming_up else feats, extra)
         mem_c = _sequence_memory(xc, first, self.critic.gru, burn)
         st = state[:, train] if state is not None else None
         q1, q2 = self.critic.q(mem_c[:, train], xc[:, train], st, batch["action"][:, train])
@@ -386,7 +438,7 @@ class SacDrqRecurrentAgent(SacDrqBase):
         self.critic_opt.step()
         out["critic_loss"], out["q_mean"] = critic_loss, (q1 * weight).sum()
 
-        if self.num_updates % cfg.actor_update_freq == 0:
+        if self.num_updates % cfg.actor_update_freq == 0 and not warming_up:
             xa = self.actor.inputs(feats_d, extra)
             mem = _sequence_memory(xa, first, self.actor.gru, burn)
             mu, log_std = self.actor.out(mem[:, train], xa[:, train])
@@ -395,7 +447,16 @@ class SacDrqRecurrentAgent(SacDrqBase):
             # its Q-heads and projection are the stepped ones
             xc_now = self.critic.inputs(feats_d[:, train], extra[:, train])
             aq1, aq2 = self.critic.q(mem_c[:, train].detach(), xc_now, st, pi)
-            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out)
+            penalty = None
+            bc_weight = self.bc_weight_now if "demo" in batch else 0.0
+            if bc_weight > 0:
+                # TD3+BC's term on the demonstration sequences' loss steps, as SAC-DrQ's (drq_actor_loss)
+                rows = batch["demo"].unsqueeze(-1)  # (B, 1, 1)
+                error = (torch.tanh(mu) - batch["action"][:, train]).pow(2).sum(-1, keepdim=True)
+                bc_loss = (rows * error).sum() / (rows.sum() * error.shape[1]).clamp(min=1.0)
+                penalty = bc_weight * torch.min(aq1, aq2).abs().mean().detach() * bc_loss
+                out["bc_loss"] = bc_loss
+            self.actor_and_alpha_step(alpha, log_pi, aq1, aq2, out, penalty)
             out["entropy"] = gaussian_entropy(log_std.reshape(-1, log_std.shape[-1]))
 
         return self.finish_update(out)

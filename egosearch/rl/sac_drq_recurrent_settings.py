@@ -8,12 +8,13 @@ from dataclasses import dataclass
 
 from egosearch.rl.network_settings import RandomShiftSettings, SacSettings
 from egosearch.rl.run_settings import Complaint
-from egosearch.rl.training_aids import PrivilegedCriticSettings
+from egosearch.rl.training_aids import DemonstrationSettings, PrivilegedCriticSettings
 
 
 @dataclass
-class SacDrqRecurrentSettings(PrivilegedCriticSettings, SacSettings, RandomShiftSettings):
-    """The settings recurrent SAC-DrQ reads beyond the run settings (a privileged critic, not demonstrations)."""
+class SacDrqRecurrentSettings(PrivilegedCriticSettings, DemonstrationSettings, SacSettings, RandomShiftSettings):
+    """The settings recurrent SAC-DrQ reads beyond the run settings: a privileged critic and the demonstrations
+    (imitation on sequences, then fine-tuning, as SAC-DrQ's), SAC's and the shifted input's, and its own."""
 
     recurrent_hidden_dim: int = 128
     """Ni et al. 2022 (a separate GRU for the actor and for the critic; 128 units is ours),

@@ -19,8 +19,8 @@ ENCODER_AUX_LOSSES = ("none", "reconstruction")
 @dataclass
 class SacDrqSettings(PrivilegedCriticSettings, DemonstrationSettings, SacSettings, RandomShiftSettings):
     """The settings SAC-DrQ reads beyond the run settings: a privileged critic and the demonstrations
-    (:mod:`egosearch.rl.training_aids`; it is the one learner whose update takes the batch's demonstration
-    rows and the cloning term), the networks, SAC's and the pooled, shifted input's settings, and its own."""
+    (:mod:`egosearch.rl.training_aids`), the networks, SAC's and the pooled, shifted input's settings, and its
+    own."""
 
     critic_layer_norm: bool = False
     """Paper: False (Table 2's Q-functions are plain MLPs). True ("sac_drq" only): a LayerNorm after

@@ -38,7 +38,6 @@ folder, fsync, ``os.replace``).
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import os
@@ -567,21 +566,10 @@ class LiveRun:
     def sample(self) -> dict:
         """An update's batch, the agent's draw: transitions (a recurrent agent's sequences, PPO's rollout);
         with ``demo_batch_fraction`` that share drawn from the demonstrations (marked by ``demo``)."""
-        if self.demos is None or not demonstration_settings(self.cfg).demo_batch_fraction:
+        fraction = demonstration_settings(self.cfg).demo_batch_fraction
+        if self.demos is None or not fraction:
             return self.agent.sample_batch(self.replay)
-        demo_rows = self.demo_rows
-        from_demos = int(demo_rows.sum())
-        online, demo = self.replay.sample(len(demo_rows) - from_demos), self.demos.sample(from_demos)
-        batch = {k: torch.cat([online[k], demo[k]]) for k in online}
-        batch["demo"] = demo_rows
-        return batch
-
-    @functools.cached_property
-    def demo_rows(self) -> torch.Tensor:
-        """(batch_size, 1): 1 on the rows a batch draws from the demonstrations (the last ones), once per run."""
-        size = self.cfg.batch_size
-        from_demos = round(size * demonstration_settings(self.cfg).demo_batch_fraction)
-        return torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
+        return self.agent.sample_with_demonstrations(self.replay, self.demos, fraction)
 
     # ---- imitating ------------------------------------------------------------------------
     def imitate(self) -> None:

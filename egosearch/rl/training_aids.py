@@ -3,7 +3,7 @@ demonstrations (cloning, DAgger, the critic's warm-up, demonstrations in replay,
 
 Neither is the paper's (its critic sees what the actor sees and it has no teacher); the ``cpu`` profile uses
 both (see :func:`egosearch.rl.profiles.cpu_profile`). A learner's settings class that reads one lists its
-class among its bases (SAC-DrQ's both, recurrent SAC-DrQ's and PPO's the privileged critic), so its config
+class among its bases (SAC-DrQ's and recurrent SAC-DrQ's both, PPO's the privileged critic), so its config
 has those fields and no other learner's does: a profile's values of them reach only the learners that have
 them, and a variant that sets one for another learner is refused in one line. The training loop, the
 demonstrations and the cost model read them through :func:`demonstration_settings` and
