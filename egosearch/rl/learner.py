@@ -16,6 +16,7 @@ this module). What it reads of a config is :class:`LearnerSettings`.
 
 from __future__ import annotations
 
+import functools
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING, Any, ClassVar, NotRequired, Protocol, TypedDict, runtime_checkable
 
@@ -117,6 +118,15 @@ class Agent(Protocol):
     def actor_state(self, metadata: dict[str, Any] | None = None) -> ActorFile: ...
 
 
+@functools.cache
+def demo_column(rows: int, from_demos: int, device: torch.device) -> torch.Tensor:
+    """(rows, 1): 0 on a batch's online rows, 1 on its last ``from_demos`` rows (the demonstrations'); made once
+    per size and device, not at every update."""
+    import torch
+
+    return torch.cat([torch.zeros(rows - from_demos, 1), torch.ones(from_demos, 1)]).to(device)
+
+
 class AgentBase(ABC):
     """A learner's optional hooks, with the behaviour of a memoryless agent whose replay holds the
     env's observations as they are and that cannot learn from demonstrations. A subclass sets
@@ -177,8 +187,7 @@ class AgentBase(ABC):
         from_demos = round(size * fraction)
         online, demo = replay.sample(size - from_demos), demos.sample(from_demos)
         batch = {k: torch.cat([online[k], demo[k]]) for k in online}
-        device = batch["reward"].device
-        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(device)
+        batch["demo"] = demo_column(size, from_demos, batch["reward"].device)
         return batch
 
     def cloning_batch(self, sources: list[MultiReplay], batch_size: int) -> dict[str, torch.Tensor]:

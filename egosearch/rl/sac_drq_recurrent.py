@@ -62,6 +62,7 @@ from egosearch.rl.common import (
     squashed_sample,
 )
 from egosearch.rl.config import LearnerConfig
+from egosearch.rl.learner import demo_column
 from egosearch.rl.pooled import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
 from egosearch.rl.replay import MultiReplay, ReplayBuffer, proportional_counts
 from egosearch.rl.training_aids import demonstration_settings
@@ -340,6 +341,8 @@ class SacDrqRecurrentAgent(SacDrqBase):
         cfg = self.cfg
         parts = [sample_sequences(source, n, cfg.burn_in, cfg.sequence_length, cfg.n_step, cfg.gamma, self.device)
                  for source, n in zip(sources, counts) if n > 0]
+        if len(parts) == 1:  # an update's plain draw: no copy
+            return parts[0]
         return {k: torch.cat([p[k] for p in parts]) for k in parts[0]}
 
     def sample_with_demonstrations(self, replay: MultiReplay, demos: MultiReplay,
@@ -349,7 +352,7 @@ class SacDrqRecurrentAgent(SacDrqBase):
         size = sequences_per_batch(self.cfg)
         from_demos = round(size * fraction)
         batch = self._sequences([replay, demos], [size - from_demos, from_demos])
-        batch["demo"] = torch.cat([torch.zeros(size - from_demos, 1), torch.ones(from_demos, 1)]).to(self.device)
+        batch["demo"] = demo_column(size, from_demos, self.device)
         return batch
 
     def cloning_batch(self, sources: list[MultiReplay], batch_size: int) -> dict[str, torch.Tensor]:
