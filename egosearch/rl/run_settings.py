@@ -114,8 +114,9 @@ class RunSettings:
     2019's form, which the paper cites; potential-based shaping as in habitat-lab). "geodesic" =
     the decrease of the geodesic distance to where the target counts as found, at every step,
     seen or not (habitat-lab's DistanceToGoalReward), with the collision term unclipped (the
-    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``head_on_geodesic``
-    lever, no profile's default. TRAINING ONLY: evaluation always scores the paper's task
+    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``cpu`` profile's since
+    the stuck-student redo (``ablations/head_on_geodesic_finetune.yaml`` screened it on three seeds;
+    before it the profile took "progress"). TRAINING ONLY: evaluation always scores the paper's task
     (success, SPL), whatever the training reward. A variant's ``train_env: distance_reward``
     takes precedence."""
     curriculum_steps: int = 0

@@ -64,8 +64,9 @@ class DemonstrationSettings:
     """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
     of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
     classical row (``egosearch.searchers.frontier``). "frontier_tuned": the same searcher tuned on
-    training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row). Either holds its head
-    fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
+    training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row; ``egosearch tune`` redoes
+    the tuning), the ``cpu`` profile's since the stuck-student redo (it was "frontier" before). Either holds
+    its head fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
     bc_updates: int = 0
     """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
     before the first env step, this many behaviour-cloning steps of the encoder and the actor on
