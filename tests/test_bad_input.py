@@ -52,7 +52,8 @@ BAD_VARIANT_FILES = [
     ("cloning_without_teacher", HEAD + "config: {demo_episodes: 0}\n",
      "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=12000 "
      "is out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations "
-     "set bc_updates: 0, critic_warmup_updates: 0, demo_batch_fraction: 0, bc_weight: 0, bc_decay_steps: 0"),
+     "set bc_updates: 0, critic_warmup_updates: 0, demo_batch_fraction: 0, bc_weight: 0, bc_decay_steps: 0, "
+     "demo_teacher: frontier"),
     ("half_batches_all_demos", HEAD + "config: {demo_episodes: 100, demo_batch_fraction: 1.0}\n",
      "ablations/half_batches_all_demos.yaml: config (on the cpu learner profile): "
      "LearnerConfig.demo_batch_fraction=1.0 is out of range; allowed: [0, 1) (the rest of each batch is online)"),

@@ -121,17 +121,19 @@ class DemonstrationSettings:
             bad("bc_weight", ">= 0")
         if self.demo_teacher not in DEMO_TEACHERS:
             bad("demo_teacher", ", ".join(DEMO_TEACHERS))
-        if self.demo_teacher != "frontier" and self.demo_episodes == 0:
-            bad("demo_teacher", "frontier (the default) unless demo_episodes >= 1 (no demonstrations, no teacher)")
         uses = {"bc_updates": self.bc_updates > 0, "demo_batch_fraction": self.demo_batch_fraction > 0,
                 "bc_weight": self.bc_weight > 0}
         for name, used in uses.items():
             if used and self.demo_episodes == 0:
                 # the cpu profile sets them all: name every one that needs turning off with the teacher
-                on = [n for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
-                                  "bc_decay_steps") if getattr(self, n)]
+                on = [f"{n}: 0" for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
+                                          "bc_decay_steps") if getattr(self, n)]
+                if self.demo_teacher != "frontier":
+                    on.append("demo_teacher: frontier")
                 bad(name, "0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations set "
-                    + ", ".join(f"{n}: 0" for n in on))
+                    + ", ".join(on))
+        if self.demo_teacher != "frontier" and self.demo_episodes == 0:
+            bad("demo_teacher", "frontier (the default) unless demo_episodes >= 1 (no demonstrations, no teacher)")
         if self.dagger_rounds and not self.bc_updates:
             bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
         if bool(self.dagger_rounds) != bool(self.dagger_episodes):
