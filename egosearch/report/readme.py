@@ -138,7 +138,7 @@ def block_provenance(root: Path, profile: str) -> str:
     config = workflow_config()
     summed = {"all": 0.0, "generalise": 0.0, "other": 0.0}
     for job in record["jobs"]:
-        summed[job_study(job, config)] += job_cost_s(job)
+        summed[job_study(job, config, record["profile"])] += job_cost_s(job)
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
              f"{record['date_utc'][:16].replace('T', ' ')} UTC on {machine_words(machine)}, "
              f"torch {machine.get('torch', '?')}.",
