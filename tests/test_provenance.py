@@ -1,10 +1,18 @@
 """The provenance record: a rewrite keeps what it does not recompute (the note), and every job names the
-machine it ran on, where that is known."""
+machine it ran on, where that is known; and what git stores stays small enough to clone."""
 
 import json
+import shutil
+import subprocess
 from pathlib import Path
 
+import pytest
+
 from egosearch.report import provenance
+
+REPO = Path(__file__).resolve().parent.parent
+TRACKED_FILE_LIMIT = 10 * 1024 * 1024
+"""The most bytes one file tracked by git may hold (10 MB)."""
 
 
 def _results(root: Path) -> Path:
@@ -73,3 +81,26 @@ def test_a_job_recorded_before_records_named_machines_is_not_given_one(tmp_path)
     record.write_text(json.dumps(old))
     jobs = {j["rule"]: j for j in provenance.write_provenance("p", results, record)["jobs"]}
     assert jobs["eval"]["machine"] is None and jobs["train"]["machine"]["cpu"] == "Far Away CPU"
+
+
+def _tracked_files() -> list[str]:
+    """The files git tracks in this checkout, relative to its root; skips the test without git or a checkout."""
+    if shutil.which("git") is None:
+        pytest.skip("git is not installed")
+    top = subprocess.run(["git", "rev-parse", "--show-toplevel"], cwd=REPO, capture_output=True, text=True)
+    if top.returncode != 0 or Path(top.stdout.strip()).resolve() != REPO:
+        pytest.skip(f"{REPO} is not the root of a git checkout")
+    listed = subprocess.run(["git", "ls-files", "-z"], cwd=REPO, capture_output=True, text=True, check=True)
+    return [name for name in listed.stdout.split("\0") if name]
+
+
+def test_every_tracked_file_stays_under_10_mb():
+    """A stored result, figure or weight file over 10 MB is one git keeps in every clone for good: store it
+    smaller (or leave it out of git) instead."""
+    names = _tracked_files()
+    assert names, "git lists no tracked file"
+    sizes = {name: (REPO / name).stat().st_size for name in names
+             if (REPO / name).is_file() and not (REPO / name).is_symlink()}
+    over = sorted(((size, name) for name, size in sizes.items() if size >= TRACKED_FILE_LIMIT), reverse=True)
+    assert not over, (f"{len(over)} tracked file(s) of {TRACKED_FILE_LIMIT / 2**20:g} MB or more: "
+                      + "; ".join(f"{name} ({size / 2**20:.1f} MB, {size:,} bytes)" for size, name in over))

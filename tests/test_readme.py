@@ -194,6 +194,41 @@ def test_the_repository_readme_and_docs_match_the_stored_cpu_results():
                          "results/cpu + paper_figs/cpu: run `egosearch report readme --profile cpu`")
 
 
+def test_the_readings_contrasts_read_the_profiles_seeds_only(tmp_path):
+    """head_on also stores the reference's spread seeds beyond the profile's (`snakemake seed_spread`): the
+    reading's height and cabinet contrasts are Table 1's, read on the profile's seeds alone."""
+    import yaml
+
+    from egosearch.report.readme import table1_contrast
+
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    seeds, spread = config["profiles"]["cpu"]["seeds"], config["profiles"]["cpu"]["spread_seeds"]
+    extra = [s for s in spread if s not in seeds]
+    assert seeds == [0, 1, 2] and extra, "the cpu profile's spread seeds go beyond its seeds"
+    home, n = config["homes"][0], 20
+    results = tmp_path / "results" / "cpu"
+    for height in (0.45, 1.05):
+        scen = results / "scenarios" / home / "everywhere" / f"h{height:g}.csv"
+        scen.parent.mkdir(parents=True, exist_ok=True)
+        # the same draws at both heights: every scenario is a shared draw
+        pd.DataFrame({"scenario_id": range(n), "layout": home, "placement": "everywhere", "height": height,
+                      "start_x": [float(i) for i in range(n)], "start_y": 1.0, "start_theta": 0.0,
+                      "target_object": "cereal_box", "target_x": 2.0, "target_y": 3.0,
+                      "target_z": 0.45}).to_csv(scen, index=False)
+        for seed in seeds + extra:
+            # Table 1's seeds succeed in every episode at both heights; a spread seed fails at 1.05 m
+            success = 0 if (seed in extra and height == 1.05) else 1
+            path = results / "eval" / "head_on" / f"seed{seed}" / home / "everywhere" / scen.name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            pd.DataFrame({"scenario_id": range(n), "success": success}).to_csv(path, index=False)
+    res = table1_contrast(tmp_path, "cpu")((1.05, "everywhere"), (0.45, "everywhere"))
+    assert res["n_seeds"] == len(seeds) and res["n_shared"] == n
+    assert res["difference"] == 0.0 and res["ci_low"] == res["ci_high"] == 0.0
+    # a profile with fewer seeds reads fewer of them (the smoke profile: seed 0)
+    (tmp_path / "results" / "cpu").rename(tmp_path / "results" / "smoke")
+    assert table1_contrast(tmp_path, "smoke")((1.05, "everywhere"), (0.45, "everywhere"))["n_seeds"] == 1
+
+
 @needs_stored_run
 def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, monkeypatch):
     """`egosearch report regenerate` from the stored CSVs gives the numbers the DAG stored."""

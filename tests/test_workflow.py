@@ -336,6 +336,59 @@ def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
         ["head_on", "head_off"], ["frontier", "frontier_head_off"]]
 
 
+def recorded_job(rule: str, profile: str, **wildcards) -> dict:
+    """The provenance row of one job of ``rule``, keyed as the record keys it (egosearch.report.provenance):
+    the rule's ``benchmark:`` path, as its .smk file writes it, under results/<profile>/benchmarks/, split
+    into its first folder (the recorded rule) and the rest (the job)."""
+    text = "\n".join(path.read_text() for path in sorted((REPO / "egosearch/workflow/rules").glob("*.smk")))
+    [body] = re.findall(rf"^rule {rule}:\n(.*?)(?=^\S|\Z)", text, re.MULTILINE | re.DOTALL)
+    [benchmark] = re.findall(r'benchmark:\s*\n\s*"([^"]+)\.tsv"', body)
+    key = benchmark.format(profile=profile, **wildcards).removeprefix(f"results/{profile}/benchmarks/")
+    first, rest = key.split("/", 1)
+    return {"rule": first, "job": rest, "wall_s": 1.0}
+
+
+def test_a_policys_job_is_of_all_only_for_a_variant_of_all_at_one_of_the_profiles_seeds():
+    """The study a recorded job is counted in (README's provenance, docs/gpu.md): the starts' evaluations of
+    `all`'s pair (what learning adds) are of `all`, a lever's start is not; the reference's spread seeds
+    (`snakemake seed_spread`, beyond the profile's seeds) are outside `all` whichever rule ran them."""
+    from egosearch.report.workflow_jobs import job_study, profile_seeds, variants_of_all
+
+    config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
+    assert profile_seeds(config, "cpu") == [0, 1, 2] and profile_seeds(config, "smoke") == [0]
+    assert profile_seeds({**config, "profile": "smoke"}) == [0]
+    lever = "head_on_tuned_teacher_geodesic_contact"
+    assert (REPO / "ablations" / f"{lever}.yaml").is_file() and lever not in variants_of_all(config)
+    assert {"head_on", "head_off"} <= set(variants_of_all(config))
+    cell = {"layout": "kitchen_living", "placement": "everywhere", "height": "1.05"}
+
+    def study(rule, variant, seed, profile="cpu"):
+        job = recorded_job(rule, profile, variant=variant, seed=seed, **cell)
+        return job_study(job, config, profile)
+
+    start = recorded_job("evaluate_start", "cpu", variant="head_on", seed=0, **cell)
+    assert start == {"rule": "eval_start", "job": "head_on/seed0/kitchen_living/everywhere/h1.05", "wall_s": 1.0}
+    assert study("evaluate_start", "head_on", 0) == "all"
+    assert study("evaluate_start", "head_off", 2) == "all"
+    assert study("evaluate_start", lever, 0) == "other"
+    assert study("evaluate_start", "head_on", 3) == "other"
+    for rule in ("train", "evaluate"):
+        assert study(rule, "head_on", 1) == "all"
+        assert study(rule, "head_on", 3) == "other" and study(rule, "head_on", 4) == "other"
+        assert study(rule, lever, 0) == "other"
+        assert study(rule, "head_on_generated_homes", 0) == "generalise"
+        # the smoke profile's `all` trains seed 0 alone
+        assert study(rule, "head_on", 0, "smoke") == "all" and study(rule, "head_on", 1, "smoke") == "other"
+    # the profile is the job's, not the config's: a cpu record read with a smoke config
+    job = recorded_job("train", "cpu", variant="head_on", seed=1)
+    assert job_study(job, {**config, "profile": "smoke"}, "cpu") == "all"
+    assert job_study(job, {**config, "profile": "smoke"}) == "other"
+    # a record of a profile the config does not list: its seeds are unknown, so every seed counts
+    with pytest.raises(ValueError, match="profile 'p' is not in the config"):
+        profile_seeds(config, "p")
+    assert job_study(recorded_job("train", "p", variant="head_on", seed=3), config, "p") == "all"
+
+
 def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_random_decisions():
     """At the cpu profile (a modular searcher): head_on against modular_random, head_off against
     modular_random_head_off, every seed against the floor's one, on the stored sets; nothing at a profile

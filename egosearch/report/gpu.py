@@ -59,7 +59,7 @@ def projection(root: Path) -> dict | None:
     other_s, provenance = 0.0, root / "results" / "cpu" / "provenance.json"
     if provenance.exists():
         for job in json.loads(provenance.read_text(encoding="utf-8"))["jobs"]:
-            if job["rule"] != "train" and job_study(job, config) == "all":
+            if job["rule"] != "train" and job_study(job, config, "cpu") == "all":
                 other_s += job_cost_s(job) * (scale if job["rule"].startswith("fullbody") else 1.0)
     cores = int(record["machine"]["cores"])
     out = {"train_h": train_s / 3600, "trainings": trainings, "trainings_h": trainings * train_s / 3600,

@@ -29,7 +29,7 @@ from egosearch.report.gpu import block_gpu, block_gpu_projection
 from egosearch.report.speed import HOSTS, block_speed, machine_words
 from egosearch.report.stats import cell_contrast
 from egosearch.report.tables import BOTH_HOMES, PAPER_TABLE1
-from egosearch.report.workflow_jobs import job_cost_s, job_study, workflow_config
+from egosearch.report.workflow_jobs import job_cost_s, job_study, profile_seeds, workflow_config
 
 BLOCK = re.compile(r"(<!-- egosearch:begin (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- egosearch:end (?P=name) -->)",
                    re.DOTALL)
@@ -138,7 +138,7 @@ def block_provenance(root: Path, profile: str) -> str:
     config = workflow_config()
     summed = {"all": 0.0, "generalise": 0.0, "other": 0.0}
     for job in record["jobs"]:
-        summed[job_study(job, config)] += job_cost_s(job)
+        summed[job_study(job, config, record["profile"])] += job_cost_s(job)
     lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
              f"{record['date_utc'][:16].replace('T', ' ')} UTC on {machine_words(machine)}, "
              f"torch {machine.get('torch', '?')}.",
@@ -362,22 +362,25 @@ def _contrast_text(res: dict | None, intervals: tuple) -> str:
 
 def table1_contrast(root: Path, profile: str, variant: str = "head_on") -> Callable[[tuple, tuple], dict | None]:
     """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every Table 1
-    home it was evaluated in (not the generalisation groups) and every seed, each episode joined to
+    home it was evaluated in (not the generalisation groups) and the profile's seeds (Table 1's:
+    :func:`profile_seeds`, not the reference's spread seeds stored beside them), each episode joined to
     its scenario's draw (home, start, target)."""
-    homes = set(workflow_config()["homes"])
+    config = workflow_config()
+    homes, seeds = set(config["homes"]), profile_seeds(config, profile)
 
     def cell(height: float, placement: str) -> pd.DataFrame | None:
         frames = []
         runs = root / "results" / profile / "eval" / variant
-        for path in sorted(runs.glob(f"seed*/*/{placement}/h{height:g}.csv")):
-            home, seed = path.parent.parent.name, int(path.parent.parent.parent.name.removeprefix("seed"))
-            if home not in homes:
-                continue
-            scen = root / "results" / profile / "scenarios" / home / placement / path.name
-            if not scen.exists():
-                return None
-            eps = pd.read_csv(path).merge(pd.read_csv(scen), on="scenario_id", validate="one_to_one")
-            frames.append(eps.assign(seed=seed))
+        for seed in seeds:
+            for path in sorted((runs / f"seed{seed}").glob(f"*/{placement}/h{height:g}.csv")):
+                home = path.parent.parent.name
+                if home not in homes:
+                    continue
+                scen = root / "results" / profile / "scenarios" / home / placement / path.name
+                if not scen.exists():
+                    return None
+                eps = pd.read_csv(path).merge(pd.read_csv(scen), on="scenario_id", validate="one_to_one")
+                frames.append(eps.assign(seed=seed))
         return pd.concat(frames, ignore_index=True) if frames else None
 
     def contrast(first: tuple, second: tuple) -> dict | None:

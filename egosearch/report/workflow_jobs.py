@@ -50,15 +50,31 @@ def claims_pairs(config: dict) -> list[list[str]]:
     return profile.get("claims_pairs", config.get("claims_pairs", []))
 
 
+def profile_seeds(config: dict, profile: str | None = None) -> list[int]:
+    """The training seeds ``all`` trains and Table 1 reads at ``profile`` (the config's own profile unless
+    given): the profile's ``seeds``. Its ``spread_seeds`` beyond them (the reference's, trained for
+    `snakemake seed_spread`) are no part of ``all`` or of its tables."""
+    profile = profile or config["profile"]
+    if profile not in config["profiles"]:
+        raise ValueError(f"profile {profile!r} is not in the config; its profiles: {', '.join(config['profiles'])}")
+    return list(config["profiles"][profile]["seeds"])
+
+
 def variants_of_all(config: dict | None = None) -> list[str]:
     """The variants `snakemake all` trains, in the DAG's order (comparisons train others)."""
     config = config or workflow_config()
     return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
 
 
-def job_study(job: dict, config: dict | None = None) -> str:
+def job_study(job: dict, config: dict | None = None, profile: str | None = None) -> str:
     """Which command a recorded job belongs to: "all", "generalise", or "other" (comparisons,
-    the budget study, the fresh-set check, the traces)."""
+    the budget study, the fresh-set check, the traces, the spread seeds). ``profile``: the one the job
+    ran at (a provenance record's ``profile``), the config's own unless given; its seeds
+    (:func:`profile_seeds`) are those ``all`` and ``generalise`` train (a profile the config does not
+    list has no known seeds: every seed counts). A policy's job (``train``, ``eval``, ``eval_start``:
+    ``variant/seedN/...``) is of ``all`` only for a variant of ``all`` (:func:`variants_of_all`) at one
+    of those seeds; a start's evaluation (``eval_start``, what learning adds) is of ``all`` for those
+    variants alone, never of ``generalise``."""
     config = config or workflow_config()
     of_all = set(variants_of_all(config))
     generalise_only = set(config.get("generalise", {}).get("variants", [])) - of_all
@@ -69,10 +85,14 @@ def job_study(job: dict, config: dict | None = None) -> str:
         return REPORTS_OUTSIDE_ALL.get(parts[0], "all")
     if any(part in GENERATED_GROUPS for part in parts):
         return "generalise"
-    if rule in ("train", "eval"):
+    if rule in ("train", "eval", "eval_start"):
+        if (profile or config["profile"]) in config["profiles"]:
+            seeds = {f"seed{seed}" for seed in profile_seeds(config, profile)}
+            if len(parts) < 2 or parts[1] not in seeds:
+                return "other"
         if parts[0] in of_all:
             return "all"
-        return "generalise" if parts[0] in generalise_only else "other"
+        return "generalise" if rule != "eval_start" and parts[0] in generalise_only else "other"
     return "all"
 
 
