@@ -152,17 +152,21 @@ register("frontier_head_off", "egosearch.searchers.frontier:FrontierPolicy", env
          path_style=("#bd9e39", ":", "D"),
          fig6_level=("classical searcher, head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "#777777"))
 # The frontier searcher tuned on training-side sets (egosearch.searchers.frontier_tuned), a bound row of its
-# own: the untuned rows above stay Table 1's classical reference.
+# own: the untuned rows above stay Table 1's classical reference. It is the cpu profile's teacher
+# (demo_teacher) since the stuck-student redo, so Figure 6 draws it as a level too.
 register("frontier_tuned", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy", head=True,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
          label="frontier searcher, tuned", bound=True, classical=True, path_style=("#637939", "-.", "P"),
          what="the frontier searcher with its parameters tuned on training-side sets only (generated homes, "
-              "other scenario seeds), never on Table 1's")
+              "other scenario seeds), never on Table 1's",
+         fig6_level=("tuned searcher (the cpu profile's teacher), head moving", "-.", "#637939"))
 register("frontier_tuned_head_off", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy",
          env_id="EgoSearchNoHead-v0", head=False,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
          label="frontier searcher, tuned, head fixed", what="the same with the camera fixed to the body",
-         bound=True, classical=True, path_style=("#8ca252", ":", "X"))
+         bound=True, classical=True, path_style=("#8ca252", ":", "X"),
+         fig6_level=("tuned searcher (the cpu profile's teacher), head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)),
+                     "#8ca252"))
 register("modular_random", "egosearch.searchers.modular:random_decisions", head=True, takes_seed=True,
          help="the modular searcher's walk with random decisions", label="modular searcher's walk, random decisions",
          what="the modular searcher's walk with each decision drawn uniformly at random",
