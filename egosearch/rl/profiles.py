@@ -120,8 +120,9 @@ env step ~10x cheaper and spends the steps that buys (see the budget study,
   ``critic_warmup_updates``, ``demo_batch_fraction``, ``bc_weight``, ``bc_decay_steps``; the
   paper learns from scratch): a TEACHER THE PAPER'S LEARNER DOES NOT HAVE. A training first
   runs the tuned classical frontier searcher (``demo_teacher``, since the stuck-student redo;
-  head fixed for the head-off variant) for 1,500 episodes of its training envs, clones it (12,000 steps; PIRLNav, Ramrakhya
-  et al. CVPR 2023), trains the critic alone for 2,500 updates, then runs SAC with half of every
+  head fixed for the head-off variant) for 1,500 episodes of its training envs, clones it
+  (12,000 steps; PIRLNav, Ramrakhya et al. CVPR 2023), trains the critic alone for 2,500
+  updates, then runs SAC with half of every
   batch from the demonstrations (RLPD, Ball et al. ICML 2023) and a cloning term of weight 0.4
   on the actor (TD3+BC) that decays to 0 over the first 100k env steps. The policy acts at every
   body step, the paper's policy class, and its step-0 policy (the clone) is stored

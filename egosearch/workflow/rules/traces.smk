@@ -1,7 +1,8 @@
 # Per-step traces and what they say about how the policies search (`snakemake --cores 2 behaviour
 # searches`, outside `all`): each trained policy reruns its Table 1 evaluation of the trace cells
-# with `--traces`. The runs are deterministic, so the episodes CSV beside each trace repeats the
-# stored evaluation row for row. Names: common.smk.
+# with `--traces`. The runs are deterministic on one machine, so the episodes CSV beside each trace
+# repeats the stored evaluation row for row where both ran on the same CPU (another CPU's floating point
+# can change some episodes: docs/results.md, "The same actors on another machine"). Names: common.smk.
 
 # Every Table 1 cell: the behaviour statistics pool them, with the cell and scenario as the unit.
 TRACE_CELLS = [(placement, height) for placement in PLACEMENTS for height in HEIGHTS]
