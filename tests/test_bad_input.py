@@ -1428,8 +1428,8 @@ ISSUE57_ENV_OPTIONS = [
 # Item 3: a stopped run of head_on (cpu, seed 0) resumed with demonstrations that are not its own, or not whole
 # (fixture `bad`): refused before any env is built, naming the file and what was expected.
 RESUME = "egosearch train: error: --out-dir: {t}/%s/ckpt/train_state.ckpt cannot resume with its demonstrations: "
-HEAD_ON_KWARGS = ("{'distance_reward': 'progress', 'train_heights': [0.45, 1.8], 'privileged_state': True, 'layout': "
-                  "'paper_homes', 'placement': 'everywhere'}")
+HEAD_ON_KWARGS = ("{'contact_signal': True, 'distance_reward': 'geodesic', 'train_heights': [0.45, 1.8], "
+                  "'privileged_state': True, 'layout': 'paper_homes', 'placement': 'everywhere'}")
 ISSUE57_DEMOS = [
     ("train_resume_with_another_variants_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
                                                                "{t}/dr_variant"],
@@ -1438,8 +1438,9 @@ ISSUE57_DEMOS = [
     ("train_resume_with_another_profiles_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
                                                                "{t}/dr_profile"],
      RESUME % "dr_profile" + "{t}/dr_profile/ckpt/demos.replay.npz holds other demonstrations than this run's: "
-     "env_id='EgoSearch-v0', env_kwargs={'layout': 'paper_homes', 'placement': 'everywhere'}, image_size=100; "
-     f"expected env_id='EgoSearchMemory-v0', env_kwargs={HEAD_ON_KWARGS}, image_size=50"),
+     "env_id='EgoSearch-v0', env_kwargs={'layout': 'paper_homes', 'placement': 'everywhere'}, teacher='frontier', "
+     f"image_size=100; expected env_id='EgoSearchMemory-v0', env_kwargs={HEAD_ON_KWARGS}, teacher='frontier_tuned', "
+     "image_size=50"),
     ("train_resume_with_the_npz_replaced", "cryptic", ["train", "--variant", "head_on", "--out-dir", "{t}/dr_npz"],
      RESUME % "dr_npz" + "{t}/dr_npz/ckpt/demos.replay.npz does not match its summary demos.json: the file holds "
      "image_size=100, transitions=3; the summary says image_size=50, transitions=2"),
@@ -1560,12 +1561,14 @@ ISSUE57_NEW_CASES = [
      "random acts at every body step: give a body env (EgoSearch-v0 or EgoSearchNoHead-v0), or leave --env-id out"),
     ("evaluate_an_actor_without_its_memory", "clear", [*EVALUATE, "--weights", HEAD_ON_ACTOR, "--env-id",
                                                        "EgoSearch-v0"],
-     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 (5 action values, 39 "
-     "observation values besides depth), not in EgoSearch-v0 (5 and 34): run it in EgoSearchMemory-v0"),
+     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 with contact_signal "
+     "(5 action values, 41 observation values besides depth), not in EgoSearch-v0 with contact_signal (5 and 36): "
+     "run it in EgoSearchMemory-v0 with contact_signal"),
     ("evaluate_an_actor_with_a_floor_map", "clear", [*EVALUATE, "--weights", HEAD_ON_ACTOR, "--env-id",
                                                      "EgoSearchMap-v0"],
-     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 (5 action values, 39 "
-     "observation values besides depth), not in EgoSearchMap-v0 (5 and 186): run it in EgoSearchMemory-v0"),
+     f"egosearch evaluate: error: {HEAD_ON_ACTOR}: this actor was trained in EgoSearchMemory-v0 with contact_signal "
+     "(5 action values, 41 observation values besides depth), not in EgoSearchMap-v0 with contact_signal (5 and 188): "
+     "run it in EgoSearchMemory-v0 with contact_signal"),
     ("evaluate_the_tuned_searcher_head_fixed", "clear", [*EVALUATE, "--policy", "frontier_tuned", "--env-id",
                                                          "EgoSearchNoHeadMemory-v0"],
      "egosearch evaluate: error: --env-id=EgoSearchNoHeadMemory-v0 fixes the head, and --policy frontier_tuned is the "
