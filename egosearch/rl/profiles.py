@@ -133,7 +133,7 @@ env step ~10x cheaper and spends the steps that buys (see the budget study,
   carries the result"'s levers measured (``docs/ablations.md``) did not beat it;
 - **the stuck-student redo** (``demo_teacher`` "frontier_tuned", ``train_distance_reward``
   "geodesic", ``contact_signal``): the student failed stuck against furniture in 6.5-15.7 % of
-  the stored Table 1 episodes per cell, the frontier searcher in 0.7-2.2 %. Three levers screened on three
+  the stored Table 1 episodes per cell, the frontier searcher in at most 2.2 %. Three levers screened on three
   seeds each against the reference's spread seeds, combined as
   ``ablations/head_on_tuned_teacher_geodesic_contact.yaml`` (and its head-off half), raised
   success in every cell by point estimate (none detected after Holm) and lowered the stuck
