@@ -28,7 +28,13 @@ from egosearch.report.provenance import check_stored, verify, write_provenance
 from egosearch.report.readme import pages, update_pages, update_readme
 from egosearch.report.searches import searches_report
 from egosearch.report.tables import stuck_path
-from egosearch.report.workflow_jobs import bound_eval_files, variants_of_all, workflow_config, workflow_heights
+from egosearch.report.workflow_jobs import (
+    bound_eval_files,
+    profile_seeds,
+    variants_of_all,
+    workflow_config,
+    workflow_heights,
+)
 from egosearch.rl.config import departure_rows, load_config, table2_rows
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.searchers import registry as searchers
@@ -596,7 +602,7 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
     homes = set(config["homes"])
     # the profile's seeds only: the reference's spread seeds beyond them (snakemake seed_spread) are no
     # part of Table 1, Figure 6 or the path-length tables, as in the DAG
-    seeds = {f"seed{s}" for s in config["profiles"][profile]["seeds"]}
+    seeds = {f"seed{s}" for s in profile_seeds(config, profile)}
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv")
                    if Path(p).parts[-3] in homes and Path(p).parts[-4] in seeds)
     curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv") if p.parts[-2] in seeds)
