@@ -221,6 +221,52 @@ def test_dagger_labels_each_state_the_student_reaches_with_the_teachers_action(d
     assert np.abs(buf.action[:buf.n_added]).max() > 0.1  # the teacher wanted to move
 
 
+def test_near_contact_keeps_the_steps_within_the_window_of_a_collision():
+    from egosearch.rl.imitation import near_contact
+
+    collided = [False] * 12
+    collided[3] = collided[10] = True
+    # window 2: steps 1-5 around the first collision, 8-11 around the second (the episode ends at 11)
+    assert near_contact(collided, window=2) == [i in (1, 2, 3, 4, 5, 8, 9, 10, 11) for i in range(12)]
+    assert near_contact([False] * 5) == [False] * 5
+    assert near_contact([True], window=5) == [True]
+
+
+class DriveForward(StandStill):
+    """A student that walks straight ahead: it runs into furniture or a wall within an episode."""
+
+    def act(self, obs, deterministic=True):
+        return np.array([1.0, 0.0, 0.0, 0.0, 0.0], np.float32)
+
+
+def test_a_contact_round_keeps_exactly_the_labelled_states_near_the_students_collisions(demos):
+    from egosearch.rl.imitation import DAGGER_SEED_BASE, dagger_round, near_contact
+    from egosearch.rl.train_env import make_train_env, train_env_kwargs
+
+    cfg_all, _ = demos
+    cfg_contact = load_config("smoke", {**SMALL, "seed": 2, "dagger_states": "contact"})
+    every, figures_all = dagger_round(DriveForward(), "EgoSearchMemory-v0", cfg_all, ENV, 1, round_index=0)
+    near, figures = dagger_round(DriveForward(), "EgoSearchMemory-v0", cfg_contact, ENV, 1, round_index=0)
+    # the same episode again, to read which steps ran into something
+    env = make_train_env("EgoSearchMemory-v0", train_env_kwargs(cfg_all, ENV))
+    env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg_all.seed)
+    collided, done = [], False
+    while not done:
+        _, _, terminated, truncated, info = env.step(DriveForward().act(None))
+        collided.append(bool(info["collided"]))
+        done = terminated or truncated
+    env.close()
+    keep = np.flatnonzero(near_contact(collided))
+    assert figures_all["transitions"] == figures["states_reached"] == len(collided)
+    assert 0 < figures["transitions"] == len(keep) < len(collided)  # it hit something, and not at every step
+    np.testing.assert_allclose(near.buffers[0].action[:len(keep)], every.buffers[0].action[keep], atol=1e-6)
+
+
+def test_dagger_states_other_than_all_or_contact_is_refused_in_one_line():
+    with pytest.raises(ValueError, match="dagger_states.*all, contact"):
+        load_config("smoke", {**SMALL, "dagger_states": "stuck"})
+
+
 def test_a_training_with_dagger_records_its_rounds(tmp_path):
     cfg = load_config("smoke", {**SMALL, "seed": 5, "demo_episodes": 2, "bc_updates": 10, "dagger_rounds": 2,
                                 "dagger_episodes": 1, "total_env_steps": 150, "init_steps": 100, "eval_every": 150,

@@ -35,6 +35,19 @@ DAGGER_SEED_BASE + 100_000 s + 10_000 r + i: apart from the demonstrations' (``r
 and the training curve's evaluation episodes."""
 MAX_DAGGER_EPISODES = 10_000
 """A round's episodes stay below the next round's seeds."""
+CONTACT_WINDOW = 5
+"""With ``dagger_states: contact``, a state is kept when a step at most this many steps before or after
+it ran the body into something: the approach the teacher would have turned from, and the push."""
+
+
+def near_contact(collided: list[bool], window: int = CONTACT_WINDOW) -> list[bool]:
+    """For each step t of an episode (``collided[t]``: the step taken from state t ran into something),
+    whether some step within ``window`` steps of t, before or after, did."""
+    hits = np.flatnonzero(np.asarray(collided, dtype=bool))
+    keep = np.zeros(len(collided), dtype=bool)
+    for t in hits:
+        keep[max(0, t - window):t + window + 1] = True
+    return keep.tolist()
 
 
 def clone(agent, sources: list[MultiReplay], steps: int, batch_size: int, optimiser: torch.optim.Optimizer,
@@ -50,17 +63,19 @@ def clone(agent, sources: list[MultiReplay], steps: int, batch_size: int, optimi
 
 
 def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episodes: int, round_index: int,
-                 device: torch.device | str = "cpu") -> tuple[MultiReplay, dict]:
+                 device: torch.device | str = "cpu") -> tuple[MultiReplay | None, dict]:
     """One DAgger round: the student (``agent``'s mean action) drives ``episodes`` training-side episodes
     of ``env_id`` under ``cfg``'s training env settings; at every state the teacher says what it would
-    do. Returns the labelled states (one ring, actions = the teacher's labels) and the round's figures:
-    the student's success, the mean squared difference of its actions from the labels, CPU seconds."""
+    do. Returns the labelled states that ``dagger_states`` keeps (one ring, actions = the teacher's labels;
+    None if it kept none) and the round's figures: the student's success, the mean squared difference of
+    its actions from the labels, the states kept, CPU seconds."""
     if not 1 <= episodes <= MAX_DAGGER_EPISODES:
         raise ValueError(f"episodes={episodes}; allowed: 1..{MAX_DAGGER_EPISODES}")
+    only_contact = demonstration_settings(cfg).dagger_states == "contact"
     env = make_train_env(env_id, train_env_kwargs(cfg, env_kwargs))
     cpu0 = time.process_time()
     labelled = None
-    successes, differences = [], []
+    successes, differences, reached = [], [], 0
     try:
         for episode in range(episodes):
             obs, _ = env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg.seed + 10_000 * round_index + episode)
@@ -73,21 +88,29 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
             teacher = new_teacher(env, demonstration_settings(cfg).demo_teacher)
             agent.reset_policy_state()  # a student with a memory starts each episode afresh
             stored = stored_observation(obs, cfg)
+            steps, collided = [], []
             terminated = truncated = False
             while not (terminated or truncated):
                 label = teacher.act(obs)
                 action = agent.act(obs, deterministic=True)
                 differences.append(float(np.sum((action - label) ** 2)))
-                obs, reward, terminated, truncated, _ = env.step(action)
+                obs, reward, terminated, truncated, info = env.step(action)
                 next_stored = stored_observation(obs, cfg)
-                labelled.add(0, stored, label, float(reward), next_stored, terminated, truncated)
+                steps.append((stored, label, float(reward), next_stored, terminated, truncated))
+                collided.append(bool(info.get("collided", False)))
                 stored = next_stored
+            reached += len(steps)
+            keep = near_contact(collided) if only_contact else [True] * len(steps)
+            for step, kept in zip(steps, keep):
+                if kept:
+                    labelled.add(0, *step)
             successes.append(bool(terminated))
     finally:
         env.close()
-    figures = {"round": round_index + 1, "episodes": episodes, "transitions": len(labelled),
+    kept = len(labelled) if labelled is not None else 0
+    figures = {"round": round_index + 1, "episodes": episodes, "transitions": kept, "states_reached": reached,
                "student_success": round(float(np.mean(successes)), 4),
                "squared_difference_from_teacher": round(float(np.mean(differences)), 4),
                "cpu_s": round(time.process_time() - cpu0, 1)}
-    return labelled, figures
+    return (labelled if kept else None), figures
 

@@ -589,8 +589,10 @@ class LiveRun:
             self.imitation["dagger"].append(figures)
             self.say(f"DAgger round {r + 1}/{aids.dagger_rounds}: the student succeeded in "
                      f"{figures['student_success']:.2f} of {figures['episodes']} episodes; "
-                     f"{figures['transitions']} states labelled ({figures['cpu_s']:.0f} CPU-s)")
-            sources.append(labelled)
+                     f"{figures['transitions']} of its {figures['states_reached']} states labelled "
+                     f"({aids.dagger_states}; {figures['cpu_s']:.0f} CPU-s)")
+            if labelled is not None:  # "contact": a round whose student never touched anything adds nothing
+                sources.append(labelled)
             loss = clone(self.agent, sources, aids.bc_updates, cfg.batch_size, optimiser, self.say,
                          f"DAgger round {r + 1}: cloning")
         # The learner's own rate (env steps per CPU-second, what the estimates scale) leaves this out.

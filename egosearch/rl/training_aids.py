@@ -21,6 +21,8 @@ from typing import Any, ClassVar
 from egosearch.rl.run_settings import Complaint
 
 DEMO_TEACHERS = ("frontier", "frontier_tuned")
+DAGGER_STATES = ("all", "contact")
+"""What a DAgger round keeps of the states the student reaches (``dagger_states``)."""
 """The classical searchers demonstrations may come from (see ``DemonstrationSettings.demo_teacher``;
 ``egosearch.rl.demos.TEACHERS`` maps each to its class)."""
 
@@ -83,6 +85,13 @@ class DemonstrationSettings:
     proportion to their sizes (``egosearch.rl.imitation``)."""
     dagger_episodes: int = 0
     """Ours (with ``dagger_rounds``): episodes the student drives in each DAgger round."""
+    dagger_states: str = "all"
+    """Ours (with ``dagger_rounds``): which of the student's states a round labels and keeps, one of
+    :data:`DAGGER_STATES`. "all": every state it reaches (DAgger as Ross et al.). "contact": only the states
+    within ``imitation.CONTACT_WINDOW`` steps of a step on which its body ran into something, before or
+    after, so the teacher is asked only where the student meets furniture: the part of lever (c) of the
+    stuck-student issue that relabels the student's stuck states (``ablations/head_on_dagger_contact.yaml``;
+    the clone, before RL, fails stuck in 12-23 % of the stored episodes per height)."""
     critic_warmup_updates: int = 0
     """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
     the first policy steps follow a critic fitted to it): the first this many RL updates train only
@@ -138,6 +147,8 @@ class DemonstrationSettings:
             bad("dagger_rounds", "0 unless bc_updates >= 1 (each round clones the student again)")
         if bool(self.dagger_rounds) != bool(self.dagger_episodes):
             bad("dagger_episodes", "1..10000 with dagger_rounds >= 1, else 0")
+        if self.dagger_states not in DAGGER_STATES:
+            bad("dagger_states", ", ".join(DAGGER_STATES))
         if self.dagger_episodes > 10_000:
             bad("dagger_episodes", "1..10000 (a round's episodes stay below the next round's seeds)")
         if self.bc_weight > 0 and self.demo_batch_fraction == 0:
