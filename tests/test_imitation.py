@@ -233,10 +233,16 @@ def test_near_contact_keeps_the_steps_within_the_window_of_a_collision():
 
 
 class DriveForward(StandStill):
-    """A student that walks straight ahead: it runs into furniture or a wall within an episode."""
+    """A student that walks ahead for 25 steps, backs off for 10, and so on: it runs into furniture or a
+    wall, leaves it and comes back, so that its contact states come in runs inside the episode."""
+
+    def __init__(self):
+        self.calls = 0
 
     def act(self, obs, deterministic=True):
-        return np.array([1.0, 0.0, 0.0, 0.0, 0.0], np.float32)
+        self.calls += 1
+        forward = 1.0 if (self.calls - 1) % 35 < 25 else -1.0
+        return np.array([forward, 0.0, 0.0, 0.0, 0.0], np.float32)
 
 
 def test_a_contact_round_keeps_exactly_the_labelled_states_near_the_students_collisions(demos):
@@ -250,16 +256,24 @@ def test_a_contact_round_keeps_exactly_the_labelled_states_near_the_students_col
     # the same episode again, to read which steps ran into something
     env = make_train_env("EgoSearchMemory-v0", train_env_kwargs(cfg_all, ENV))
     env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg_all.seed)
-    collided, done = [], False
+    collided, done, student = [], False, DriveForward()
     while not done:
-        _, _, terminated, truncated, info = env.step(DriveForward().act(None))
+        _, _, terminated, truncated, info = env.step(student.act(None))
         collided.append(bool(info["collided"]))
         done = terminated or truncated
     env.close()
-    keep = np.flatnonzero(near_contact(collided))
+    flags = near_contact(collided)
+    keep = np.flatnonzero(flags)
+    runs_inside = sum(1 for t in range(1, len(flags)) if flags[t] and not flags[t - 1])
     assert figures_all["transitions"] == figures["states_reached"] == len(collided)
     assert 0 < figures["transitions"] == len(keep) < len(collided)  # it hit something, and not at every step
-    np.testing.assert_allclose(near.buffers[0].action[:len(keep)], every.buffers[0].action[keep], atol=1e-6)
+    assert runs_inside >= 2  # runs that start inside the episode, after states that were left out
+    # each kept state is stored as the student saw it: its whole depth stack, mask and proprioception
+    mine, theirs = near.buffers[0], every.buffers[0]
+    np.testing.assert_array_equal(mine.stacks(np.arange(len(keep)))[0], theirs.stacks(keep)[0])
+    np.testing.assert_array_equal(mine.proprio[:len(keep)], theirs.proprio[keep])
+    np.testing.assert_array_equal(mine.mask[:len(keep)], theirs.mask[keep])
+    np.testing.assert_allclose(mine.action[:len(keep)], theirs.action[keep], atol=1e-6)
 
 
 def test_dagger_states_other_than_all_or_contact_is_refused_in_one_line():

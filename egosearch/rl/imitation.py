@@ -81,7 +81,9 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
             obs, _ = env.reset(seed=DAGGER_SEED_BASE + 100_000 * cfg.seed + 10_000 * round_index + episode)
             if labelled is None:
                 state_dim = int(np.asarray(obs["state"]).shape[0]) if critic_reads_state(cfg) else 0
-                labelled = MultiReplay(1, episodes * MAX_STEPS, agent.replay_image_size, cfg.frame_history,
+                # "contact" writes each kept run's depth stack before it: up to twice the frames per state
+                capacity = episodes * MAX_STEPS * (2 if only_contact else 1)
+                labelled = MultiReplay(1, capacity, agent.replay_image_size, cfg.frame_history,
                                        int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
                                        state_dim=state_dim)
@@ -101,13 +103,20 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
                 stored = next_stored
             reached += len(steps)
             keep = near_contact(collided) if only_contact else [True] * len(steps)
-            for step, kept in zip(steps, keep):
-                if kept:
-                    labelled.add(0, *step)
+            for t, (step, kept) in enumerate(zip(steps, keep)):
+                if not kept:
+                    continue
+                if t > 0 and not keep[t - 1]:  # a run that starts inside the episode: its own stored episode
+                    labelled.end_episodes()
+                    labelled.begin_mid_episode(0, step[0])
+                labelled.add(0, *step)
+            labelled.end_episodes()  # a run may stop before the episode does
             successes.append(bool(terminated))
     finally:
         env.close()
     kept = len(labelled) if labelled is not None else 0
+    if labelled is not None and kept != labelled.buffers[0].n_added:
+        raise RuntimeError(f"DAgger round: {labelled.buffers[0].n_added - kept} labelled states overwritten")
     figures = {"round": round_index + 1, "episodes": episodes, "transitions": kept, "states_reached": reached,
                "student_success": round(float(np.mean(successes)), 4),
                "squared_difference_from_teacher": round(float(np.mean(differences)), 4),

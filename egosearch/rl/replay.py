@@ -120,6 +120,19 @@ class ReplayBuffer:
         the env was reset although the last stored transition did not end its episode)."""
         self.in_episode = False
 
+    def begin_mid_episode(self, obs: dict) -> None:
+        """Start a stored episode at ``obs``, a state inside an env episode: its whole depth stack is
+        written as the frames before its transition, so that the stored state rebuilds exactly (a
+        DAgger round that keeps only some of the student's states). The next :meth:`add` takes ``obs``."""
+        depth = obs["depth"]
+        if depth.shape != (self.k, self.image_size, self.image_size):
+            raise ValueError(f"depth must have shape {(self.k, self.image_size, self.image_size)}, got {depth.shape}")
+        self.episode_start = self._write_frame(depth[0])
+        for frame in depth[1:]:
+            self._write_frame(frame)
+        self.t = self.k - 1  # frame j of the stack is f_{t-(k-1)+j}: the frames just written
+        self.in_episode = True
+
     def _write_frame(self, frame: np.ndarray) -> int:
         no = self.frames_written
         self.frames[no % self.n_frames] = frame
@@ -359,6 +372,9 @@ class MultiReplay:
     def new_episode(self) -> None:
         for b in self.buffers:
             b.new_episode()
+
+    def begin_mid_episode(self, env_index: int, obs: dict) -> None:
+        self.buffers[env_index].begin_mid_episode(obs)
 
     def end_episodes(self) -> None:
         """Cut every ring's running episode: its last transition becomes truncated (n-step returns
