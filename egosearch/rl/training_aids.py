@@ -21,10 +21,10 @@ from typing import Any, ClassVar
 from egosearch.rl.run_settings import Complaint
 
 DEMO_TEACHERS = ("frontier", "frontier_tuned")
-DAGGER_STATES = ("all", "contact")
-"""What a DAgger round keeps of the states the student reaches (``dagger_states``)."""
 """The classical searchers demonstrations may come from (see ``DemonstrationSettings.demo_teacher``;
 ``egosearch.rl.demos.TEACHERS`` maps each to its class)."""
+DAGGER_STATES = ("all", "contact")
+"""What a DAgger round keeps of the states the student reaches (``DemonstrationSettings.dagger_states``)."""
 
 
 @dataclass
