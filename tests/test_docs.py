@@ -63,15 +63,22 @@ def test_the_departures_are_one_link_from_the_readme():
 
 
 def test_the_readme_keeps_the_commands_ci_runs():
-    """.ci/run runs the README's test command first, then the slow tests it leaves out (so that every
-    test runs in CI): the first must stay in the README as a command block, the second be named there."""
+    """.ci/run runs the README's test command first, then the slow tests it leaves out but for the
+    exhaustive ones: the first must stay in the README as a command block, the second be named there."""
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     ci = [line for line in (REPO / ".ci" / "run").read_text().splitlines() if "-m pytest" in line]
     assert len(ci) == 2 and all(line.startswith("python3 -m pytest") for line in ci), ci
     assert "```bash\npython " + ci[0].removeprefix("python3 ") + "\n```" in readme
-    assert ci[0].endswith('-m "not slow"') and ci[1].endswith("-m slow")
+    assert ci[0].endswith('-m "not slow"') and ci[1].endswith('-m "slow and not exhaustive"')
     assert "`python " + ci[1].removeprefix("python3 ") + "`" in readme
     assert "```bash\nsnakemake --cores 2 all\n```" in readme
+
+
+def test_no_exhaustive_test_is_left_in_this_run_unless_slow_ones_are(request):
+    """An exhaustive test is marked slow too, so the README's ``-m "not slow"`` never selects it."""
+    for item in request.session.items:
+        if item.get_closest_marker("exhaustive"):
+            assert item.get_closest_marker("slow"), f"{item.nodeid} is marked exhaustive but not slow"
 
 
 def test_the_readme_is_a_two_minute_read_and_the_test_time_lives_there_only():
