@@ -6,7 +6,8 @@ evaluations, and by driving the env on the stored scenario sets with four search
 random actions, a beeline that walks straight at the target into whatever is in the way, and a
 follower of ℓ's own grid that walks into contact with furniture when that is shorter. The default run
 takes the two shortest scenarios of each stored set; ``-m slow`` adds every 5th scenario of Table 1's sets,
-and ``-m exhaustive`` every scenario of them.
+and ``-m exhaustive`` every scenario of them (the stored ℓ are recomputed the same way: the first three of
+each set, every 5th, every one).
 """
 
 from __future__ import annotations
@@ -258,7 +259,7 @@ def test_ell_bounds_every_success_on_the_shortest_stored_scenarios():
 
 
 TABLE1_SETS = [p for p in STORED_SETS if p.parts[-3] in ("kitchen_living", "bedroom_bath")]
-# CI's slow run takes every 5th scenario of each of Table 1's sets, starting at a different place in each set
+# The slow spread checks (CI's) take every 5th scenario of each set, starting at a different place in each set
 SPREAD_STEP = 5
 
 
