@@ -221,13 +221,14 @@ SEARCHERS = {"oracle": OraclePolicy, "random": lambda env: RandomPolicy(5, seed=
 
 
 def _check_sets(pick, sets=None) -> dict[str, int]:
-    """Run every searcher on ``pick(scenarios)`` of each stored set; every success must respect ℓ."""
+    """Run every searcher on ``pick(scenarios, index of the set)`` of each stored set; every success must
+    respect ℓ."""
     sets = STORED_SETS if sets is None else sets
     assert sets, "no stored scenario sets under results/*/scenarios"
     successes = dict.fromkeys(SEARCHERS, 0)
     broken = []
-    for path in sets:
-        chosen = pick(read_scenarios(path))
+    for index, path in enumerate(sets):
+        chosen = pick(read_scenarios(path), index)
         env = SearchEnv(chosen[0].layout, chosen[0].placement, head=True, height=chosen[0].height)
         try:
             for sc in chosen:
@@ -253,7 +254,7 @@ def _check_sets(pick, sets=None) -> dict[str, int]:
 
 
 def test_ell_bounds_every_success_on_the_shortest_stored_scenarios():
-    successes = _check_sets(lambda scs: sorted(scs, key=lambda s: s.shortest_path)[:2])
+    successes = _check_sets(lambda scs, _: sorted(scs, key=lambda s: s.shortest_path)[:2])
     # Each searcher must have produced successes for the check to mean anything.
     assert all(successes.values()), successes
 
@@ -278,8 +279,7 @@ def test_the_spread_covers_every_scenario_of_a_set_once_over_its_five_offsets():
 def test_ell_bounds_every_success_on_a_spread_of_the_stored_scenarios():
     # A fifth of Table 1's sets; the generalisation groups' sets (800 more scenarios over 40 homes) are
     # checked on their shortest scenarios by the test above
-    picks = iter(range(len(TABLE1_SETS)))
-    successes = _check_sets(lambda scs: _spread(scs, next(picks)), TABLE1_SETS)
+    successes = _check_sets(_spread, TABLE1_SETS)
     assert successes["oracle"] >= 0.9 * sum(len(_spread(read_scenarios(p), i)) for i, p in enumerate(TABLE1_SETS))
     assert all(successes.values()), successes
 
@@ -288,33 +288,32 @@ def test_ell_bounds_every_success_on_a_spread_of_the_stored_scenarios():
 @pytest.mark.exhaustive
 def test_ell_bounds_every_success_on_every_stored_scenario():
     # Table 1's sets whole (about 10 CPU-minutes): run it when the scenario sets, ℓ or the body change
-    successes = _check_sets(lambda scs: scs, TABLE1_SETS)
+    successes = _check_sets(lambda scs, _: scs, TABLE1_SETS)
     assert successes["oracle"] >= 0.9 * sum(len(read_scenarios(p)) for p in TABLE1_SETS), successes
     assert all(successes.values()), successes
 
 
 # --------------------------------------------------------------------------------------------- stored files
 def _stored_ell_matches(pick) -> None:
-    for path in STORED_SETS:
-        for sc in pick(read_scenarios(path)):
+    for index, path in enumerate(STORED_SETS):
+        for sc in pick(read_scenarios(path), index):
             ell = shortest_path_length(sc.layout, sc.target(), sc.height, sc.start_x, sc.start_y)
             assert sc.shortest_path == pytest.approx(round(ell, 4), abs=1e-9), (path, sc.scenario_id)
 
 
 def test_stored_ell_is_what_the_code_computes_now():
-    _stored_ell_matches(lambda scs: scs[:3])
+    _stored_ell_matches(lambda scs, _: scs[:3])
 
 
 @pytest.mark.slow
 def test_a_spread_of_the_stored_ell_is_what_the_code_computes_now():
-    picks = iter(range(len(STORED_SETS)))
-    _stored_ell_matches(lambda scs: _spread(scs, next(picks)))
+    _stored_ell_matches(_spread)
 
 
 @pytest.mark.slow
 @pytest.mark.exhaustive
 def test_every_stored_ell_is_what_the_code_computes_now():
-    _stored_ell_matches(lambda scs: scs)
+    _stored_ell_matches(lambda scs, _: scs)
 
 
 # Stored scenarios whose ℓ a stored success undercuts, with what was found; a defect of ℓ to mend
