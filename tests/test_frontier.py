@@ -2,6 +2,7 @@
 finds targets without learning."""
 
 import numpy as np
+import pytest
 
 import egosearch.sim.body_envs  # noqa: F401
 from egosearch.runs.evaluate import evaluate, make_env
@@ -167,3 +168,83 @@ def test_the_tuned_searcher_reads_only_its_pose_and_is_named_by_its_head():
     for env_id in ("EgoSearch-v0", "EgoSearchNoHead-v0"):
         rows = evaluate(env_id, lambda env: FrontierTunedPolicy(PoseOnly(env)), scenarios, seed=0)
         assert sum(r["success"] for r in rows) >= 4, rows  # the untuned searcher's bar in the test above
+
+
+
+# ---- the memory window -------------------------------------------------------------------------------------------
+
+def _walk(n_steps=30, seed=5):
+    """Depth frames and the poses they were seen from, along a walk of the frontier searcher, and the sensor."""
+    scenario = generate_scenarios("kitchen_living", "everywhere", 1.05, n=1, seed=seed)[0]
+    env = make_env("EgoSearch-v0", scenario)
+    policy = FrontierPolicy(env)
+    obs, _ = env.reset(seed=0, options={"scenario": scenario})
+    policy.reset()
+    seen = []
+    for _ in range(n_steps):
+        seen.append((obs["depth"][-1].copy(), env.unwrapped.state))
+        obs, _, term, trunc, _ = env.step(policy.act(obs))
+        if term or trunc:
+            break
+    sensor = env.unwrapped.sensor
+    env.close()
+    return seen, sensor
+
+
+def test_a_windowed_map_is_the_map_of_its_last_frames_alone():
+    """After every frame, the map held to K frames equals a map built afresh (same origin) from those K frames alone,
+    visits included; with K beyond the walk it is the whole-episode map at every step."""
+    from egosearch.sim.floormap import FloorMap, WindowedFloorMap
+
+    seen, sensor = _walk()
+    assert len(seen) >= 20
+    whole = FloorMap.for_sensor(sensor)
+    for window in (1, 4, 1000):
+        windowed = WindowedFloorMap.for_sensor(sensor, window=window)
+        whole.reset()
+        for t, (frame, state) in enumerate(seen):
+            windowed.update(frame, state)
+            whole.update(frame, state)
+            fresh = FloorMap.for_sensor(sensor)
+            fresh.origin = windowed.origin
+            for old_frame, old_state in seen[max(0, t + 1 - window):t + 1]:
+                fresh.update(old_frame, old_state)
+            assert np.array_equal(windowed.grid, fresh.grid), (window, t)
+            assert np.array_equal(windowed.visits, fresh.visits), (window, t)
+            if window == 1000:
+                assert np.array_equal(windowed.grid, whole.grid), t
+        if window < len(seen):  # forgetting is real: the short window knows less than the whole episode
+            assert (windowed.grid != 0).sum() < (whole.grid != 0).sum()
+
+
+def test_a_memory_window_beyond_the_episode_changes_nothing_and_a_short_one_forgets_its_notes():
+    """The tuned searcher with a window longer than any episode plays every episode as the whole-episode searcher
+    does; with a window of K steps, a place it noted (a reached frontier, a place tried, a blocked cell) is gone K
+    steps later, while the target's last-seen place stays."""
+    from functools import partial
+
+    from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
+
+    scenarios = generate_scenarios("bedroom_bath", "everywhere", 0.45, n=3, seed=2)
+    for env_id in ("EgoSearch-v0", "EgoSearchNoHead-v0"):
+        whole = evaluate(env_id, FrontierTunedPolicy, scenarios)
+        long_window = evaluate(env_id, partial(FrontierTunedPolicy, memory_window=1000), scenarios)
+        assert whole == long_window
+
+    env = make_env("EgoSearch-v0", scenarios[0])
+    policy = FrontierTunedPolicy(env, memory_window=3)
+    policy.reset()
+    policy.note("tried", (1.0, 2.0))
+    policy.note("reached_goals", (10, 12))
+    policy.blocked[(4, 4)] = policy.steps
+    policy.target = np.array([0.5, 0.5, 0.3])
+    for step in range(1, 4):
+        policy.steps = step
+        policy.forget()
+        held = step < 3
+        assert (policy.tried == [(1.0, 2.0)]) == held and (policy.reached_goals == [(10, 12)]) == held
+        assert ((4, 4) in policy.blocked) == held
+    assert policy.target is not None
+    env.close()
+    with pytest.raises(ValueError, match="memory_window=0"):
+        FrontierTunedPolicy(make_env("EgoSearch-v0", scenarios[0]), memory_window=0)

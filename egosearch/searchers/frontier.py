@@ -9,6 +9,12 @@ shows the target it remembers where it is (from the depth under the mask) and wa
 looking at it. It is a reference, never a tuning target: the learned searcher's headroom.
 
 ``head=False`` holds the camera fixed (the head-off body): the searcher must turn its body to look.
+
+``memory_window=K`` holds the searcher to its last K steps (the memory-window measurement,
+docs/baselines.md#how-much-memory-the-task-asks-for): its map is the one its last K depth frames build
+(:class:`egosearch.sim.floormap.WindowedFloorMap`), and what it noted about places (cells found blocked; the
+tuned searcher's reached frontiers and tried places) is forgotten K steps after it was noted. The target's
+last-seen position is kept, as a learned actor's target memory keeps it. ``None``: the whole episode.
 """
 
 from __future__ import annotations
@@ -21,7 +27,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from egosearch.sim.body import wrap_angle
-from egosearch.sim.floormap import FREE, OCCUPIED, UNKNOWN, FloorMap
+from egosearch.sim.floormap import FREE, OCCUPIED, UNKNOWN, FloorMap, WindowedFloorMap
 from egosearch.sim.scenarios import SUCCESS_DISTANCE
 from egosearch.sim.sensor import camera_axes
 
@@ -37,12 +43,16 @@ class FrontierPolicy:
     REPLAN_EVERY = 3
     """Steps between path plans (and at once when something changes: the target seen, stuck)."""
 
-    def __init__(self, env, head: bool | None = None):
+    def __init__(self, env, head: bool | None = None, memory_window: int | None = None):
         self.env = env.unwrapped
         spec = self.env.spec_agent
         self.head = spec.head if head is None else bool(head) and spec.head
+        if memory_window is not None and int(memory_window) < 1:
+            raise ValueError(f"memory_window={memory_window}: a searcher remembers at least its latest step")
+        self.memory_window = None if memory_window is None else int(memory_window)
         sensor = self.env.sensor
-        self.map = FloorMap.for_sensor(sensor)
+        self.map = (FloorMap.for_sensor(sensor) if self.memory_window is None
+                    else WindowedFloorMap.for_sensor(sensor, window=self.memory_window))
         self.max_depth = sensor.max_depth
         self.focal = sensor.focal_px
         self.n = self.map.n
@@ -56,9 +66,19 @@ class FrontierPolicy:
         self.path: list[tuple[int, int]] = []
         self.last_plan = -99
         self.recent: list[tuple[float, float]] = []
-        self.blocked: set[tuple[int, int]] = set()
+        self.blocked: dict[tuple[int, int], int] = {}
+        """Cells found blocked (the body stuck walking into them), each with the step it was noted at."""
         self.reach = SUCCESS_DISTANCE - 0.15
         self.idle = 0
+
+    def forgotten(self, noted_at: int) -> bool:
+        """Whether what was noted at step ``noted_at`` lies outside the memory window by now."""
+        return self.memory_window is not None and self.steps - noted_at >= self.memory_window
+
+    def forget(self) -> None:
+        """Drop what lies outside the memory window (nothing without one); a subclass drops its own notes too."""
+        if self.memory_window is not None:
+            self.blocked = {cell: at for cell, at in self.blocked.items() if not self.forgotten(at)}
 
     @property
     def grid(self) -> np.ndarray:
@@ -212,13 +232,14 @@ class FrontierPolicy:
         env, s, spec = self.env, self.env.state, self.env.spec_agent
         if env.steps == 0 and self.steps:
             self.reset()
+        self.forget()
         seen = self._map(obs)
         start = self._cell(s.x, s.y)
         self.recent = (self.recent + [(s.x, s.y)])[-6:]
         stuck = len(self.recent) == 6 and math.hypot(self.recent[0][0] - s.x, self.recent[0][1] - s.y) < 0.05
         if stuck and self.path:  # something the map missed: block the cell ahead
             ahead = self.path[min(3, len(self.path) - 1)]
-            self.blocked.add(ahead)
+            self.blocked[ahead] = self.steps
             self.recent = []
         if (self.steps - self.last_plan >= self.REPLAN_EVERY or seen or stuck or not self.path
                 or start not in self.path):

@@ -82,6 +82,22 @@ class FrontierTunedPolicy(FrontierPolicy):
         self.frontier_goal: tuple[int, int] | None = None
         self.reached_goals: list[tuple[int, int]] = []
         self.tried: list[tuple[float, float]] = []
+        self.noted_at: dict[str, list[int]] = {"reached_goals": [], "tried": []}
+        """The step each entry of ``reached_goals`` and ``tried`` was noted at (what a memory window forgets)."""
+
+    def note(self, notes: str, item) -> None:
+        """Append ``item`` to the list ``notes`` (``reached_goals`` or ``tried``), stamped with this step."""
+        getattr(self, notes).append(item)
+        self.noted_at[notes].append(self.steps)
+
+    def forget(self) -> None:
+        super().forget()
+        if self.memory_window is None:
+            return
+        for notes, stamps in self.noted_at.items():
+            keep = [i for i, at in enumerate(stamps) if not self.forgotten(at)]
+            setattr(self, notes, [getattr(self, notes)[i] for i in keep])
+            self.noted_at[notes] = [stamps[i] for i in keep]
 
     # -- exploring ----------------------------------------------------------------------------------
     def information_gain(self, shape: tuple[int, int], offset: tuple[int, int]) -> np.ndarray:
@@ -137,7 +153,7 @@ class FrontierTunedPolicy(FrontierPolicy):
 
     def target_not_in_view(self) -> None:
         s = self.env.state
-        self.tried.append((s.x, s.y))
+        self.note("tried", (s.x, s.y))
         if len(self.tried) % 3 == 0:  # three places tried at this distance: go closer, as the untuned searcher does
             super().target_not_in_view()
 
@@ -146,14 +162,14 @@ class FrontierTunedPolicy(FrontierPolicy):
             s = self.env.state
             x, y = self._xy(*self.frontier_goal)
             if math.hypot(x - s.x, y - s.y) <= 0.5:  # the base drops goals nearer than 0.5 m by path
-                self.reached_goals.append(self.frontier_goal)
+                self.note("reached_goals", self.frontier_goal)
                 self.frontier_goal = None
         action = super().act(obs)
         if self.target is not None and self.idle >= 3:
             # at the place chosen, the target in view and still no success: it is further than the estimate
             # said (the untuned searcher would stand here until the episode ends); try another place
             s = self.env.state
-            self.tried.append((s.x, s.y))
+            self.note("tried", (s.x, s.y))
             self.idle = 0
             self.last_plan = -99
         return action

@@ -54,7 +54,8 @@ class Searcher:
     it (traced by the ``trace_bound`` rule); ``floor_of``: the decision env (``*Modular-v0``) whose
     trained high level is read against it (the ``decisions_floor`` rule); ``path_style``: its line in
     the path-length figure, (colour, line style, marker), None for its default line; ``fig6_level``: a
-    horizontal line in Figure 6, (label, line style, colour), None for none."""
+    horizontal line in Figure 6, (label, line style, colour), None for none; ``options``: keyword arguments
+    its factory is called with, as ``(name, value)`` pairs (a memory window: ``(("memory_window", 5),)``)."""
 
     name: str
     factory: str | Callable[..., Any]
@@ -70,6 +71,7 @@ class Searcher:
     floor_of: str | None = None
     path_style: tuple | None = None
     fig6_level: tuple | None = None
+    options: tuple[tuple[str, Any], ...] = ()
 
     def policy_factory(self) -> Callable[..., Any]:
         return resolve(self.factory)
@@ -77,7 +79,10 @@ class Searcher:
     def maker(self, seed: int = 0) -> Callable[[Any], Any]:
         """``make(env) -> policy`` for ``--seed``: the factory itself when it takes no seed."""
         factory = self.policy_factory()
-        return partial(factory, seed=seed) if self.takes_seed else factory
+        kwargs = dict(self.options)
+        if self.takes_seed:
+            kwargs["seed"] = seed
+        return partial(factory, **kwargs) if kwargs else factory
 
     def make(self, env, seed: int = 0):
         """Its policy for ``env``."""
@@ -167,6 +172,27 @@ register("frontier_tuned_head_off", "egosearch.searchers.frontier_tuned:Frontier
          bound=True, classical=True, path_style=("#8ca252", ":", "X"),
          fig6_level=("tuned searcher (the cpu profile's teacher), head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)),
                      "#8ca252"))
+# The tuned searcher held to its last K steps (egosearch.searchers.frontier: memory_window): how much memory the
+# task asks for, against the student's 5 frames (`snakemake memory_window`, docs/baselines.md). Not Table 1 rows.
+MEMORY_WINDOWS = (5, 10, 20, 50)
+"""The windows (steps) of the memory-window searchers: ``frontier_tuned_window{K}`` and its head-fixed twin."""
+for _k in MEMORY_WINDOWS:
+    register(f"frontier_tuned_window{_k}", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy", head=True,
+             options=(("memory_window", _k),), help="the tuned searcher held to its last K steps (K = 5, 10, 20, 50)",
+             label=f"tuned searcher, last {_k} steps", what=f"the tuned frontier searcher with the map and notes of "
+             f"its last {_k} steps only (the target's last-seen place kept)")
+    register(f"frontier_tuned_head_off_window{_k}", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy",
+             env_id="EgoSearchNoHead-v0", head=False, options=(("memory_window", _k),),
+             help="the tuned searcher held to its last K steps (K = 5, 10, 20, 50)",
+             label=f"tuned searcher, head fixed, last {_k} steps", what="the same with the camera fixed to the body")
+
+
+def memory_window_searchers(head: bool) -> dict[int | None, str]:
+    """The tuned searcher by memory window (None: the whole episode), head moving or fixed."""
+    whole = "frontier_tuned" if head else "frontier_tuned_head_off"
+    return {**{k: f"{whole}_window{k}" for k in MEMORY_WINDOWS}, None: whole}
+
+
 register("modular_random", "egosearch.searchers.modular:random_decisions", head=True, takes_seed=True,
          help="the modular searcher's walk with random decisions", label="modular searcher's walk, random decisions",
          what="the modular searcher's walk with each decision drawn uniformly at random",

@@ -9,11 +9,15 @@ learned actor (:meth:`FloorMap.egocentric`).
 
 It reads the pose as habitat's GPS+compass sensor gives it (position, heading, head angles and
 camera height), never the home's plan.
+
+:class:`WindowedFloorMap` is the same map held to the last K frames (a searcher's ``memory_window``): it equals
+a map built afresh from those frames alone, at the cost of one frame added and one taken away per step.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
 
@@ -136,3 +140,60 @@ class FloorMap:
         out = blocks.mean(axis=(2, 4))
         out[2] = blocks[2].max(axis=(1, 3))  # stood anywhere in the square
         return out.reshape(-1)
+
+
+class WindowedFloorMap(FloorMap):
+    """A :class:`FloorMap` that remembers only its last ``window`` frames: after each :meth:`update` its grid and
+    visit counts are those a fresh map (with the same origin) would hold after those frames alone. Each cell
+    counts how many kept frames saw it free and how many occupied; the oldest frame's marks are taken away as
+    the newest's are added, so a step costs one frame's marks twice, whatever the window."""
+
+    def __init__(self, *args, window: int, **kwargs):
+        if int(window) < 1:
+            raise ValueError(f"window={window}: a map remembers at least its latest frame")
+        self.window = int(window)
+        super().__init__(*args, **kwargs)
+
+    def reset(self) -> None:
+        super().reset()
+        self.free_count = np.zeros((self.n, self.n), np.uint16)
+        self.occupied_count = np.zeros((self.n, self.n), np.uint16)
+        self.frames: deque[tuple[np.ndarray, np.ndarray, np.ndarray]] = deque()
+        self._marks: dict[int, list[np.ndarray]] | None = None
+
+    def copy_state(self) -> tuple:
+        frames = tuple(tuple(a.copy() for a in f) for f in self.frames)
+        return super().copy_state() + (self.free_count.copy(), self.occupied_count.copy(), frames)
+
+    def set_state(self, state: tuple) -> None:
+        super().set_state(state[:3])
+        free, occupied, frames = state[3:]
+        self.free_count, self.occupied_count = free.copy(), occupied.copy()
+        self.frames = deque(tuple(a.copy() for a in f) for f in frames)
+
+    def mark(self, xs: np.ndarray, ys: np.ndarray, value: int) -> None:
+        rows, cols = self._indices(xs, ys)
+        self._marks[value].append(np.unique(rows * self.n + cols))
+
+    def update(self, depth_frame: np.ndarray, state) -> None:
+        self._marks = {FREE: [], OCCUPIED: []}
+        before = self.visits.copy() if self.origin is not None else None
+        super().update(depth_frame, state)
+        free = np.unique(np.concatenate(self._marks[FREE])) if self._marks[FREE] else np.zeros(0, np.int64)
+        occupied = (np.unique(np.concatenate(self._marks[OCCUPIED])) if self._marks[OCCUPIED]
+                    else np.zeros(0, np.int64))
+        visited = np.flatnonzero(self.visits != before) if before is not None else np.flatnonzero(self.visits)
+        self._marks = None
+        self.free_count.flat[free] += 1
+        self.occupied_count.flat[occupied] += 1
+        self.frames.append((free, occupied, visited))
+        touched = [free, occupied]
+        if len(self.frames) > self.window:
+            old_free, old_occupied, old_visited = self.frames.popleft()
+            self.free_count.flat[old_free] -= 1
+            self.occupied_count.flat[old_occupied] -= 1
+            self.visits.flat[old_visited] -= 1
+            touched += [old_free, old_occupied]
+        cells = np.concatenate(touched)
+        occ, fr = self.occupied_count.flat[cells] > 0, self.free_count.flat[cells] > 0
+        self.grid.flat[cells] = np.where(occ, OCCUPIED, np.where(fr, FREE, UNKNOWN))
