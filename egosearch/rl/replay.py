@@ -30,6 +30,11 @@ transitions whose frames were overwritten are dropped from sampling (never retur
 At 100k transitions (Table 2) this is ~1.14 GB (:func:`replay_gb`), vs. ~10 GB for naively
 stored obs + next_obs stacks.
 
+Strided stacks: with ``frame_offsets`` (steps back, oldest first, ending at 0; the ``strided_history`` option's
+64, 16, 4, 1, 0) the stack of obs_t is frames [f_{max(t - offset_j, 0)}] and that of next_obs_t the same at t + 1,
+two gathers instead of one window; the frame ring grows by the largest offset, so that every stored transition
+still finds its oldest frame.
+
 Checkpoints: :meth:`ReplayBuffer.save` / :meth:`load` write / read an ``.npz`` (hundreds of MB
 to GB: keep them out of version control; name them ``*.replay.npz``, which is git-ignored).
 """
@@ -45,9 +50,11 @@ import torch
 _FORMAT = "egosearch-replay-v1"
 
 
-def frame_slots(capacity: int, frame_history: int) -> int:
-    """Frame-ring size for a transition capacity (see the module docstring)."""
-    return capacity + capacity // 8 + frame_history + 1
+def frame_slots(capacity: int, frame_history: int, reach: int | None = None) -> int:
+    """Frame-ring size for a transition capacity (see the module docstring); ``reach``: the oldest frame a stack
+    holds, in steps back (default K - 1)."""
+    reach = frame_history - 1 if reach is None else int(reach)
+    return capacity + capacity // 8 + reach + 2
 
 
 def replay_gb(capacity: int = 100_000, image_size: int = 100, frame_history: int = 5,
@@ -75,15 +82,23 @@ class ReplayBuffer:
 
     def __init__(self, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5,
-                 device: str | torch.device = "cpu", seed: int | None = None, state_dim: int = 0):
+                 device: str | torch.device = "cpu", seed: int | None = None, state_dim: int = 0,
+                 frame_offsets: tuple[int, ...] | None = None):
         if capacity < 1:
             raise ValueError(f"ReplayBuffer capacity={capacity} is out of range; allowed: >= 1")
         self.capacity = int(capacity)
         self.image_size = int(image_size)
         self.k = int(frame_history)
+        last_k = tuple(range(self.k - 1, -1, -1))
+        offsets = last_k if frame_offsets is None else tuple(int(o) for o in frame_offsets)
+        if len(offsets) != self.k or offsets[-1] != 0 or any(a <= b for a, b in zip(offsets, offsets[1:])):
+            raise ValueError(f"frame_offsets={offsets}; allowed: {self.k} steps back, decreasing, ending at 0")
+        self.offsets = offsets
+        self.strided = offsets != last_k
+        """Whether the stacks hold other frames than the last K (two gathers at sample time)."""
         self.mask_dim, self.proprio_dim, self.action_dim = int(mask_dim), int(proprio_dim), int(action_dim)
         self.device = torch.device(device)
-        self.n_frames = frame_slots(self.capacity, self.k)
+        self.n_frames = frame_slots(self.capacity, self.k, self.offsets[0])
         self.frames = np.zeros((self.n_frames, self.image_size, self.image_size), np.uint8)
         c = self.capacity
         self.frame_no = np.zeros(c, np.int64)  # absolute frame number of f_t
@@ -124,6 +139,9 @@ class ReplayBuffer:
         """Start a stored episode at ``obs``, a state inside an env episode: its whole depth stack is
         written as the frames before its transition, so that the stored state rebuilds exactly (a
         DAgger round that keeps only some of the student's states). The next :meth:`add` takes ``obs``."""
+        if self.strided:
+            raise ValueError("a replay of strided stacks cannot start mid-episode: the frames before the stack's "
+                             "slots are not in the observation")
         depth = obs["depth"]
         if depth.shape != (self.k, self.image_size, self.image_size):
             raise ValueError(f"depth must have shape {(self.k, self.image_size, self.image_size)}, got {depth.shape}")
@@ -176,7 +194,7 @@ class ReplayBuffer:
     def _oldest_frame_needed(self, n: np.ndarray | int) -> np.ndarray:
         i = np.asarray(n) % self.capacity
         f, t = self.frame_no[i], self.t_in_ep[i]
-        return f - np.minimum(t, self.k - 1)
+        return f - np.minimum(t, self.offsets[0])
 
     def _first_valid(self) -> int:
         """Absolute number of the oldest transition whose frames are all still stored."""
@@ -203,8 +221,18 @@ class ReplayBuffer:
         # frame j of the (K+1)-window is f_{max(t - back_j, 0)} of this episode
         return f[:, None] - np.minimum(back[None, :], t[:, None])
 
+    def strided_frame_numbers(self, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B, K) absolute frame numbers of the obs and next_obs stacks of strided stacks."""
+        i = np.asarray(n) % self.capacity
+        f, t = self.frame_no[i], self.t_in_ep[i].astype(np.int64)
+        back = np.asarray(self.offsets, np.int64)[None, :]
+        return f[:, None] - np.minimum(back, t[:, None]), f[:, None] + 1 - np.minimum(back, t[:, None] + 1)
+
     def stacks(self, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Rebuilt (obs, next_obs) depth stacks (B, K, H, W) uint8 for absolute indices ``n``."""
+        if self.strided:
+            obs, nxt = self.strided_frame_numbers(n)
+            return self.frames[obs % self.n_frames], self.frames[nxt % self.n_frames]
         window = self.frames[self.frame_numbers(n) % self.n_frames]
         return window[:, :-1], window[:, 1:]
 
@@ -217,7 +245,6 @@ class ReplayBuffer:
     def sample(self, batch_size: int, indices: np.ndarray | None = None) -> dict[str, torch.Tensor]:
         n = self.sample_indices(batch_size) if indices is None else np.asarray(indices)
         i = n % self.capacity
-        window = torch.from_numpy(self.frames[self.frame_numbers(n) % self.n_frames])
         pin = self.device.type == "cuda"
         dev = self.device
 
@@ -225,10 +252,15 @@ class ReplayBuffer:
             x = torch.from_numpy(np.ascontiguousarray(a))
             return x.pin_memory().to(dev, non_blocking=True) if pin else x.to(dev)
 
-        window = window.pin_memory().to(dev, non_blocking=True) if pin else window.to(dev)
+        if self.strided:
+            obs_depth, next_obs_depth = (put(stack) for stack in self.stacks(n))
+        else:
+            window = torch.from_numpy(self.frames[self.frame_numbers(n) % self.n_frames])
+            window = window.pin_memory().to(dev, non_blocking=True) if pin else window.to(dev)
+            obs_depth, next_obs_depth = window[:, :-1], window[:, 1:]
         batch = {
-            "obs_depth": window[:, :-1],
-            "next_obs_depth": window[:, 1:],
+            "obs_depth": obs_depth,
+            "next_obs_depth": next_obs_depth,
             "mask": put(self.mask[i]),
             "proprio": put(self.proprio[i]),
             "next_mask": put(self.next_mask[i]),
@@ -271,6 +303,8 @@ class ReplayBuffer:
             state[name] = arr[:n_fr] if name == "frames" else arr[:n_tr]
         state["rng"] = rng_to_plain(self.rng)
         state["format"] = _FORMAT
+        if self.strided:  # only then: states of last-K stacks keep their keys
+            state["frame_offsets"] = list(self.offsets)
         return state
 
     def load_state_dict(self, state: dict) -> None:
@@ -280,6 +314,10 @@ class ReplayBuffer:
             if int(state[name]) != getattr(self, name):
                 raise ValueError(f"replay buffer state has {name}={int(state[name])}, "
                                  f"this buffer has {getattr(self, name)}")
+        held = tuple(int(o) for o in state.get("frame_offsets", range(self.k - 1, -1, -1)))
+        if held != self.offsets:
+            raise ValueError(f"replay buffer state holds stacks of frames {held} steps back, this buffer "
+                             f"{self.offsets}")
         for name, arr in self._arrays().items():
             if name not in state and arr.shape[1:] == (0,):  # written before states existed
                 continue
@@ -351,14 +389,14 @@ class MultiReplay:
     def __init__(self, num_envs: int, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5, n_step: int = 1,
                  gamma: float = 0.99, device: str | torch.device = "cpu", seed: int | None = None,
-                 state_dim: int = 0):
+                 state_dim: int = 0, frame_offsets: tuple[int, ...] | None = None):
         if num_envs < 1 or n_step < 1:
             raise ValueError(f"MultiReplay num_envs={num_envs}, n_step={n_step}; allowed: >= 1 each")
         self.n_step, self.gamma = int(n_step), float(gamma)
         per_env = max(1, int(capacity) // int(num_envs))
         self.buffers = [ReplayBuffer(per_env, image_size, frame_history, mask_dim, proprio_dim, action_dim,
                                      device=device, seed=None if seed is None else seed + 104_729 * i,
-                                     state_dim=state_dim)
+                                     state_dim=state_dim, frame_offsets=frame_offsets)
                         for i in range(num_envs)]
         self.device = torch.device(device)
 

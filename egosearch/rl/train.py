@@ -42,6 +42,7 @@ import json
 import math
 import os
 import random
+import re
 import time
 from collections import deque
 from collections.abc import Callable
@@ -86,7 +87,7 @@ from egosearch.rl.run_files import (
     to_numpy,
     to_tensors,
 )
-from egosearch.rl.train_env import make_train_env, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, stack_offsets, train_env_kwargs
 from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.observation_options import extra_dims
 
@@ -117,6 +118,15 @@ class _Mean:
     def mean(self) -> dict[str, float]:
         return {k: self.sums.get(k, 0.0) / self.counts[k] if self.counts.get(k) else float("nan")
                 for k in METRIC_KEYS}
+
+
+SNAPSHOT_NAME = re.compile(r"actor_\d+k?\.pt")
+"""The actor snapshots' file names (``actor_snapshot_every``)."""
+
+
+def snapshot_name(env_steps: int) -> str:
+    """``actor_50k.pt`` for 50,000 env steps; ``actor_200.pt`` for 200, which is no whole thousand."""
+    return f"actor_{env_steps // 1000}k.pt" if env_steps % 1000 == 0 else f"actor_{env_steps}.pt"
 
 
 # ---- policies -----------------------------------------------------------------------------
@@ -259,7 +269,8 @@ def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
     ours = {CHECKPOINT_NAME.name, "actor.pt", START_ACTOR_NAME, "done.json", "config.json", "curve.csv",
             "curve_episodes.csv", "train.csv"}
     for stale in [*out_dir.glob(".tmp*"), *(out_dir / CHECKPOINT_NAME.parent).glob(".tmp*")]:
-        if stale.name.split(".", 2)[-1] in ours:  # temp files of a killed run of ours
+        name = stale.name.split(".", 2)[-1]
+        if name in ours or SNAPSHOT_NAME.fullmatch(name):  # temp files of a killed run of ours
             stale.unlink()
     ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if ckpt is not None:
@@ -362,7 +373,8 @@ class LiveRun:
         self.to_replay = self.agent.replay_obs
         self.replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, self.agent.replay_image_size, cfg.frame_history,
                                   mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
-                                  device=self.device, seed=cfg.seed, state_dim=state_dim)
+                                  device=self.device, seed=cfg.seed, state_dim=state_dim,
+                                  frame_offsets=stack_offsets(cfg))
         self.curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
         self.train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
         self.curve_episodes = CsvLogger(out_dir / "curve_episodes.csv", CURVE_EPISODE_COLUMNS)
@@ -611,6 +623,9 @@ class LiveRun:
             self.log_train(bar)
         if self.crossed(cfg.eval_every, before):
             row = self.evaluate(evaluate_fn)
+        every = cfg.actor_snapshot_every
+        if every and self.step // every > before // every:
+            self.write_snapshot(self.step // every * every)
         if checkpoint:
             self.save_checkpoint()
             if self.step < cfg.total_env_steps:
@@ -693,6 +708,12 @@ class LiveRun:
         checkpoint: a run that resumes keeps it."""
         atomic_write(self.out_dir / START_ACTOR_NAME,
                      lambda f: torch.save(self.agent.actor_state({**self.actor_meta(), "start": True}), f))
+
+    def write_snapshot(self, at_step: int) -> None:
+        """``actor_<N>k.pt``: the actor as it is at env step ``at_step`` (``actor_snapshot_every``), its metadata
+        saying so; a resumed run writes again what its checkpoint had not reached."""
+        atomic_write(self.out_dir / snapshot_name(at_step),
+                     lambda f: torch.save(self.agent.actor_state({**self.actor_meta(), "snapshot_at": at_step}), f))
 
     def finish(self, last_row: dict | None) -> dict:
         """Write actor.pt, then done.json (the run is complete), then drop the checkpoint."""

@@ -11,6 +11,13 @@ from egosearch.rl.training_aids import critic_reads_state
 from egosearch.scene.layouts import LAYOUT_NAMES
 from egosearch.sim.body import AgentSpec
 from egosearch.sim.home_pool import HomePoolEnv
+from egosearch.sim.observation_options import frame_offsets
+
+
+def stack_offsets(cfg: LearnerConfig) -> tuple[int, ...]:
+    """The frames of the depth stacks the env gives under ``cfg``'s observation options (steps back, oldest
+    first): what every replay of the run (its own, its demonstrations, a DAgger round's) rebuilds."""
+    return frame_offsets(observation_kwargs(cfg.to_dict()), cfg.frame_history)
 
 
 def make_train_env(env_id: str, env_kwargs: dict):

@@ -23,7 +23,8 @@ classical searcher plans on, as a memory of where it has been and what it has no
 The observation options (:mod:`egosearch.sim.observation_options`: keyword options with no id of their
 own, each a CHANGE OF OBSERVATION, never the paper's) append their values to these vectors, in registration
 order: ``contact_signal=True`` (:mod:`egosearch.sim.contact_signal`, after habitat-lab's ``collisions``
-measure) appends a bump bit and the recent collision count to ``proprio``.
+measure) appends a bump bit and the recent collision count to ``proprio``; ``strided_history=True``
+(:mod:`egosearch.sim.strided_history`) makes ``depth`` the newest frame and those 1, 4, 16 and 64 steps before it.
 
 Action: [dx, dy, dtheta, dq_p, dq_y] in [-1, 1], scaled by :class:`egosearch.sim.body.AgentSpec`
 (head-off: [dx, dy, dtheta]).
@@ -245,6 +246,11 @@ class SearchEnv(gymnasium.Env):
         self.observation_options = {name: True for name, on in observation_options.items() if on}
         """The observation options turned on (name -> True)."""
         self._options = observation_options_mod.build(self.observation_options)
+        self._offsets = observation_options_mod.frame_offsets(self.observation_options, FRAME_HISTORY)
+        """The depth stack's frames as steps back from the newest, oldest first (an option may space them out)."""
+        self._strided = self._offsets != tuple(range(FRAME_HISTORY - 1, -1, -1))
+        self._history: list[np.ndarray] = []
+        """With strided frames: every depth frame of the episode so far (at most T_max + 1)."""
         dims = space_dims(head, self.target_memory, floor_map, **self.observation_options)
         observation_spaces = {
             "depth": spaces.Box(0, 255, (FRAME_HISTORY, IMAGE_SIZE, IMAGE_SIZE), np.uint8),
@@ -295,6 +301,7 @@ class SearchEnv(gymnasium.Env):
         depth, mask = self._sense()
         self._remember(depth, mask)
         self._frames[:] = depth
+        self._history = [depth] if self._strided else []
         self._seen_distance = target_distance(self.state, self.target, spec.body_radius) if mask.any() else None
         if self.distance_reward == "geodesic":
             grid = navgrid_for(self.layout)
@@ -351,8 +358,7 @@ class SearchEnv(gymnasium.Env):
         self.steps += 1
         depth, mask = self._sense()
         self._remember(depth, mask)
-        self._frames[:-1] = self._frames[1:]
-        self._frames[-1] = depth
+        self._push(depth)
         visible = bool(mask.any())
         distance = target_distance(s, self.target, spec.body_radius)
         success = visible and distance <= SUCCESS_DISTANCE
@@ -412,7 +418,8 @@ class SearchEnv(gymnasium.Env):
     # -- state access for the replanner (paper Algorithm 1) ----------------------------------
     def snapshot(self) -> dict:
         """Everything a later :meth:`restore` needs to continue this episode exactly."""
-        return {"state": self.state.copy(), "frames": self._frames.copy(), "steps": self.steps,
+        return {"state": self.state.copy(), "frames": self._frames.copy(), "history": list(self._history),
+                "steps": self.steps,
                 "collisions": self.collisions, "path_length": self.path_length, "dq": self._dq.copy(),
                 "options": [option.snapshot() for option in self._options], "seen_distance": self._seen_distance,
                 "memory": (None if self._memory_point is None else self._memory_point.copy(), self._since_seen),
@@ -424,6 +431,7 @@ class SearchEnv(gymnasium.Env):
     def restore(self, snap: dict) -> None:
         self.set_agent_state(snap["state"])
         self._frames[:] = snap["frames"]
+        self._history = list(snap.get("history", []))
         self.steps, self.collisions, self.path_length = snap["steps"], snap["collisions"], snap["path_length"]
         self._dq = snap["dq"].copy()
         for option, state in zip(self._options, snap["options"]):
@@ -448,9 +456,19 @@ class SearchEnv(gymnasium.Env):
         depth, mask = self._sense()
         if push:
             self._remember(depth, mask)
+            self._push(depth)
+        return self._observation(mask), bool(mask.any())
+
+    def _push(self, depth: np.ndarray) -> None:
+        """The newest frame enters the depth stack (and, with strided frames, the episode's history)."""
+        if not self._strided:
             self._frames[:-1] = self._frames[1:]
             self._frames[-1] = depth
-        return self._observation(mask), bool(mask.any())
+            return
+        self._history.append(depth)
+        newest = len(self._history) - 1
+        for j, back in enumerate(self._offsets):
+            self._frames[j] = self._history[max(0, newest - back)]
 
     # -- sensing ---------------------------------------------------------------------------
     def _sense(self):

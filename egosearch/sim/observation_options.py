@@ -31,6 +31,10 @@ class ObservationOption:
 
     extra_dims: ClassVar[Mapping[str, int]] = {}
     """Values appended to each observation vector it changes (``{"proprio": 2}``)."""
+    frame_offsets: ClassVar[tuple[int, ...] | None] = None
+    """The past frames the ``depth`` stack holds instead of the last K, as steps back from the newest, oldest
+    first and ending at 0 (K of them; frames before the episode's first are that first frame, as at reset);
+    None: the last K. At most one option turned on may set it (:func:`frame_offsets`)."""
 
     def reset(self, env: Any) -> None:
         """A new episode begins in ``env`` (a :class:`egosearch.sim.env.SearchEnv`)."""
@@ -97,6 +101,26 @@ def extra_dims(on: Mapping[str, Any]) -> dict[str, int]:
     return out
 
 
+def frame_offsets(on: Mapping[str, Any], frame_history: int) -> tuple[int, ...]:
+    """The depth stack's frames (steps back, oldest first) with the options turned on in ``on``: the one option's
+    that sets :attr:`ObservationOption.frame_offsets`, else the last ``frame_history`` (K-1, ..., 0). The env,
+    the replay and the demonstrations read it here, so that they rebuild the same stacks."""
+    chosen = [(name, entry.option_class().frame_offsets) for name, entry in OPTIONS.items()
+              if on.get(name) and entry.option_class().frame_offsets is not None]
+    if len(chosen) > 1:
+        raise ValueError(f"options {' and '.join(n for n, _ in chosen)} both choose the depth stack's frames; "
+                         "allowed: one of them")
+    if not chosen:
+        return tuple(range(int(frame_history) - 1, -1, -1))
+    name, offsets = chosen[0]
+    offsets = tuple(int(o) for o in offsets)
+    if (len(offsets) != int(frame_history) or offsets[-1] != 0
+            or any(a <= b for a, b in zip(offsets, offsets[1:]))):
+        raise ValueError(f"option {name}: frame_offsets={offsets}; allowed: {frame_history} steps back, "
+                         "decreasing, ending at 0")
+    return offsets
+
+
 def build(on: Mapping[str, Any]) -> list[ObservationOption]:
     """Fresh option states for the options turned on in ``on``, in registration order."""
     return [entry.option_class()() for name, entry in OPTIONS.items() if on.get(name)]
@@ -106,3 +130,5 @@ def build(on: Mapping[str, Any]) -> list[ObservationOption]:
 
 register("contact_signal", "egosearch.sim.contact_signal:ContactSignal",
          "egosearch.sim.contact_signal:ContactSignalSettings")
+register("strided_history", "egosearch.sim.strided_history:StridedHistory",
+         "egosearch.sim.strided_history:StridedHistorySettings")
