@@ -146,18 +146,64 @@ class Projection(nn.Module):
         return torch.tanh(z) if self.tanh else z
 
 
+class MapReader(nn.Module):
+    """An image inside the observation's extra values (an image option's, ``map_image``), read by small convs:
+    ``(B, D) -> (B, D - C*H*W + out_dim)``, the image's values replaced by its features. Two 3x3 stride-2 convs and
+    a projection with LayerNorm and tanh, as the depth encoder's."""
+
+    def __init__(self, start: int, shape: tuple[int, int, int], filters: int = 16, out_dim: int = 64,
+                 act: str = "relu"):
+        super().__init__()
+        self.start, self.shape = int(start), tuple(int(v) for v in shape)
+        channels, side = self.shape[0], self.shape[1]
+        self.convs = nn.ModuleList([nn.Conv2d(channels, filters, 3, stride=2),
+                                    nn.Conv2d(filters, 2 * filters, 3, stride=2)])
+        for _ in range(2):
+            side = (side - 3) // 2 + 1
+        self.fc = nn.Linear(2 * filters * side * side, out_dim)
+        self.ln = nn.LayerNorm(out_dim)
+        self.act = activation(act)
+        self.size, self.out_dim = channels * self.shape[1] * self.shape[2], int(out_dim)
+
+    def extra_dim(self, extra_dim: int) -> int:
+        """The size of what :meth:`forward` gives for ``extra_dim`` values in."""
+        return extra_dim - self.size + self.out_dim
+
+    def forward(self, extra: torch.Tensor) -> torch.Tensor:
+        end = self.start + self.size
+        x = extra[..., self.start:end].reshape(-1, *self.shape)
+        for conv in self.convs:
+            x = self.act(conv(x))
+        features = torch.tanh(self.ln(self.fc(x.flatten(1)))).reshape(*extra.shape[:-1], self.out_dim)
+        return torch.cat([extra[..., :self.start], extra[..., end:], features], dim=-1)
+
+
+def map_reader(arch: dict[str, Any]) -> MapReader | None:
+    """The :class:`MapReader` an arch dict asks for (``map_image``: the image's shape, ``map_offset``: where its
+    values start in the extra values), or None."""
+    if "map_image" not in arch:
+        return None
+    return MapReader(arch["map_offset"], tuple(arch["map_image"]))
+
+
 class ActorHead(nn.Module):
-    """Actor on conv features: own projection, concat [mask, proprio], MLP -> (mu, log_std)."""
+    """Actor on conv features: own projection, concat [mask, proprio], MLP -> (mu, log_std). With a ``map_reader``
+    (an image inside mask) the image's values are replaced by its features first."""
 
     def __init__(self, conv_dim: int, latent_dim: int, extra_dim: int, action_dim: int,
                  hidden_dim: int, num_layers: int, act: str, log_std_min: float,
-                 log_std_max: float, tanh: bool):
+                 log_std_max: float, tanh: bool, map_reader: MapReader | None = None):
         super().__init__()
         self.proj = Projection(conv_dim, latent_dim, tanh)
+        if map_reader is not None:  # a submodule only then: actor files without a map keep their keys
+            self.map_reader = map_reader
+            extra_dim = map_reader.extra_dim(extra_dim)
         self.trunk = mlp(latent_dim + extra_dim, hidden_dim, 2 * action_dim, num_layers, act)
         self.log_std_min, self.log_std_max = float(log_std_min), float(log_std_max)
 
     def forward(self, h: torch.Tensor, extra: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        if hasattr(self, "map_reader"):
+            extra = self.map_reader(extra)
         mu, log_std = self.trunk(torch.cat([self.proj(h), extra], dim=-1)).chunk(2, dim=-1)
         log_std = torch.tanh(log_std)
         log_std = self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
@@ -168,7 +214,7 @@ def actor_head(conv_dim: int, arch: dict[str, Any]) -> ActorHead:
     """The :class:`ActorHead` an arch dict (a learner's ``arch()``) describes."""
     return ActorHead(conv_dim, arch["encoder_latent_dim"], arch["extra_dim"], arch["action_dim"],
                      arch["actor_hidden_dim"], arch["actor_num_layers"], arch["actor_activation"],
-                     arch["actor_log_std_min"], arch["actor_log_std_max"], arch["encoder_tanh"])
+                     arch["actor_log_std_min"], arch["actor_log_std_max"], arch["encoder_tanh"], map_reader(arch))
 
 
 # ---- the networks an update's arithmetic calls ------------------------------------------------

@@ -38,7 +38,7 @@ from egosearch.rl.config import LearnerConfig
 from egosearch.rl.pooled import pool_depth, pooled_side
 from egosearch.rl.replay import MultiReplay, ReplayBuffer
 from egosearch.rl.run_files import atomic_json
-from egosearch.rl.train_env import make_train_env, stack_offsets, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, replay_layout, train_env_kwargs
 from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.searchers.frontier import FrontierPolicy
 from egosearch.searchers.frontier_tuned import FrontierTunedPolicy
@@ -164,7 +164,7 @@ def collect_demonstrations(env_id: str, cfg: LearnerConfig, env_kwargs: dict, ep
         action_dim = int(env.action_space.shape[0])
         buffer = ReplayBuffer(episodes * MAX_STEPS, side, cfg.frame_history, int(np.asarray(obs["mask"]).shape[0]),
                               int(np.asarray(obs["proprio"]).shape[0]), action_dim, seed=seed, state_dim=state_dim,
-                              frame_offsets=stack_offsets(cfg))
+                              **replay_layout(cfg))
         successes, lengths, returns = [], [], []
         bar = _progress(episodes, progress)
         for episode in range(episodes):
@@ -219,7 +219,7 @@ def load_demonstrations(path: str | Path, cfg: LearnerConfig, device: str = "cpu
         head = json.loads(bytes(data["__meta__"]).decode())
     sizes = [int(head[name]) for name in ("capacity", "image_size", "k", "mask_dim", "proprio_dim", "action_dim")]
     replay = MultiReplay(1, *sizes, n_step=cfg.n_step, gamma=cfg.gamma, device=device, seed=cfg.seed,
-                         state_dim=int(meta["state_dim"]), frame_offsets=stack_offsets(cfg))
+                         state_dim=int(meta["state_dim"]), **replay_layout(cfg))
     try:
         replay.buffers[0].load(path)
     except ValueError as err:  # an array that does not read back (a corrupt member) or does not fit the header

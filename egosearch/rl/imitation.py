@@ -25,7 +25,7 @@ import torch
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.demos import new_teacher, stored_observation
 from egosearch.rl.replay import MultiReplay, proportional_counts  # noqa: F401 (read here by the tests)
-from egosearch.rl.train_env import make_train_env, stack_offsets, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, replay_layout, train_env_kwargs
 from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.scenarios import MAX_STEPS
 
@@ -86,7 +86,7 @@ def dagger_round(agent, env_id: str, cfg: LearnerConfig, env_kwargs: dict, episo
                 labelled = MultiReplay(1, capacity, agent.replay_image_size, cfg.frame_history,
                                        int(np.asarray(obs["mask"]).shape[0]), int(np.asarray(obs["proprio"]).shape[0]),
                                        int(env.action_space.shape[0]), device=device, seed=cfg.seed,
-                                       state_dim=state_dim, frame_offsets=stack_offsets(cfg))
+                                       state_dim=state_dim, **replay_layout(cfg))
             teacher = new_teacher(env, demonstration_settings(cfg).demo_teacher)
             agent.reset_policy_state()  # a student with a memory starts each episode afresh
             stored = stored_observation(obs, cfg)

@@ -83,7 +83,7 @@ class ReplayBuffer:
     def __init__(self, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5,
                  device: str | torch.device = "cpu", seed: int | None = None, state_dim: int = 0,
-                 frame_offsets: tuple[int, ...] | None = None):
+                 frame_offsets: tuple[int, ...] | None = None, mask_bytes: int = 0):
         if capacity < 1:
             raise ValueError(f"ReplayBuffer capacity={capacity} is out of range; allowed: >= 1")
         self.capacity = int(capacity)
@@ -107,9 +107,16 @@ class ReplayBuffer:
         self.reward = np.zeros(c, np.float32)
         self.terminated = np.zeros(c, bool)
         self.truncated = np.zeros(c, bool)
-        self.mask = np.zeros((c, self.mask_dim), np.float32)
+        if not 0 <= int(mask_bytes) <= self.mask_dim:
+            raise ValueError(f"mask_bytes={mask_bytes}; allowed: 0..mask_dim={self.mask_dim}")
+        self.mask_bytes = int(mask_bytes)
+        """The last this many mask values are multiples of 1/255 (an image option's), stored as bytes."""
+        floats = self.mask_dim - self.mask_bytes
+        self.mask = np.zeros((c, floats), np.float32)
         self.proprio = np.zeros((c, self.proprio_dim), np.float32)
-        self.next_mask = np.zeros((c, self.mask_dim), np.float32)
+        self.next_mask = np.zeros((c, floats), np.float32)
+        self.mask_u8 = np.zeros((c, self.mask_bytes), np.uint8)
+        self.next_mask_u8 = np.zeros((c, self.mask_bytes), np.uint8)
         self.next_proprio = np.zeros((c, self.proprio_dim), np.float32)
         self.state_dim = int(state_dim)
         self.state = np.zeros((c, self.state_dim), np.float32)
@@ -177,9 +184,9 @@ class ReplayBuffer:
         self.reward[i] = float(reward)
         self.terminated[i] = bool(terminated)
         self.truncated[i] = bool(truncated)
-        self.mask[i] = obs["mask"]
+        self._store_mask(self.mask, self.mask_u8, i, obs["mask"])
         self.proprio[i] = obs["proprio"]
-        self.next_mask[i] = next_obs["mask"]
+        self._store_mask(self.next_mask, self.next_mask_u8, i, next_obs["mask"])
         self.next_proprio[i] = next_obs["proprio"]
         if self.state_dim:
             self.state[i] = obs["state"]
@@ -189,6 +196,22 @@ class ReplayBuffer:
         self.t += 1
         if terminated or truncated:
             self.in_episode = False
+
+    def _store_mask(self, floats: np.ndarray, octets: np.ndarray, i: int, mask) -> None:
+        mask = np.asarray(mask, np.float32)
+        if not self.mask_bytes:
+            floats[i] = mask
+            return
+        floats[i] = mask[:-self.mask_bytes]
+        octets[i] = np.round(mask[-self.mask_bytes:] * 255.0).astype(np.uint8)
+
+    def masks(self, i: np.ndarray, nxt: bool = False) -> np.ndarray:
+        """The (B, mask_dim) float32 mask vectors of obs (``nxt``: next_obs) at ring slots ``i``, as the env gave
+        them (byte-valued values back to multiples of 1/255)."""
+        floats, octets = (self.next_mask, self.next_mask_u8) if nxt else (self.mask, self.mask_u8)
+        if not self.mask_bytes:
+            return floats[i]
+        return np.concatenate([floats[i], octets[i].astype(np.float32) / np.float32(255.0)], axis=-1)
 
     # ---- reading -----------------------------------------------------------------------
     def _oldest_frame_needed(self, n: np.ndarray | int) -> np.ndarray:
@@ -261,9 +284,9 @@ class ReplayBuffer:
         batch = {
             "obs_depth": obs_depth,
             "next_obs_depth": next_obs_depth,
-            "mask": put(self.mask[i]),
+            "mask": put(self.masks(i)),
             "proprio": put(self.proprio[i]),
-            "next_mask": put(self.next_mask[i]),
+            "next_mask": put(self.masks(i, nxt=True)),
             "next_proprio": put(self.next_proprio[i]),
             "action": put(self.action[i]),
             "reward": put(self.reward[i][:, None]),
@@ -292,7 +315,7 @@ class ReplayBuffer:
     def _arrays(self) -> dict[str, np.ndarray]:
         return {name: getattr(self, name) for name in (
             "frames", "frame_no", "t_in_ep", "action", "reward", "terminated", "truncated",
-            "mask", "proprio", "next_mask", "next_proprio", "state", "next_state")}
+            "mask", "proprio", "next_mask", "next_proprio", "state", "next_state", "mask_u8", "next_mask_u8")}
 
     def state_dict(self) -> dict:
         """Plain arrays + scalars (only the filled part of the rings)."""
@@ -319,7 +342,7 @@ class ReplayBuffer:
             raise ValueError(f"replay buffer state holds stacks of frames {held} steps back, this buffer "
                              f"{self.offsets}")
         for name, arr in self._arrays().items():
-            if name not in state and arr.shape[1:] == (0,):  # written before states existed
+            if name not in state and arr.shape[1:] == (0,):  # written before states (or byte masks) existed
                 continue
             src = np.asarray(state[name])
             if src.shape[1:] != arr.shape[1:] or src.shape[0] > arr.shape[0]:
@@ -389,14 +412,14 @@ class MultiReplay:
     def __init__(self, num_envs: int, capacity: int, image_size: int = 100, frame_history: int = 5,
                  mask_dim: int = 30, proprio_dim: int = 4, action_dim: int = 5, n_step: int = 1,
                  gamma: float = 0.99, device: str | torch.device = "cpu", seed: int | None = None,
-                 state_dim: int = 0, frame_offsets: tuple[int, ...] | None = None):
+                 state_dim: int = 0, frame_offsets: tuple[int, ...] | None = None, mask_bytes: int = 0):
         if num_envs < 1 or n_step < 1:
             raise ValueError(f"MultiReplay num_envs={num_envs}, n_step={n_step}; allowed: >= 1 each")
         self.n_step, self.gamma = int(n_step), float(gamma)
         per_env = max(1, int(capacity) // int(num_envs))
         self.buffers = [ReplayBuffer(per_env, image_size, frame_history, mask_dim, proprio_dim, action_dim,
                                      device=device, seed=None if seed is None else seed + 104_729 * i,
-                                     state_dim=state_dim, frame_offsets=frame_offsets)
+                                     state_dim=state_dim, frame_offsets=frame_offsets, mask_bytes=mask_bytes)
                         for i in range(num_envs)]
         self.device = torch.device(device)
 
@@ -469,8 +492,8 @@ class MultiReplay:
 
         batch = {
             "obs_depth": put(obs_stack), "next_obs_depth": put(next_stack),
-            "mask": put(buf.mask[i0]), "proprio": put(buf.proprio[i0]),
-            "next_mask": put(buf.next_mask[i1]), "next_proprio": put(buf.next_proprio[i1]),
+            "mask": put(buf.masks(i0)), "proprio": put(buf.proprio[i0]),
+            "next_mask": put(buf.masks(i1, nxt=True)), "next_proprio": put(buf.next_proprio[i1]),
             "action": put(buf.action[i0]), "reward": put(reward.astype(np.float32)[:, None]),
             "not_done": put((~buf.terminated[i1]).astype(np.float32)[:, None]),
             "discount": put(discount.astype(np.float32)[:, None]),

@@ -45,6 +45,7 @@ from torch import nn
 
 from egosearch.rl.common import (
     AgentStateError,
+    MapReader,
     ModuleNets,
     Projection,
     actor_head,
@@ -52,12 +53,28 @@ from egosearch.rl.common import (
     check_agent_state,
     crop_at,
     gaussian_entropy,
+    map_reader,
     mlp,
     squashed_sample,
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.pooled import DRQ_ACTOR_FORMAT, SacDrqBase
+from egosearch.sim.observation_options import extra_dims, mask_images
+
+
+def map_arch(cfg: LearnerConfig, mask_dim: int) -> dict[str, Any]:
+    """``{"map_image": shape, "map_offset": where its values start}`` when an image option is on (SAC-DrQ reads it
+    with a :class:`MapReader` in its actor and its critic), else ``{}`` (the arch of every run before it)."""
+    on = {name: True for name, value in cfg.to_dict().items() if value is True}
+    images = mask_images(on)
+    if not images:
+        return {}
+    if len(images) > 1:
+        raise ValueError("SAC-DrQ reads one image inside mask; more than one image option is on")
+    before, shape = images[0]
+    options_start = mask_dim - extra_dims(on).get("mask", 0)
+    return {"map_image": list(shape), "map_offset": options_start + before}
 
 AGENT_FORMAT = "egosearch-sac-drq-agent-v1"
 ACTOR_FORMAT = DRQ_ACTOR_FORMAT
@@ -135,11 +152,16 @@ def drq_actor_loss(nets, h, extra, critic_extra, action, demo, noise, alpha, *, 
 class DrqCritic(nn.Module):
     """Projection of the conv features and twin Q-heads (the part that has a Polyak target)."""
 
-    def __init__(self, conv_dim: int, cfg: LearnerConfig, extra_dim: int, action_dim: int):
+    def __init__(self, conv_dim: int, cfg: LearnerConfig, extra_dim: int, action_dim: int,
+                 map_reader: MapReader | None = None):
         """``extra_dim``: the mask and proprio values, plus the privileged state's when the
-        critic reads it (the caller concatenates them)."""
+        critic reads it (the caller concatenates them); ``map_reader``: the critic's own reader of an image
+        inside mask (``map_image``)."""
         super().__init__()
         self.proj = Projection(conv_dim, cfg.encoder_latent_dim, cfg.encoder_tanh)
+        if map_reader is not None:  # a submodule only then: states without a map keep their keys
+            self.map_reader = map_reader
+            extra_dim = map_reader.extra_dim(extra_dim)
         in_dim = cfg.encoder_latent_dim + extra_dim + action_dim
         self.q1 = mlp(in_dim, cfg.critic_hidden_dim, 1, cfg.critic_num_layers, cfg.critic_activation,
                       cfg.critic_layer_norm)
@@ -147,6 +169,8 @@ class DrqCritic(nn.Module):
                       cfg.critic_layer_norm)
 
     def forward(self, h: torch.Tensor, extra: torch.Tensor, action: torch.Tensor):
+        if hasattr(self, "map_reader"):
+            extra = self.map_reader(extra)
         x = torch.cat([self.proj(h), extra, action], dim=-1)
         return self.q1(x), self.q2(x)
 
@@ -189,10 +213,12 @@ class SacDrqAgent(SacDrqBase):
         arch = super().arch()
         if self.cfg.critic_layer_norm:  # recorded only when on, so that states and actors before it still match
             arch["critic_layer_norm"] = True
+        arch.update(map_arch(self.cfg, self.mask_dim))
         return arch
 
     def make_critic(self, arch: dict[str, Any]) -> DrqCritic:
-        return DrqCritic(self.encoder.out_dim, self.cfg, arch["extra_dim"] + self.state_dim, self.action_dim)
+        return DrqCritic(self.encoder.out_dim, self.cfg, arch["extra_dim"] + self.state_dim, self.action_dim,
+                         map_reader(arch))
 
     def make_actor(self, arch: dict[str, Any]) -> nn.Module:
         return actor_head(self.encoder.out_dim, arch)

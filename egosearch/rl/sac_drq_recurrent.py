@@ -189,8 +189,8 @@ def sample_ring_sequences(buf: ReplayBuffer, starts: np.ndarray, burn_in: int, l
     frame_no = np.concatenate([fn[:, :, :-1], fn[:, -1:, 1:]], axis=1)  # (B, W+1, K): obs..., last next_obs
     depth = buf.frames[frame_no % buf.n_frames]
     last = i[:, -1]
-    extra = np.concatenate([np.concatenate([buf.mask[i], buf.proprio[i]], -1),
-                            np.concatenate([buf.next_mask[last], buf.next_proprio[last]], -1)[:, None]], axis=1)
+    extra = np.concatenate([np.concatenate([buf.masks(i), buf.proprio[i]], -1),
+                            np.concatenate([buf.masks(last, nxt=True), buf.next_proprio[last]], -1)[:, None]], axis=1)
     first = np.zeros((b, w + 1), np.float32)
     first[:, :w] = buf.t_in_ep[i] == 0
     term, trunc, reward = buf.terminated[i], buf.truncated[i], buf.reward[i].astype(np.float64)

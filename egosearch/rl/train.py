@@ -87,7 +87,7 @@ from egosearch.rl.run_files import (
     to_numpy,
     to_tensors,
 )
-from egosearch.rl.train_env import make_train_env, stack_offsets, train_env_kwargs
+from egosearch.rl.train_env import make_train_env, replay_layout, train_env_kwargs
 from egosearch.rl.training_aids import critic_reads_state, demonstration_settings
 from egosearch.sim.observation_options import extra_dims
 
@@ -374,7 +374,7 @@ class LiveRun:
         self.replay = MultiReplay(cfg.num_envs, cfg.replay_capacity, self.agent.replay_image_size, cfg.frame_history,
                                   mask_dim, proprio_dim, action_dim, n_step=cfg.n_step, gamma=cfg.gamma,
                                   device=self.device, seed=cfg.seed, state_dim=state_dim,
-                                  frame_offsets=stack_offsets(cfg))
+                                  **replay_layout(cfg))
         self.curve = CsvLogger(out_dir / "curve.csv", CURVE_COLUMNS)
         self.train_log = CsvLogger(out_dir / "train.csv", TRAIN_COLUMNS)
         self.curve_episodes = CsvLogger(out_dir / "curve_episodes.csv", CURVE_EPISODE_COLUMNS)

@@ -11,13 +11,19 @@ from egosearch.rl.training_aids import critic_reads_state
 from egosearch.scene.layouts import LAYOUT_NAMES
 from egosearch.sim.body import AgentSpec
 from egosearch.sim.home_pool import HomePoolEnv
-from egosearch.sim.observation_options import frame_offsets
+from egosearch.sim.observation_options import byte_valued_tail, frame_offsets
 
 
 def stack_offsets(cfg: LearnerConfig) -> tuple[int, ...]:
     """The frames of the depth stacks the env gives under ``cfg``'s observation options (steps back, oldest
     first): what every replay of the run (its own, its demonstrations, a DAgger round's) rebuilds."""
     return frame_offsets(observation_kwargs(cfg.to_dict()), cfg.frame_history)
+
+
+def replay_layout(cfg: LearnerConfig) -> dict:
+    """What every replay of a run under ``cfg`` is built with besides its sizes: the depth stacks' frames
+    (:func:`stack_offsets`) and how many of mask's last values are an image it stores as bytes."""
+    return {"frame_offsets": stack_offsets(cfg), "mask_bytes": byte_valued_tail(observation_kwargs(cfg.to_dict()))}
 
 
 def make_train_env(env_id: str, env_kwargs: dict):

@@ -31,6 +31,11 @@ class ObservationOption:
 
     extra_dims: ClassVar[Mapping[str, int]] = {}
     """Values appended to each observation vector it changes (``{"proprio": 2}``)."""
+    byte_valued: ClassVar[bool] = False
+    """Its ``mask`` values are multiples of 1/255 in [0, 1] (an image), which a replay stores as bytes. Such an
+    option's values must come last in ``mask`` (:func:`byte_valued_tail`)."""
+    image_shape: ClassVar[tuple[int, int, int] | None] = None
+    """(channels, rows, columns) when its ``mask`` values are an image a learner reads with convs (channel-major)."""
     frame_offsets: ClassVar[tuple[int, ...] | None] = None
     """The past frames the ``depth`` stack holds instead of the last K, as steps back from the newest, oldest
     first and ending at 0 (K of them; frames before the episode's first are that first frame, as at reset);
@@ -121,6 +126,41 @@ def frame_offsets(on: Mapping[str, Any], frame_history: int) -> tuple[int, ...]:
     return offsets
 
 
+def byte_valued_tail(on: Mapping[str, Any]) -> int:
+    """How many of ``mask``'s last values are byte-valued (:attr:`ObservationOption.byte_valued`) with the options
+    turned on in ``on``: a replay stores those as bytes. ValueError when another option's ``mask`` values would
+    follow them."""
+    tail, after = 0, []
+    for name, entry in OPTIONS.items():
+        option = entry.option_class()
+        n = int(option.extra_dims.get("mask", 0))
+        if not on.get(name) or not n:
+            continue
+        if option.byte_valued:
+            tail += n
+        elif tail:
+            after.append(name)
+    if after:
+        raise ValueError(f"option(s) {', '.join(after)} append to mask after byte-valued values; register them "
+                         "before the image options")
+    return tail
+
+
+def mask_images(on: Mapping[str, Any]) -> list[tuple[int, tuple[int, int, int]]]:
+    """``(values before it in the options' part of mask, image shape)`` of each image option turned on in
+    ``on``, in the order its values follow one another at the end of ``mask``."""
+    out, before = [], 0
+    for name, entry in OPTIONS.items():
+        option = entry.option_class()
+        n = int(option.extra_dims.get("mask", 0))
+        if not on.get(name) or not n:
+            continue
+        if option.image_shape is not None:
+            out.append((before, tuple(option.image_shape)))
+        before += n
+    return out
+
+
 def build(on: Mapping[str, Any]) -> list[ObservationOption]:
     """Fresh option states for the options turned on in ``on``, in registration order."""
     return [entry.option_class()() for name, entry in OPTIONS.items() if on.get(name)]
@@ -132,3 +172,5 @@ register("contact_signal", "egosearch.sim.contact_signal:ContactSignal",
          "egosearch.sim.contact_signal:ContactSignalSettings")
 register("strided_history", "egosearch.sim.strided_history:StridedHistory",
          "egosearch.sim.strided_history:StridedHistorySettings")
+# byte-valued images last: a replay stores the end of mask as bytes (byte_valued_tail)
+register("map_image", "egosearch.sim.map_image:MapImage", "egosearch.sim.map_image:MapImageSettings")
