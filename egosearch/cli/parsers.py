@@ -427,6 +427,18 @@ def add_report(sub) -> None:
                    "what they are pressed against, seen before or not, what they did (egosearch.report.stuck_contacts)")
     add_force(r)
 
+    r = reports.add_parser("memory-window", help="how much memory the task asks for: the tuned searcher held to its "
+                                                "last K steps against the students (egosearch.report.memory_window)")
+    r.add_argument("--searchers", nargs="+", required=True, metavar="CSV",
+                   help="evaluation CSVs of the memory-window searchers (frontier_tuned_window{K}, "
+                        "frontier_tuned_head_off_window{K}) and of the whole-episode ones, on Table 1's sets: "
+                        ".../eval/{searcher}/seed0/{home}/{placement}/h{height}.csv")
+    r.add_argument("--students", nargs="+", required=True, metavar="CSV",
+                   help="the students' evaluation CSVs on the same sets, every seed: one head-moving variant and "
+                        "one head-fixed variant")
+    r.add_argument("--out-prefix", required=True, help=prefix.format(".csv, .md, .png and .pdf"))
+    add_force(r)
+
     r = reports.add_parser("null-screen", help="the reference's seeds screened against each other, before and after "
                                              "the seed spread counts; its summary (docs/statistics.md)")
     r.add_argument("files", nargs="+", help="every spread seed's evaluation CSVs of one variant")

@@ -51,7 +51,8 @@ PREFIX_FILES = {"table1": ("table1", (".csv", ".md", ".tex")), "table2": ("table
                 "budget": ("budget", (".csv", ".png", ".pdf")), "pathlength": ("pathlength", (".md", ".png", ".pdf")),
                 "generalise": ("generalise", (".csv", ".md", ".png")), "fresh": ("fresh", (".csv", ".md")),
                 "behaviour": ("behaviour", ("_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md")),
-                "failures": ("failures", (".csv", "_stuck.csv", ".md"))}
+                "failures": ("failures", (".csv", "_stuck.csv", ".md")),
+                "memory-window": ("memory_window", (".csv", ".md", ".png", ".pdf"))}
 """Per report with ``--out-prefix``: the name it takes in a folder given as the prefix, and what it
 adds to the prefix for each file it writes (as the report modules name them)."""
 
@@ -83,6 +84,7 @@ def report_inputs(args) -> dict[str, list[str]]:
         beside = [str(Path(f).with_suffix(".csv")) for f in args.files if f.endswith(".npz")]
         return {"the input files": args.files, "the traces' episodes CSVs": [f for f in beside if os.path.isfile(f)]}
     names = {"files": "the input files", "bounds": "--bounds", "levels": "--levels", "reference": "--reference",
+             "searchers": "--searchers", "students": "--students",
              "candidate": "--candidate", "spread": "--spread", "scenarios": "--scenarios", "stored": "--stored",
              "fresh": "--fresh"}
     out = {}
@@ -530,6 +532,14 @@ def _failures(args) -> None:
     print(f"wrote {csv}, {stuck_csv} and {md} ({len(by_method)} searchers, {len(df)} cells)")
 
 
+def _memory_window(args) -> None:
+    from egosearch.report.memory_window import memory_window_inputs, memory_window_report
+
+    searchers, students = memory_window_inputs(args.searchers, args.students)
+    for path in memory_window_report(searchers, students, args.out_prefix):
+        print(f"wrote {path}")
+
+
 def _null_screen(args) -> None:
     import json
 
@@ -573,7 +583,7 @@ REPORTS = {"table1": _table1, "table2": _table2, "fig6": _fig6, "fig7": _fig7, "
            "generalise": _generalise, "fresh": _fresh, "pathlength": _pathlength, "compare": _compare,
            "behaviour": _behaviour, "searches": _searches, "provenance": _provenance, "regenerate": _regenerate,
            "verify": _verify, "readme": _readme, "null-screen": _null_screen, "failures": _failures,
-           "reread-screens": _reread_screens}
+           "reread-screens": _reread_screens, "memory-window": _memory_window}
 """Each ``egosearch report`` sub-command (its parser: :func:`egosearch.cli.parsers.add_report`)."""
 
 

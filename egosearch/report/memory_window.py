@@ -56,6 +56,34 @@ def _read(paths: Iterable[str]) -> pd.DataFrame:
     return df
 
 
+def memory_window_inputs(searcher_paths: Iterable[str], student_paths: Iterable[str]):
+    """Command-line paths -> (``searchers``, ``students``) of :func:`memory_window_frame`: each searcher's files by
+    its body and memory window (read from its registered name and options), the students' by body (from the
+    variant's head, which its files' name tells: a ``head_off`` variant is the head-fixed one). ValueError, one
+    line, for a file of an unknown searcher or more than one student per body."""
+    from egosearch.searchers import registry
+
+    searchers: dict[str, dict[int | None, list[str]]] = {}
+    for path in searcher_paths:
+        name = parse_eval_path(path)["variant"]
+        if name not in registry.SEARCHERS or not name.startswith("frontier_tuned"):
+            raise ValueError(f"{path}: {name!r} is not the tuned searcher or one of its memory windows "
+                             f"({', '.join(registry.memory_window_searchers(True).values())}, and head-fixed)")
+        searcher = registry.get(name)
+        memory = dict(searcher.options).get("memory_window")
+        body = BODIES[0] if searcher.head else BODIES[1]
+        searchers.setdefault(body, {}).setdefault(memory, []).append(path)
+    students: dict[str, tuple[str, list[str]]] = {}
+    for path in student_paths:
+        variant = parse_eval_path(path)["variant"]
+        body = BODIES[1] if "head_off" in variant else BODIES[0]
+        held = students.setdefault(body, (variant, []))
+        if held[0] != variant:
+            raise ValueError(f"{path}: a second {body} student ({variant}, after {held[0]}); allowed: one per body")
+        held[1].append(path)
+    return searchers, students
+
+
 def memory_window_frame(searchers: Mapping[str, Mapping[int | None, Iterable[str]]],
                         students: Mapping[str, tuple[str, Iterable[str]]]) -> pd.DataFrame:
     """``searchers``: body -> {memory steps (None: the whole episode) -> its evaluation CSVs}; ``students``:

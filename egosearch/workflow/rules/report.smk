@@ -357,3 +357,24 @@ rule decisions_floor_compare:
     shell:
         "egosearch report compare --force --reference {input.reference} --candidate {input.candidate} "
         "--out {output.cells} > {log} 2>&1"
+
+
+rule memory_window:
+    """How much memory the search asks for (outside `all`): the tuned frontier searcher held to its last K steps
+    (K = 5, 10, 20, 50, and the whole episode; head moving and fixed) on every Table 1 set, beside the students
+    that see 5 frames (the first of claims_pairs). About 19,000 episodes for the windows."""
+    input:
+        searchers=ancient(bound_files(bounds=[name for head in (True, False)
+                                              for name in searchers.memory_window_searchers(head).values()])),
+        students=ancient(eval_files(claims_pairs(config)[0][0]) + eval_files(claims_pairs(config)[0][1])),
+    output:
+        expand(f"{FIGS}/memory_window.{{ext}}", ext=["csv", "md", "png", "pdf"]),
+    log:
+        f"{RESULTS}/logs/report/memory_window.log",
+    params:
+        prefix=lambda wc, output: output[0].rsplit(".", 1)[0],
+    conda:
+        CONDA_ENV
+    shell:
+        "egosearch report memory-window --force --searchers {input.searchers} --students {input.students} "
+        "--out-prefix {params.prefix} > {log} 2>&1"
