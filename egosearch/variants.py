@@ -20,7 +20,7 @@ import jsonschema
 import yaml
 
 from egosearch.core.schema_errors import schema_error
-from egosearch.envs import observed_env_id
+from egosearch.envs import env_options, observed_env_id
 from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
 from egosearch.searchers import registry as searchers
 from egosearch.sim.home_pool import check_home_split
@@ -147,6 +147,13 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
     config = load_config(profile, {**variant.config, **(overrides or {})})
     env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
     return ResolvedVariant(variant, profile, config, env_id)
+
+
+def variant_head(variant: str | Path | Variant) -> bool:
+    """Whether the variant's body moves its head (its env id's ``head``)."""
+    if not isinstance(variant, Variant):
+        variant = load_variant(variant)
+    return env_options(variant.env_id).head
 
 
 def check_learner_config(variant: Variant, learner_profile: str) -> None:

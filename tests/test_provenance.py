@@ -83,6 +83,35 @@ def test_a_job_recorded_before_records_named_machines_is_not_given_one(tmp_path)
     assert jobs["eval"]["machine"] is None and jobs["train"]["machine"]["cpu"] == "Far Away CPU"
 
 
+def test_a_copied_run_inherits_its_sources_machine_and_is_counted_once(tmp_path, monkeypatch):
+    """A stored run copied under a new name keeps its benchmark files byte for byte: the copy names its source,
+    takes the source's machine (not the machine that wrote the record) and is left out of the totals."""
+    results = _results(tmp_path)
+    (results / "train" / "v" / "seed0" / "done.json").write_text(json.dumps(
+        {"variant": "v", "machine": {"cpu": "Far Away CPU", "vector_unit": "AVX2", "cores": 16}}))
+    record = results / "provenance.json"
+    monkeypatch.setattr(provenance, "this_machine", lambda: {"cpu": "Old CPU", "vector_unit": None, "cores": 2})
+    provenance.write_provenance("p", results, record)
+    # later, on another machine: v's run copied to w (its done.json still names v)
+    shutil.copytree(results / "train" / "v", results / "train" / "w")
+    for rule, job in (("train", "v/seed0"), ("eval", "v/seed0/h1.05")):
+        source = results / "benchmarks" / rule / f"{job}.tsv"
+        copy = results / "benchmarks" / rule / f"{job.replace('v/', 'w/', 1)}.tsv"
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, copy)
+    (results / "eval" / "w" / "seed0").mkdir(parents=True)
+    (results / "eval" / "w" / "seed0" / "h1.05.csv").write_text("scenario_id,success\n0,1\n")
+    monkeypatch.setattr(provenance, "this_machine", lambda: {"cpu": "New CPU", "vector_unit": None, "cores": 2})
+    written = provenance.write_provenance("p", results, record)
+    jobs = {(j["rule"], j["job"]): j for j in written["jobs"]}
+    assert jobs[("eval", "w/seed0/h1.05")]["copy_of"] == "eval/v/seed0/h1.05"
+    assert jobs[("train", "w/seed0")]["copy_of"] == "train/v/seed0"
+    assert "copy_of" not in jobs[("eval", "v/seed0/h1.05")]
+    assert jobs[("eval", "w/seed0/h1.05")]["machine"]["cpu"] == "Old CPU"  # where its source ran
+    assert (written["jobs_counted"], written["jobs_copied"]) == (2, 2)
+    assert written["wall_s_all_jobs_summed"] == 53.0 and sum(m["jobs"] for m in written["machines"]) == 2
+
+
 def _tracked_files() -> list[str]:
     """The files git tracks in this checkout, relative to its root; skips the test without git or a checkout."""
     if shutil.which("git") is None:

@@ -79,7 +79,10 @@ def fig6_levels() -> dict[str, tuple]:
 
 START_LABEL = "policy at step 0"
 """Legend text of the dotted line at each curve's first point (its start: untrained, or cloned)."""
-FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "n_scenarios", "success_rate", "low", "high", "ci_unit")
+FIG6_COLUMNS = ("variant", "label", "env_steps", "n_seeds", "n_scenarios", "success_rate", "low", "high", "ci_unit",
+                "rise", "rise_low", "rise_high")
+"""``rise``: the success rate at this step minus the curve's first (its start), with the 95 % interval of that
+difference paired on the same episodes and seeds (two-level bootstrap; NaN where the episodes are not stored)."""
 CI_TWO_LEVEL, CI_SEEDS, CI_WILSON = "scenarios, then seeds", "seeds", "episodes (Wilson)"
 FIG7_COLUMNS = ("mg", "method", "label", "M", "T", "baseline", "n_episodes", "n_scenarios", "n_seeds",
                 "success_rate", "spl", "spl_low", "spl_high", "attempts", "attempts_low", "attempts_high",
@@ -194,20 +197,31 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
         episodes = _curve_episodes(paths)
         if episodes is not None:
             curve_episode_sets[variant] = episodes[episodes["env_steps"] == episodes["env_steps"].min()]
+        start_matrix, start_rate = None, None
         for step, g in df.groupby("env_steps", sort=True):
             v = g["success_rate"].to_numpy(dtype=float)
+            start_rate = float(v.mean()) if start_rate is None else start_rate
             at = None if episodes is None else episodes[episodes["env_steps"] == step]
+            rise_lo = rise_hi = math.nan
             if at is not None and set(at["seed"]) == set(g["seed"]) and not at.empty:
-                m, _ = scenario_seed_matrix(at, "success")
+                m, keys = scenario_seed_matrix(at, "success")
                 _, lo, hi = two_level_ci(m, confidence, n_resamples, seed)
                 unit, n_scen = CI_TWO_LEVEL, m.shape[0]
+                if start_matrix is None:
+                    start_matrix = (m, keys)
+                elif start_matrix[1] == keys and start_matrix[0].shape == m.shape:
+                    # the same episodes and seeds as the start: the rise's interval is paired on them
+                    _, rise_lo, rise_hi = two_level_ci(m - start_matrix[0], confidence, n_resamples, seed)
+                if start_matrix[0] is m:
+                    rise_lo = rise_hi = 0.0
             else:
                 lo, hi = (bootstrap_ci(v, np.mean, confidence, n_resamples, seed) if v.size >= 2
                           else (math.nan, math.nan))
                 unit, n_scen = CI_SEEDS, math.nan
             rows.append({"variant": variant, "label": labels.get(variant, variant), "env_steps": int(step),
                          "n_seeds": int(v.size), "n_scenarios": n_scen, "success_rate": float(v.mean()),
-                         "low": lo, "high": hi, "ci_unit": unit})
+                         "low": lo, "high": hi, "ci_unit": unit, "rise": float(v.mean()) - start_rate,
+                         "rise_low": rise_lo, "rise_high": rise_hi})
     by_level: dict[str, list] = {}
     for path in level_files or []:
         by_level.setdefault(level_searcher(path), []).append(path)
@@ -227,7 +241,8 @@ def figure6_frame(curves: Mapping[str, Iterable[PathLike]], labels: Mapping[str,
         for step in sorted({r["env_steps"] for r in rows}):
             rows.append({"variant": name, "label": levels[name][0], "env_steps": step,
                          "n_seeds": 1, "n_scenarios": n, "success_rate": k / n,
-                         "low": lo, "high": hi, "ci_unit": CI_WILSON})
+                         "low": lo, "high": hi, "ci_unit": CI_WILSON, "rise": 0.0, "rise_low": math.nan,
+                         "rise_high": math.nan})
     return pd.DataFrame(rows, columns=list(FIG6_COLUMNS))
 
 

@@ -12,6 +12,7 @@ import hashlib
 import json
 import os
 import platform
+import re
 import subprocess
 from collections.abc import Iterable
 from importlib import metadata
@@ -141,6 +142,54 @@ def _job_key(job: dict) -> tuple[str, str]:
     return job["rule"], job["job"]
 
 
+def _variant_of(job: str) -> str | None:
+    """The variant of a job path ``[.../]<variant>/seed<N>/...`` (the folder before its first ``seed<N>``)."""
+    parts = job.split("/")
+    for i, part in enumerate(parts[1:], start=1):
+        if re.fullmatch(r"seed\d+", part):
+            return parts[i - 1]
+    return None
+
+
+def _trained_as(results: Path, job: str) -> str | None:
+    """The variant a job's run trained as (its ``done.json``'s), for a job path ``[.../]<variant>/seed<N>/...``."""
+    variant = _variant_of(job)
+    seed = next((p for p in job.split("/") if re.fullmatch(r"seed\d+", p)), None)
+    if variant is None or seed is None:
+        return None
+    try:
+        return json.loads((results / "train" / variant / seed / "done.json").read_text(encoding="utf-8"))["variant"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def mark_copies(jobs: list[dict], benchmarks_dir: Path, results: Path) -> None:
+    """A job whose benchmark file is byte for byte another's was copied from it (a stored run moved under a new
+    name keeps its files): it gets ``copy_of`` (``rule/job`` of its source) and is counted once, as its source.
+    The source is the job whose run trained under its own name (its ``done.json``); else the first by name."""
+    by_digest: dict[str, list[dict]] = {}
+    for job in jobs:
+        path = Path(benchmarks_dir) / job["rule"] / f"{job['job']}.tsv"
+        try:
+            digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError:
+            continue
+        by_digest.setdefault(digest, []).append(job)
+    for group in by_digest.values():
+        if len(group) < 2:
+            continue
+        own = [j for j in group if _trained_as(results, j["job"]) == _variant_of(j["job"])]
+        source = (own or sorted(group, key=lambda j: j["job"]))[0]
+        for job in group:
+            if job is not source:
+                job["copy_of"] = f"{source['rule']}/{source['job']}"
+
+
+def counted(jobs: list[dict]) -> list[dict]:
+    """The jobs that ran: every job but the copies (:func:`mark_copies`)."""
+    return [job for job in jobs if "copy_of" not in job]
+
+
 def attach_machines(jobs: list[dict], results: Path, previous: dict | None) -> None:
     """Give each job the machine it ran on, where that is known: a training's from its ``done.json``
     (the trainer records it); a job the previous record already held, with the same wall time, keeps
@@ -165,13 +214,18 @@ def attach_machines(jobs: list[dict], results: Path, previous: dict | None) -> N
         elif machine is None:
             machine = here
         job["machine"] = machine
+    # a copy ran where its source ran
+    by_key = {f"{j['rule']}/{j['job']}": j for j in jobs}
+    for job in jobs:
+        if "copy_of" in job and job["copy_of"] in by_key:
+            job["machine"] = by_key[job["copy_of"]]["machine"]
 
 
 def machines_of(jobs: list[dict]) -> list[dict]:
     """Every machine the jobs name, with how many jobs and how many summed wall seconds each ran (most
     first), and one entry ``{"cpu": None, ...}`` for the jobs that name none."""
     groups: dict[str, dict] = {}
-    for job in jobs:
+    for job in counted(jobs):
         machine = job.get("machine") or {"cpu": None, "vector_unit": None, "cores": None}
         key = json.dumps(machine, sort_keys=True)
         entry = groups.setdefault(key, {**machine, "jobs": 0, "wall_s": 0.0})
@@ -189,9 +243,10 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
     out = Path(out)
     previous = _read_record(out) if out.is_file() else None
     jobs = rule_times(results / "benchmarks")
+    mark_copies(jobs, results / "benchmarks", results)
     attach_machines(jobs, results, previous)
     per_rule: dict[str, float] = {}
-    for job in jobs:
+    for job in counted(jobs):
         per_rule[job["rule"]] = round(per_rule.get(job["rule"], 0.0) + job["wall_s"], 1)
     status = _git("status", "--porcelain", "--untracked-files=no")
     record = {
@@ -207,6 +262,8 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
         "machines": machines_of(jobs),
         "wall_s_per_rule_summed": per_rule,
         "wall_s_all_jobs_summed": round(sum(per_rule.values()), 1),
+        "jobs_counted": len(counted(jobs)),
+        "jobs_copied": len(jobs) - len(counted(jobs)),
         "jobs": jobs,
         "files": record_files(results),
     }

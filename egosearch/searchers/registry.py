@@ -187,6 +187,23 @@ for _k in MEMORY_WINDOWS:
              label=f"tuned searcher, head fixed, last {_k} steps", what="the same with the camera fixed to the body")
 
 
+def with_head(name: str, head: bool) -> str:
+    """The registered searcher that is ``name``'s policy with the head moving (``head``) or fixed: the one with
+    the same factory and options whose ``head`` is ``head`` (``frontier_tuned`` -> ``frontier_tuned_head_off``);
+    ValueError, one line, when none is registered."""
+    searcher = get(name)
+    for other in SEARCHERS.values():
+        if other.factory == searcher.factory and other.options == searcher.options and other.head is head:
+            return other.name
+    raise ValueError(f"no registered searcher is {name!r} with its head {'moving' if head else 'fixed'}")
+
+
+def classical_with_head(head: bool) -> tuple[str, ...]:
+    """The classical searchers (``classical``) of one head, in registration order: what a policy of that head is
+    read against (``snakemake versus_teacher``)."""
+    return tuple(s.name for s in SEARCHERS.values() if s.classical and s.head is head)
+
+
 def memory_window_searchers(head: bool) -> dict[int | None, str]:
     """The tuned searcher by memory window (None: the whole episode), head moving or fixed."""
     whole = "frontier_tuned" if head else "frontier_tuned_head_off"

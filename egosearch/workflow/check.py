@@ -17,7 +17,14 @@ from pathlib import Path
 from egosearch.core.schema_errors import schema_error
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
 from egosearch.searchers import registry as searchers
-from egosearch.variants import ABLATIONS_DIR, Variant, VariantError, check_learner_config, load_variant
+from egosearch.variants import (  # noqa: F401  (variant_head: the rules import it from here)
+    ABLATIONS_DIR,
+    Variant,
+    VariantError,
+    check_learner_config,
+    load_variant,
+    variant_head,
+)
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "config.schema.json"
 
@@ -178,3 +185,4 @@ def reports_missing_inputs(rules, exists=lambda p: Path(p).exists()) -> list[str
                          f"(e.g. {missing[0]}); Snakemake will not make them for it: "
                          f"add `-R {name}` to make them and redo {name}")
     return lines
+

@@ -12,7 +12,7 @@ from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
 from egosearch.workflow.cluster import is_cluster, partitions_asked, slurm_run_problem, snakemake_executor
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
-from egosearch.workflow.check import claims_pairs
+from egosearch.workflow.check import claims_pairs, variant_head
 
 # The executor of this run (--executor, or a profile's executor:, as profiles/slurm names slurm): Snakemake
 # parses the Snakefile before it hands the run its executor, so workflow.local_exec cannot tell
@@ -283,6 +283,10 @@ BOUNDS = searchers.bounds()
 REFERENCE_SEARCHERS = searchers.names()
 CLASSICAL_SEARCHERS = searchers.classical()
 MODULAR_FLOORS = searchers.modular_floors()
+# `versus_teacher`'s comparisons: Figure 6's pair, each against the classical searchers of its own head (the one it
+# learned from, read from its config, among them), as (variant, searcher) pairs.
+VERSUS_TEACHER = [(variant, searcher) for variant in claims_pairs(config)[0]
+                  for searcher in searchers.classical_with_head(variant_head(variant))]
 
 
 def bound_files(bounds=BOUNDS, placements=None, homes=None):

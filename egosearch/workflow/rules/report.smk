@@ -305,9 +305,9 @@ rule decisions_floor:
 
 
 rule teacher_compare:
-    """Figure 6's pair against the classical searcher each learned from (its teacher at the cpu profile):
-    head_on against frontier, head_off against frontier_head_off, every seed against the teacher's one, on the
-    same stored sets; per cell, per shortest-path bin and the stuck share."""
+    """A variant (every seed) against a classical searcher (its one seed) on the same stored sets: per cell, per
+    shortest-path bin and the stuck share. `versus_teacher` asks for Figure 6's pair against the classical
+    searchers of its head, the teacher each learned from (its config's demo_teacher) among them."""
     input:
         reference=ancient(lambda wc: bound_files([wc.teacher])),
         candidate=ancient(lambda wc: eval_files(wc.variant)),
@@ -318,7 +318,7 @@ rule teacher_compare:
     log:
         f"{RESULTS}/logs/report/teacher_compare_{{variant}}_vs_{{teacher}}.log",
     wildcard_constraints:
-        teacher="frontier|frontier_head_off",
+        teacher="|".join(CLASSICAL_SEARCHERS),
     conda:
         CONDA_ENV
     shell:
@@ -327,11 +327,11 @@ rule teacher_compare:
 
 
 rule versus_teacher:
-    """`snakemake --cores 2 versus_teacher`: head_on against frontier, head_off against frontier_head_off."""
+    """`snakemake --cores 2 versus_teacher`: Figure 6's pair (the first of claims_pairs) against every classical
+    searcher of its head (searchers registered as classical): the untuned frontier searcher, Table 1's classical
+    row, and the tuned one, the teacher the cpu profile's pair learned from (VERSUS_TEACHER, common.smk)."""
     input:
-        # Figure 6's pair: the first of claims_pairs
-        expand(f"{RESULTS}/compare/{{pair}}.csv", pair=[f"{claims_pairs(config)[0][0]}_vs_frontier",
-                                                       f"{claims_pairs(config)[0][1]}_vs_frontier_head_off"]),
+        [f"{RESULTS}/compare/{variant}_vs_{searcher}.csv" for variant, searcher in VERSUS_TEACHER],
 
 
 rule teacher_tuning:
