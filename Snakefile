@@ -74,13 +74,20 @@ if (workflow.is_main_process and workflow.output_settings.dryrun and EXECUTOR ==
 
 # A job that Slurm killed at its time or memory limit: one line each when the run stops, saying which
 # limit, what the same command does next (a training resumes from its checkpoint in partial/) and the
-# --set-resources that gives it more (egosearch.workflow.cluster.killed_job_lines).
+# --set-resources that gives it more (egosearch.workflow.cluster.killed_job_lines); then, whatever the executor,
+# each failed job's own reason (egosearch.workflow.failures).
 onerror:
     if EXECUTOR == "slurm":
         from egosearch.workflow.cluster import killed_job_lines
 
         for line in killed_job_lines(log, train_checkpoint):
             print(line, file=sys.stderr)
+    # each failed job's own one-line reason, last on the console (its log holds the rest); a job that would
+    # replace stored files has restored them (its outputs are update(): rules/*.smk)
+    from egosearch.workflow.failures import failed_job_lines
+
+    for line in failed_job_lines(log):
+        print(line, file=sys.stderr)
 
 
 # A run killed by SIGKILL leaves its lock: rerunning the same command removes it when no other

@@ -41,6 +41,27 @@ def one_core():
 REWARDS_TIMED = ("progress", "geodesic")
 """The training r_d forms ``bench env`` times side by side: the cpu profile's and the geodesic lever's."""
 REWARD_ROUNDS = 6
+OPTIONS_TIMED = ("map_image", "strided_history")
+"""The memory levers' observation options ``bench env`` times beside the env without them, in the same run."""
+
+
+def _interleaved_ms(envs: dict, actions: np.ndarray, seed: int) -> dict[str, float]:
+    """Milliseconds per step of each env on the same actions, in interleaved rounds of one run: the machine's
+    load falls on every env alike, so their ratios hold on a busy machine too."""
+    spent = dict.fromkeys(envs, 0.0)
+    for e in envs.values():
+        e.reset(seed=seed)
+    for chunk in np.array_split(actions, REWARD_ROUNDS):
+        for name, e in envs.items():
+            t0 = time.perf_counter()
+            for a in chunk:
+                _, _, terminated, truncated, _ = e.step(a)
+                if terminated or truncated:
+                    e.reset()
+            spent[name] += time.perf_counter() - t0
+    for e in envs.values():
+        e.close()
+    return {name: 1000 * t / len(actions) for name, t in spent.items()}
 
 
 def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3000, seed: int = 0) -> dict:
@@ -64,21 +85,12 @@ def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3
         env.close()
         # The training rewards side by side on the same actions, interleaved rounds, in this one run: a ratio
         # the machine's load cancels from (the geodesic reward reads the navigation grid at every step).
-        reward_s = {name: 0.0 for name in REWARDS_TIMED}
-        envs = {name: gymnasium.make("EgoSearch-v0", layout=layout, distance_reward=name) for name in REWARDS_TIMED}
-        for e in envs.values():
-            e.reset(seed=seed)
-        for chunk in np.array_split(actions, REWARD_ROUNDS):
-            for name, e in envs.items():
-                t0 = time.perf_counter()
-                for a in chunk:
-                    _, _, terminated, truncated, _ = e.step(a)
-                    if terminated or truncated:
-                        e.reset()
-                reward_s[name] += time.perf_counter() - t0
-        for e in envs.values():
-            e.close()
-    per_step_ms = {name: 1000 * t / steps for name, t in reward_s.items()}
+        per_step_ms = _interleaved_ms({name: gymnasium.make("EgoSearch-v0", layout=layout, distance_reward=name)
+                                       for name in REWARDS_TIMED}, actions, seed)
+        # the memory levers' observations beside the plain one, the same way
+        by_option = _interleaved_ms({"none": gymnasium.make("EgoSearchMemory-v0", layout=layout),
+                                     **{name: gymnasium.make("EgoSearchMemory-v0", layout=layout, **{name: True})
+                                        for name in OPTIONS_TIMED}}, actions, seed)
     return {
         "layout": layout,
         "triangles": triangle_count(scene),
@@ -89,6 +101,8 @@ def bench_env(layout: str = "kitchen_living", frames: int = 3000, steps: int = 3
         "env_resets_included": done_episodes,
         "env_ms_per_step_by_reward": {name: round(v, 3) for name, v in per_step_ms.items()},
         "geodesic_over_progress": round(per_step_ms["geodesic"] / per_step_ms["progress"], 3),
+        "env_ms_per_step_by_option": {name: round(v, 3) for name, v in by_option.items()},
+        "option_over_none": {name: round(by_option[name] / by_option["none"], 3) for name in OPTIONS_TIMED},
         "pinned_core": core,
         "cpu": platform.processor() or platform.machine(),
     }

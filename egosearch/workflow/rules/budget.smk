@@ -6,7 +6,7 @@ rule budget:
     input:
         ancient([path for runs in budget_inputs().values() for pair in runs for path in pair]),
     output:
-        expand(f"{FIGS}/budget.{{ext}}", ext=["png", "pdf", "csv"]),
+        update(expand(f"{FIGS}/budget.{{ext}}", ext=["png", "pdf", "csv"])),
     log:
         f"{RESULTS}/logs/report/budget.log",
     benchmark:

@@ -4,7 +4,7 @@ rule evaluate:
         actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        "results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -28,7 +28,7 @@ rule evaluate_start:
         actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        "results/{profile}/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -57,7 +57,7 @@ rule curve_level:
     variant's training curve is evaluated on, each episode seeded as the curve's: its level in Figure 6,
     read on the curve's own episodes."""
     output:
-        "results/{profile}/eval_curve/{bound}/{variant}.csv",
+        update("results/{profile}/eval_curve/{bound}/{variant}.csv"),
     log:
         "results/{profile}/logs/eval_curve/{bound}/{variant}.log",
     benchmark:
@@ -80,7 +80,7 @@ rule tune_teacher:
     fit split, the one chosen and the untuned searcher on a held-out split, never a stored set; the record
     says whether the shipped parameters still win and what they do held out. About 13,000 episodes."""
     output:
-        "results/{profile}/teacher_tuning/record.json",
+        update("results/{profile}/teacher_tuning/record.json"),
     log:
         "results/{profile}/logs/teacher_tuning.log",
     benchmark:
@@ -104,7 +104,7 @@ rule bound:
     input:
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        "results/{profile}/eval/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/eval/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:

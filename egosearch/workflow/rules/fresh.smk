@@ -7,7 +7,7 @@
 
 use rule scenarios as fresh_scenarios with:
     output:
-        "results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/fresh/scenarios/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -22,7 +22,7 @@ use rule evaluate as fresh_evaluate with:
         actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         scenarios="results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
     output:
-        "results/{profile}/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -35,7 +35,7 @@ rule fresh:
         stored=ancient(fresh_files("stored")),
         fresh=fresh_files("fresh"),
     output:
-        expand(f"{FIGS}/fresh.{{ext}}", ext=["csv", "md"]),
+        update(expand(f"{FIGS}/fresh.{{ext}}", ext=["csv", "md"])),
     log:
         f"{RESULTS}/logs/report/fresh.log",
     benchmark:

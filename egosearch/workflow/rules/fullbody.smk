@@ -4,7 +4,7 @@ rule fullbody:
         actor=ancient(f"{RESULTS}/train/{REF}/seed{{seed}}/actor.pt"),
         scenarios=ancient(fullbody_scenarios),
     output:
-        "results/{profile}/fullbody/{setting}/seed{seed}.csv",
+        update("results/{profile}/fullbody/{setting}/seed{seed}.csv"),
     log:
         "results/{profile}/logs/fullbody/{setting}/seed{seed}.log",
     benchmark:
@@ -30,7 +30,7 @@ rule fullbody_oracle:
     input:
         scenarios=ancient(fullbody_scenarios),
     output:
-        "results/{profile}/fullbody_oracle/{setting}/seed{seed}.csv",
+        update("results/{profile}/fullbody_oracle/{setting}/seed{seed}.csv"),
     log:
         "results/{profile}/logs/fullbody_oracle/{setting}/seed{seed}.log",
     benchmark:
@@ -59,8 +59,8 @@ rule video:
         scenarios=ancient(scenario_file("everywhere", "1.65")),
         fullbody=ancient(f"{RESULTS}/fullbody/ours-M5-humanoid_phase/seed{FULLBODY['seeds'][0]}.csv"),
     output:
-        gif=f"{FIGS}/search.gif",
-        still=f"{FIGS}/search_still.png",
+        gif=update(f"{FIGS}/search.gif"),
+        still=update(f"{FIGS}/search_still.png"),
     log:
         f"{RESULTS}/logs/report/video.log",
     benchmark:

@@ -4,7 +4,7 @@
 rule group_scenarios:
     """One scenario set over a group of generated homes: `scenarios_per_home` in each."""
     output:
-        "results/{profile}/scenarios/{group}/{placement}/h{height}.csv",
+        update("results/{profile}/scenarios/{group}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/scenarios/{group}/{placement}/h{height}.log",
     benchmark:
@@ -36,7 +36,7 @@ rule generalise:
         policies=ancient([generalise_files(v, SEEDS) for v in GEN_VARIANTS]),
         bounds=ancient([generalise_files(b, BOUND_SEEDS) for b in ("random", "oracle")]),
     output:
-        expand(f"{FIGS}/generalise.{{ext}}", ext=["csv", "md", "png"]),
+        update(expand(f"{FIGS}/generalise.{{ext}}", ext=["csv", "md", "png"])),
     log:
         f"{RESULTS}/logs/report/generalise.log",
     benchmark:

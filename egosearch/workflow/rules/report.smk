@@ -9,7 +9,7 @@ rule table1:
         bounds=ancient(bound_files()),
         learning_adds=ancient(f"{RESULTS}/compare/{REF}_vs_its_start.csv"),
     output:
-        expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"]),
+        update(expand(f"{FIGS}/table1.{{ext}}", ext=["md", "csv", "tex"])),
     log:
         f"{RESULTS}/logs/report/table1.log",
     benchmark:
@@ -27,7 +27,7 @@ rule table1:
 rule table2:
     """The learner's hyperparameters of this profile, generated from the config (paper Table 2)."""
     output:
-        expand(f"{FIGS}/table2.{{ext}}", ext=["md", "tex"]),
+        update(expand(f"{FIGS}/table2.{{ext}}", ext=["md", "tex"])),
     log:
         f"{RESULTS}/logs/report/table2.log",
     benchmark:
@@ -44,7 +44,7 @@ rule table2:
 rule table2_paper:
     """Table 2 of the paper, regenerated from the `paper` profile of the config."""
     output:
-        expand("paper_figs/table2.{ext}", ext=["md", "tex"]),
+        update(expand("paper_figs/table2.{ext}", ext=["md", "tex"])),
     log:
         f"{RESULTS}/logs/report/table2_paper.log",
     benchmark:
@@ -64,7 +64,7 @@ rule fig6:
         curves=ancient([curve_files(v) for v in VARIANTS]),
         levels=ancient(fig6_level_files()),
     output:
-        expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"]),
+        update(expand(f"{FIGS}/fig6.{{ext}}", ext=["png", "pdf", "csv"])),
     log:
         f"{RESULTS}/logs/report/fig6.log",
     benchmark:
@@ -82,7 +82,7 @@ rule fig7:
     input:
         ancient(fullbody_files()),
     output:
-        expand(f"{FIGS}/fig7.{{ext}}", ext=["png", "pdf", "csv"]),
+        update(expand(f"{FIGS}/fig7.{{ext}}", ext=["png", "pdf", "csv"])),
     log:
         f"{RESULTS}/logs/report/fig7.log",
     benchmark:
@@ -100,7 +100,7 @@ rule fig7_oracle:
     input:
         ancient(fullbody_files("oracle")),
     output:
-        expand(f"{FIGS}/fig7_oracle.{{ext}}", ext=["png", "pdf", "csv"]),
+        update(expand(f"{FIGS}/fig7_oracle.{{ext}}", ext=["png", "pdf", "csv"])),
     log:
         f"{RESULTS}/logs/report/fig7_oracle.log",
     benchmark:
@@ -121,10 +121,10 @@ rule pathlength:
         scenarios=ancient(table1_scenario_files()),
         bounds=ancient(bound_files()),
     output:
-        csv=f"{RESULTS}/pathlength/{{variant}}.csv",
-        md=f"{FIGS}/pathlength_{{variant}}.md",
-        png=f"{FIGS}/pathlength_{{variant}}.png",
-        pdf=f"{FIGS}/pathlength_{{variant}}.pdf",
+        csv=update(f"{RESULTS}/pathlength/{{variant}}.csv"),
+        md=update(f"{FIGS}/pathlength_{{variant}}.md"),
+        png=update(f"{FIGS}/pathlength_{{variant}}.png"),
+        pdf=update(f"{FIGS}/pathlength_{{variant}}.pdf"),
     log:
         f"{RESULTS}/logs/report/pathlength_{{variant}}.log",
     benchmark:
@@ -141,7 +141,7 @@ rule pathlength:
 rule pictures:
     """The world's pictures: top-down map, placements, first/third-person views."""
     output:
-        expand("paper_figs/world/{layout}_{kind}.png", layout=[LAYOUT], kind=["topdown", "placements", "views"]),
+        update(expand("paper_figs/world/{layout}_{kind}.png", layout=[LAYOUT], kind=["topdown", "placements", "views"])),
     log:
         f"{RESULTS}/logs/report/pictures.log",
     benchmark:
@@ -162,9 +162,9 @@ rule compare:
         reference=ancient(eval_files(REF)),
         candidate=compare_candidate,
     output:
-        cells=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv",
-        by_length=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_by_length.csv",
-        stuck=f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_stuck.csv",
+        cells=update(f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}.csv"),
+        by_length=update(f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_by_length.csv"),
+        stuck=update(f"{RESULTS}/compare/{config.get('variant') or 'none'}_vs_{REF}_stuck.csv"),
     log:
         f"{RESULTS}/logs/report/compare_{config.get('variant') or 'none'}.log",
     conda:
@@ -185,10 +185,10 @@ rule screen:
         reference=ancient(spread_files(REF)),
         candidate=screen_candidate,
     output:
-        cells=f"{RESULTS}/compare/{screen_name()}.csv",
-        by_length=f"{RESULTS}/compare/{screen_name()}_by_length.csv",
-        aggregate=f"{RESULTS}/compare/{screen_name()}_aggregate.csv",
-        stuck=f"{RESULTS}/compare/{screen_name()}_stuck.csv",
+        cells=update(f"{RESULTS}/compare/{screen_name()}.csv"),
+        by_length=update(f"{RESULTS}/compare/{screen_name()}_by_length.csv"),
+        aggregate=update(f"{RESULTS}/compare/{screen_name()}_aggregate.csv"),
+        stuck=update(f"{RESULTS}/compare/{screen_name()}_stuck.csv"),
     log:
         f"{RESULTS}/logs/report/{screen_name()}.log",
     conda:
@@ -206,8 +206,8 @@ rule null_screen:
     input:
         ancient(spread_files(REF)),
     output:
-        screens=f"{RESULTS}/compare/null_screen_{REF}.csv",
-        summary=f"{RESULTS}/compare/seed_spread_{REF}.json",
+        screens=update(f"{RESULTS}/compare/null_screen_{REF}.csv"),
+        summary=update(f"{RESULTS}/compare/seed_spread_{REF}.json"),
     log:
         f"{RESULTS}/logs/report/null_screen_{REF}.log",
     conda:
@@ -223,7 +223,7 @@ rule screens_reread:
     input:
         ancient(stored_one_seed_screens()),
     output:
-        f"{RESULTS}/compare/screens_reread.csv",
+        update(f"{RESULTS}/compare/screens_reread.csv"),
     log:
         f"{RESULTS}/logs/report/screens_reread.log",
     params:
@@ -285,8 +285,8 @@ rule learning_adds_compare:
         reference=ancient(lambda wc: start_eval_files(wc.variant)),
         candidate=ancient(lambda wc: eval_files(wc.variant)),
     output:
-        cells=f"{RESULTS}/compare/{{variant}}_vs_its_start.csv",
-        by_length=f"{RESULTS}/compare/{{variant}}_vs_its_start_by_length.csv",
+        cells=update(f"{RESULTS}/compare/{{variant}}_vs_its_start.csv"),
+        by_length=update(f"{RESULTS}/compare/{{variant}}_vs_its_start_by_length.csv"),
     log:
         f"{RESULTS}/logs/report/learning_adds_{{variant}}.log",
     conda:
@@ -312,9 +312,9 @@ rule teacher_compare:
         reference=ancient(lambda wc: bound_files([wc.teacher])),
         candidate=ancient(lambda wc: eval_files(wc.variant)),
     output:
-        cells=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}.csv",
-        by_length=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_by_length.csv",
-        stuck=f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_stuck.csv",
+        cells=update(f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}.csv"),
+        by_length=update(f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_by_length.csv"),
+        stuck=update(f"{RESULTS}/compare/{{variant}}_vs_{{teacher}}_stuck.csv"),
     log:
         f"{RESULTS}/logs/report/teacher_compare_{{variant}}_vs_{{teacher}}.log",
     wildcard_constraints:
@@ -346,8 +346,8 @@ rule decisions_floor_compare:
         reference=ancient(lambda wc: bound_files([wc.floor])),
         candidate=ancient(lambda wc: eval_files(wc.variant)),
     output:
-        cells=f"{RESULTS}/compare/{{variant}}_vs_{{floor}}.csv",
-        by_length=f"{RESULTS}/compare/{{variant}}_vs_{{floor}}_by_length.csv",
+        cells=update(f"{RESULTS}/compare/{{variant}}_vs_{{floor}}.csv"),
+        by_length=update(f"{RESULTS}/compare/{{variant}}_vs_{{floor}}_by_length.csv"),
     log:
         f"{RESULTS}/logs/report/decisions_floor_{{variant}}_vs_{{floor}}.log",
     wildcard_constraints:
@@ -368,7 +368,7 @@ rule memory_window:
                                               for name in searchers.memory_window_searchers(head).values()])),
         students=ancient(eval_files(claims_pairs(config)[0][0]) + eval_files(claims_pairs(config)[0][1])),
     output:
-        expand(f"{FIGS}/memory_window.{{ext}}", ext=["csv", "md", "png", "pdf"]),
+        update(expand(f"{FIGS}/memory_window.{{ext}}", ext=["csv", "md", "png", "pdf"])),
     log:
         f"{RESULTS}/logs/report/memory_window.log",
     params:

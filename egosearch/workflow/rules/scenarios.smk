@@ -1,7 +1,7 @@
 rule scenarios:
     """The fixed scenario set of one Table 1 cell (paper 6.1)."""
     output:
-        "results/{profile}/scenarios/{layout}/{placement}/h{height}.csv",
+        update("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/scenarios/{layout}/{placement}/h{height}.log",
     benchmark:

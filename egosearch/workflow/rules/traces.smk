@@ -27,8 +27,8 @@ rule trace:
         actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        trace="results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.npz",
-        episodes="results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        trace=update("results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"),
+        episodes=update("results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -54,8 +54,8 @@ rule trace_bound:
     input:
         scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        trace="results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.npz",
-        episodes="results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv",
+        trace=update("results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.npz"),
+        episodes=update("results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
         "results/{profile}/logs/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
@@ -79,7 +79,7 @@ rule behaviour:
     input:
         ancient(TRACE_FILES),
     output:
-        expand(f"{FIGS}/behaviour{{suffix}}", suffix=["_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md"]),
+        update(expand(f"{FIGS}/behaviour{{suffix}}", suffix=["_episodes.csv", ".csv", ".md", "_claims.csv", "_claims.md"])),
     log:
         f"{RESULTS}/logs/report/behaviour.log",
     benchmark:
@@ -100,9 +100,9 @@ rule failures:
     input:
         ancient(TRACE_FILES),
     output:
-        csv=f"{FIGS}/failures.csv",
-        stuck=f"{FIGS}/failures_stuck.csv",
-        md=f"{FIGS}/failures.md",
+        csv=update(f"{FIGS}/failures.csv"),
+        stuck=update(f"{FIGS}/failures_stuck.csv"),
+        md=update(f"{FIGS}/failures.md"),
     log:
         f"{RESULTS}/logs/report/failures.log",
     params:
@@ -120,9 +120,9 @@ rule searches:
     input:
         ancient(SEARCH_TRACE_FILES),
     output:
-        [f"{FIGS}/searches/{v}_{home}_{placement}_h{height}.png"
-         for v in TRACE_VARIANTS for home in HOMES for placement, height in SEARCH_CELLS],
-        [f"{FIGS}/searches/gaze_{home}_{placement}_h{height}.png" for home in HOMES for placement, height in SEARCH_CELLS],
+        update([f"{FIGS}/searches/{v}_{home}_{placement}_h{height}.png"
+                for v in TRACE_VARIANTS for home in HOMES for placement, height in SEARCH_CELLS]),
+        update([f"{FIGS}/searches/gaze_{home}_{placement}_h{height}.png" for home in HOMES for placement, height in SEARCH_CELLS]),
     log:
         f"{RESULTS}/logs/report/searches.log",
     params:

@@ -3,8 +3,8 @@ rule train:
     CSVs, which Snakemake does not delete when it reruns a killed job), resumes there if killed, and
     publishes the outputs only when the run is complete."""
     output:
-        actor="results/{profile}/train/{variant}/seed{seed}/actor.pt",
-        curve="results/{profile}/train/{variant}/seed{seed}/curve.csv",
+        actor=update("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
+        curve=update("results/{profile}/train/{variant}/seed{seed}/curve.csv"),
     log:
         "results/{profile}/logs/train/{variant}/seed{seed}.log",
     benchmark:
