@@ -180,7 +180,7 @@ def test_what_cannot_be_stacked_is_refused():
         StackedSacCurl([curl_agent(0), curl_agent(1, critic_hidden_dim=32)], streams)
     with pytest.raises(StackingError, match="algorithm ppo is not stacked; stacked: sac_curl, sac_drq"):
         check_stackable(dataclasses.replace(load_config("smoke"), algorithm="ppo"))
-    with pytest.raises(StackingError, match="reconstruction decoder"):
+    with pytest.raises(StackingError, match="encoder_aux_loss=.reconstruction.: the stacked SacDrqAgent update"):
         check_stackable(load_config("cpu", {"encoder_aux_loss": "reconstruction"}))
     with pytest.raises(StackingError, match="share_encoder_forward"):
         StackedSacCurl([curl_agent(0, share_encoder_forward=True), curl_agent(1, share_encoder_forward=True)],
@@ -240,3 +240,40 @@ def test_the_stacked_update_recorded_as_cuda_graphs_equals_the_eager_one():
     assert graphed.graphed.captures == 2
     for name, tensor in eager.params.items():
         assert torch.allclose(graphed.params[name], tensor, rtol=1e-3, atol=1e-4), name
+
+
+def _changed(value):
+    """A value other than ``value`` of the same kind (what refusal compares; never validated here)."""
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, (int, float)):
+        return value * 2 + 1
+    return f"{value}_other"
+
+
+@pytest.mark.parametrize("algorithm", ["sac_drq", "sac_curl"])
+def test_stacked_seeds_refuse_every_field_their_update_does_not_implement(algorithm):
+    """Every field a learner's update may read is either done by the stacked update (its ``implemented`` list,
+    whose names are all the config's) or refused in one line when set away from its default, and a field added to
+    the learner's settings is refused until the stacked update implements it: stacked seeds never train without a
+    field their learner reads."""
+    from egosearch.rl.registry import learner
+    from egosearch.rl.stacked import STACKED, update_fields
+
+    cfg = load_config("cpu" if algorithm == "sac_drq" else "paper", {"algorithm": algorithm})
+    kind = STACKED[learner(algorithm).agent_factory()]
+    names = {f.name for f in update_fields(cfg)}
+    assert kind.implemented <= names, sorted(kind.implemented - names)
+    check_stackable(cfg)  # the profile itself stacks
+    for f in update_fields(cfg):
+        if f.name in kind.implemented:
+            continue
+        default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+        with pytest.raises(StackingError, match=rf"^{f.name}=.*does not implement it"):
+            check_stackable(dataclasses.replace(cfg, **{f.name: _changed(default)}))
+    # a new field of the learner's update (a critic gradient-clip norm, say) is refused until implemented
+    grown = dataclasses.make_dataclass("Grown", [("critic_grad_clip", float, dataclasses.field(default=0.0))],
+                                       bases=(type(cfg),))
+    with pytest.raises(StackingError, match="^critic_grad_clip=1.0"):
+        check_stackable(grown(**{**dataclasses.asdict(cfg), "critic_grad_clip": 1.0}))
+    check_stackable(grown(**dataclasses.asdict(cfg)))  # at its default it changes nothing

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import dataclasses
 import random
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -52,7 +53,9 @@ from torch.func import functional_call, vmap
 
 from egosearch.rl.common import METRIC_KEYS, crop_at, submodule
 from egosearch.rl.cuda_graph import GraphedUpdate
+from egosearch.rl.network_settings import NetworkSettings, SacSettings
 from egosearch.rl.registry import learner, stacked_algorithms
+from egosearch.rl.run_settings import RunSettings
 from egosearch.rl.sac_curl import (
     SacCurlAgent,
     crop_offsets,
@@ -140,6 +143,17 @@ def check_stackable(cfg: Any) -> None:
         raise StackingError(refusal)
 
 
+def update_fields(cfg: Any) -> list[dataclasses.Field]:
+    """The fields of a learner config that its update may read: all but the run settings (the training loop's:
+    steps, envs, evaluation, checkpoints) and the algorithm's name."""
+    run = {f.name for f in dataclasses.fields(RunSettings)}
+    return [f for f in dataclasses.fields(cfg) if f.name not in run and f.name != "algorithm"]
+
+
+NETWORK_FIELDS = frozenset(f.name for f in dataclasses.fields(NetworkSettings))
+SAC_FIELDS = frozenset(f.name for f in dataclasses.fields(SacSettings))
+
+
 # ---- stacked parameters -------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -190,10 +204,22 @@ class StackedAgents:
     paths: ClassVar[tuple[str, ...]]
     draw_keys: ClassVar[tuple[str, ...]]
     """The keys :meth:`draw` returns (always all of them: a recorded update needs fixed inputs)."""
+    implemented: ClassVar[frozenset[str]]
+    """The learner's config fields (all but the run settings, which the training loop reads) that the stacked
+    update does as the learner's own update does. Any other field set away from its default is refused
+    (:meth:`refusal`): a field added to the learner's update is not silently dropped by stacked seeds; it joins
+    this list once the stacked update does it too (tests/test_rl_stacked.py holds the list to the config)."""
 
     @classmethod
     def refusal(cls, cfg: Any) -> str | None:
-        """Why a config of this learner cannot be stacked (an option the stacked update lacks), or None."""
+        """Why a config of this learner cannot be stacked (a field the stacked update does not implement, set away
+        from its default), or None."""
+        for f in update_fields(cfg):
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            value = getattr(cfg, f.name)
+            if f.name not in cls.implemented and value != default:
+                return (f"{f.name}={value!r}: the stacked {cls.member_type.__name__} update does not implement it "
+                        "(egosearch.rl.stacked); train these seeds one by one, without --stack-seeds")
         return None
 
     def __init__(self, members: list[Any], streams: SeedStreams):
@@ -370,12 +396,15 @@ class StackedSacCurl(StackedAgents):
     paths = ("critic.convs", "critic.proj", "critic.q1", "critic.q2", "critic_target.convs",
              "critic_target.proj", "critic_target.q1", "critic_target.q2", "actor")
     draw_keys = ("anchor_oy", "anchor_ox", "next_oy", "next_ox", "pos_oy", "pos_ox", "noise_next", "noise_pi")
+    implemented = frozenset(NETWORK_FIELDS | SAC_FIELDS | {"crop_size", "encoder_tau", "encoder_beta1",
+                                                           "encoder_beta2", "curl_latent", "curl_double_encoder_step",
+                                                           "curl_update_freq", "contact_signal", "strided_history"})
 
     @classmethod
     def refusal(cls, cfg: Any) -> str | None:
-        if cfg.share_encoder_forward or cfg.compile:
-            return "SAC+CURL with share_encoder_forward or compile is not stacked"
-        return None
+        if cfg.compile:
+            return "SAC+CURL with compile is not stacked"
+        return super().refusal(cfg)  # share_encoder_forward among the fields it does not implement
 
     def __init__(self, members: list[SacCurlAgent], streams: SeedStreams):
         if any(getattr(m, "impl", "fast") != "fast" for m in members):
@@ -467,12 +496,12 @@ class StackedSacDrq(StackedAgents):
     member_type = SacDrqAgent
     paths = ("encoder", "critic", "critic_target", "actor")
     draw_keys = ("obs_oy", "obs_ox", "next_oy", "next_ox", "noise_next", "noise_pi")
-
-    @classmethod
-    def refusal(cls, cfg: Any) -> str | None:
-        if cfg.encoder_aux_loss != "none":
-            return "SAC-DrQ's reconstruction decoder (encoder_aux_loss) is not stacked"
-        return None
+    # not encoder_aux_loss / encoder_aux_weight (SAC-AE's decoder) nor map_image (its map readers)
+    implemented = frozenset(NETWORK_FIELDS | SAC_FIELDS | {
+        "obs_downsample", "encoder_stride2_layers", "aug_pad", "critic_layer_norm", "critic_privileged_state",
+        "demo_episodes", "demo_teacher", "bc_updates", "dagger_rounds", "dagger_episodes", "dagger_states",
+        "critic_warmup_updates", "demo_batch_fraction", "bc_weight", "bc_decay_steps", "bc_weight_floor",
+        "contact_signal", "strided_history"})
 
     def __init__(self, members: list[SacDrqAgent], streams: SeedStreams):
         super().__init__(members, streams)
