@@ -73,23 +73,44 @@ def test_the_test_by_hand():
     """docs/statistics.md, "By hand": HAND's three seeds are the reference and its spread seeds, their means
     3/4, 3/4, 1/4 (mean 7/12): the sum of squares 2 (1/6)^2 + (1/3)^2 = 1/6 over 2 df, s2 = 1/12.
 
-    One candidate seed of mean 3/4: D = 1/6, V = s2 (1 + 1/3) = 1/9 (se 1/3), read at 2 - 1 = 1 df.
-    Two candidate seeds of means 3/4 and 3/4: their own group adds 0 to the squares and 1 df, s2 = (1/6) / 3 =
-    1/18, V = (1/18)(1/2 + 1/3) = 5/108, 3 df."""
+    One candidate seed of mean 1: D = 5/12, V = s2 (1 + 1/3) = 1/9 (se 1/3), t = 5/4 on 2 df, its p taken 1.5
+    times and its interval at t(2, 1 - 0.05/3). Two candidate seeds of means 3/4 and 3/4: their own group adds
+    0 to the squares and 1 df, s2 = (1/6) / 3 = 1/18, V = (1/18)(1/2 + 1/3) = 5/108, 3 df, D = 1/6."""
     ref = HAND.mean(axis=0)
     every = np.ones(3, bool)
-    one = seed_spread_test([0.75], ref, ref, reference_in_spread=every)
-    assert one["difference"] == pytest.approx(1 / 6) and one["se"] == pytest.approx(1 / 3) and one["df"] == 1
-    assert one["ci_low"] == pytest.approx(1 / 6 - stats.t.ppf(0.975, 1) / 3)
-    assert one["p_uncorrected"] == pytest.approx(2 * stats.t.sf(0.5, 1))
+    one = seed_spread_test([1.0], ref, ref, reference_in_spread=every)
+    assert one["difference"] == pytest.approx(5 / 12) and one["se"] == pytest.approx(1 / 3) and one["df"] == 2
+    assert one["p_uncorrected"] == pytest.approx(1.5 * 2 * stats.t.sf(1.25, 2))
+    assert one["ci_low"] == pytest.approx(5 / 12 - stats.t.ppf(1 - 0.05 / 3, 2) / 3)
     assert one["seed_sd"] == pytest.approx(math.sqrt(1 / 12))
-    assert one["detectable_80"] == pytest.approx(power_multiplier(1) / 3)
-    # the plain prediction interval, the calibration's comparison: the spread seeds' full 2 df
-    assert seed_spread_test([0.75], ref, ref, reference_in_spread=every, one_seed_tail=False)["df"] == 2
+    assert one["detectable_80"] == pytest.approx(power_multiplier(2, 0.05 / 1.5) / 3)
+    # the plain prediction interval, the calibration's comparison
+    plain = seed_spread_test([1.0], ref, ref, reference_in_spread=every, one_seed_tail=False)
+    assert plain["p_uncorrected"] == pytest.approx(2 * stats.t.sf(1.25, 2))
+    assert plain["ci_low"] == pytest.approx(5 / 12 - stats.t.ppf(0.975, 2) / 3)
     two = seed_spread_test([0.75, 0.75], ref, ref, reference_in_spread=every)
     se = math.sqrt(5 / 108)
     assert two["df"] == 3 and two["se"] == pytest.approx(se)
     assert two["ci_high"] == pytest.approx(1 / 6 + stats.t.ppf(0.975, 3) * se)
+    assert two["p_uncorrected"] == pytest.approx(2 * stats.t.sf((1 / 6) / se, 3))
+    # equal seed means everywhere: no spread to read, no verdict
+    flat = seed_spread_test([0.9], [0.5, 0.5], [0.5, 0.5], reference_in_spread=[True, True])
+    assert flat["p_uncorrected"] == 1.0 and np.isnan(flat["ci_low"])
+
+
+def test_the_one_seed_factor_holds_the_claim_for_a_seed_mean_that_is_all_t3_seed_effect():
+    """Why a one-seed candidate's p is taken 1.5 times: one seed's mean drawn from a t(3) (no scenario noise to
+    thin its tail), 3 to 10 spread seeds. The plain prediction interval calls more than the 0.06 claim; with the
+    factor it stays at or below it."""
+    rng = np.random.default_rng(14)
+    for k in (3, 5, 8, 10):
+        x = stats.t.rvs(3, size=(200_000, k + 1), random_state=rng)
+        ref, cand = x[:, :k], x[:, k:]
+        kwargs = {"reference_in_spread": np.ones(k, bool)}
+        assert (seed_spread_test(cand, ref, ref, **kwargs)["p_uncorrected"] < 0.05).mean() <= LEVEL_CLAIM
+        if k >= 5:
+            plain = seed_spread_test(cand, ref, ref, one_seed_tail=False, **kwargs)["p_uncorrected"]
+            assert (plain < 0.05).mean() > LEVEL_CLAIM
 
 
 def test_one_estimate_is_counted_once_whatever_holds_it():
@@ -238,9 +259,9 @@ def test_the_simulated_level_holds_at_the_claim_and_the_simulation_can_fail():
     assert len(table) == 2 * 2 * 2 * 3 and (table["cell_tests"] == 3000 * 6).all()
     assert table["rate"].max() <= LEVEL_CLAIM, table.to_string()
     assert worst_setting(table)["rate"] == table["rate"].max()
-    # heavy-tailed seeds: one seed read at its spread seeds' full df calls more than at one fewer
+    # heavy-tailed seeds: one seed's plain prediction interval calls more than with its p taken 1.5 times
     one = table[(table["n_candidate"] == 1) & (table["law"] == "t3")]
-    assert (one["rate_without_one_seed_degree"] > one["rate"]).all()
+    assert (one["rate_without_one_seed_factor"] > one["rate"]).all()
     wide = false_positive_rates(matrices, **kwargs, laws=("normal",), truths=("per cell",), sd_scale=2.0)
     assert (wide.loc[wide["n_candidate"] == 1, "rate"] > LEVEL_CLAIM).all() and not level_holds(wide)
 
@@ -377,15 +398,21 @@ STORED_NULL = REPO / "results/cpu/compare/null_screen_head_on.csv"
 
 
 @pytest.mark.skipif(not STORED_NULL.exists(), reason="needs the stored null screen (snakemake seed_spread)")
-def test_the_stored_reference_does_not_differ_from_itself():
+def test_the_stored_reference_is_consistent_with_itself():
     """Every seed of the stored head_on screened against each other seed and against the rest, the spread from
-    the seeds on neither side: no cell differs after Holm."""
+    the seeds on neither side: far fewer cells called different than the scenarios alone call, and no more
+    screens with a call after Holm than a 5% level explains (it is a consistency check: 5 seeds, shared)."""
     df = pd.read_csv(STORED_NULL)
-    assert not df["verdict"].isin(["lower", "higher"]).any()
-    assert (df["p_holm"] >= 0.05).all()
+    success = df[df["metric"] == "success"]
+    called = ("lower", "higher")
+    assert success["verdict"].isin(called).sum() < success["scenarios_verdict"].isin(called).sum() / 4
+    screens_calling = df.groupby("screen")["verdict"].apply(lambda v: v.isin(called).any())
+    assert screens_calling.sum() <= max(1, 0.1 * len(screens_calling))
     assert df["candidate_seed"].nunique() >= 5
     for row in df.itertuples():
         assert str(row.candidate_seed) not in str(row.spread_seeds).split("+")
+        if len(str(row.reference_seeds).split("+")) == 1:
+            assert str(row.reference_seeds) not in str(row.spread_seeds).split("+")
 
 
 STORED_SUMMARY = REPO / "results/cpu/compare/seed_spread_head_on.json"

@@ -40,8 +40,8 @@ from egosearch.report.seed_spread import seed_spread, seed_spread_test
 CANDIDATE_SEEDS = (1, 2, 3, 6)
 """The screens simulated: one and two seeds (the stored lever screens), three, and the default screen_seeds."""
 RHOS = (0.0, 0.5, 0.7, 0.9)
-"""How closely one seed's shifts move together between cells: the stored seed means correlate about 0.7 between
-cells, and five seeds cannot say it more precisely."""
+"""How closely one seed's shifts move together between cells: the stored record says how closely the stored seed
+means correlate (:func:`~egosearch.report.null_screen.cell_correlation`), and five seeds cannot say it precisely."""
 LAWS = ("normal", "t3")
 TRUTHS = ("per cell", "pooled")
 LEVEL_CLAIM = 0.06
@@ -50,13 +50,12 @@ SIMULATIONS = 20_000
 """Simulated screens per setting in the stored record: 120,000 cell tests, a rate's standard error about 0.001."""
 
 CALIBRATION_COLUMNS = ("law", "truth", "rho", "n_candidate", "n_reference", "rate", "highest_cell_rate",
-                       "screens_any_after_holm", "rate_without_one_seed_degree",
-                       "highest_cell_rate_without_one_seed_degree", "cell_tests")
+                       "screens_any_after_holm", "rate_without_one_seed_factor",
+                       "highest_cell_rate_without_one_seed_factor", "cell_tests")
 """``rate``: the share of success cells called different at p < alpha (the test's level; every cell tested);
 ``highest_cell_rate``: the same in the cell where it is highest; ``screens_any_after_holm``: the share of screens
-with any cell different after Holm over their cells; ``rate_without_one_seed_degree`` and its highest cell: for
-one-seed screens, those of the plain prediction interval (the test read at ``df_s``, not ``df_s - 1``: why it
-takes one fewer)."""
+with any cell different after Holm over their cells; ``rate_without_one_seed_factor`` and its highest cell: for
+one-seed screens, those of the plain prediction interval (its p not taken 1.5 times: why it is)."""
 
 
 def scenario_probabilities(matrix: np.ndarray) -> np.ndarray:
@@ -130,8 +129,8 @@ def false_positive_rates(matrices: Mapping, n_sims: int = SIMULATIONS, seed: int
                          "rate": float(called.mean()), "highest_cell_rate": float(called.mean(axis=0).max()),
                          # Holm calls a cell only if its smallest p is below alpha / cells (its first step)
                          "screens_any_after_holm": float((p.min(axis=1) < alpha / len(cells)).mean()),
-                         "rate_without_one_seed_degree": plain,
-                         "highest_cell_rate_without_one_seed_degree": plain_highest, "cell_tests": int(called.size)})
+                         "rate_without_one_seed_factor": plain,
+                         "highest_cell_rate_without_one_seed_factor": plain_highest, "cell_tests": int(called.size)})
     return pd.DataFrame(rows, columns=list(CALIBRATION_COLUMNS))
 
 

@@ -22,7 +22,7 @@ import pandas as pd
 
 from egosearch.report.calibration import LEVEL_CLAIM, SIMULATIONS, false_positive_rates, level_holds, worst_setting
 from egosearch.report.data import parse_eval_path, read_episodes, sorted_cells
-from egosearch.report.seed_spread import power_multiplier, seed_spread, t_degrees_of_freedom
+from egosearch.report.seed_spread import power_multiplier, seed_spread, tail_factor
 from egosearch.report.stats import scenario_seed_matrix
 from egosearch.report.tables import compare_report
 
@@ -107,13 +107,14 @@ def detectable_difference(seed_sd: float, n_candidate: int, n_reference: int, al
     """The smallest true difference that a screen of ``n_candidate`` seeds against ``n_reference`` spread seeds
     detects with ``power`` (two-sided, level ``alpha``, before Holm) where one seed's cell mean spreads by
     ``seed_sd``: the test's ``(1/N_c + 1/N_r)`` standard error times the noncentral t's multiplier
-    (:func:`~egosearch.report.seed_spread.power_multiplier`) at its degrees of freedom, ``N_r - 1 + N_c - 1``
-    (one fewer for one candidate seed: :func:`~egosearch.report.seed_spread.t_degrees_of_freedom`), the
-    formula of a screen's ``detectable_80`` column."""
+    (:func:`~egosearch.report.seed_spread.power_multiplier`) at its ``N_r - 1 + N_c - 1`` degrees of freedom
+    and its level (``alpha`` over :func:`~egosearch.report.seed_spread.tail_factor`: a one-seed candidate's p is
+    taken 1.5 times), the formula of a screen's ``detectable_80`` column."""
     if n_candidate < 1 or n_reference < 2:
         raise ValueError("a screen needs 1 candidate seed or more and 2 reference seeds or more")
-    df = t_degrees_of_freedom(n_reference - 1 + n_candidate - 1, n_candidate)
-    return power_multiplier(df, alpha, power) * seed_sd * math.sqrt(1 / n_candidate + 1 / n_reference)
+    df = n_reference - 1 + n_candidate - 1
+    level = alpha / tail_factor(n_candidate)
+    return power_multiplier(df, level, power) * seed_sd * math.sqrt(1 / n_candidate + 1 / n_reference)
 
 
 def power_table(matrices: Mapping, seed_counts=(1, 2, 3, 6)) -> pd.DataFrame:

@@ -553,11 +553,10 @@ def block_seed_spread(root: Path, profile: str) -> str:
     lines += ["", f"The highest rate is {worst['rate']:.3f} ({'t (3 df)' if worst['law'] == 't3' else worst['law']} "
               f"seed effects, {worst['truth']} spread, ρ {worst['rho']:g}, N = {worst['n_candidate']}); the highest "
               f"cell's {rates['highest_cell_rate'].max():.3f}. Every setting and cell at or below "
-              f"{sm['level_claim']:g}: **{'yes' if sm['level_holds'] else 'no'}**. A one-seed screen read at its "
-              f"spread seeds' full degrees of freedom (the plain prediction interval) would call up to "
-              f"{plain['rate_without_one_seed_degree'].max():.3f} over the cells and "
-              f"{plain['highest_cell_rate_without_one_seed_degree'].max():.3f} in one cell: why it is read at one "
-              "fewer.", ""]
+              f"{sm['level_claim']:g}: **{'yes' if sm['level_holds'] else 'no'}**. A one-seed screen whose p were "
+              f"not taken 1.5 times (the plain prediction interval) would call up to "
+              f"{plain['rate_without_one_seed_factor'].max():.3f} over the cells and "
+              f"{plain['highest_cell_rate_without_one_seed_factor'].max():.3f} in one cell: why it is.", ""]
     power = pd.DataFrame(sm["detectable_80"])
     lines += [f"**Power**: the success difference the test detects with 80% power (5% level, before Holm) in a "
               f"screen of N candidate seeds against the {sm['n_seeds']} stored seeds, at each cell's stored spread "

@@ -18,6 +18,7 @@ from pathlib import Path
 import pandas as pd
 
 from egosearch.report.data import cells_from_paths
+from egosearch.report.seed_spread import SeedSpreadUnknown
 from egosearch.report.spread_sides import check_screen_inputs, is_trained
 from egosearch.report.tables import compare_report
 
@@ -75,8 +76,9 @@ def screen_seeds(name: str) -> tuple[re.Match, list[int]]:
 
 def reread_screens(compare_dir: Path, eval_dir: Path, out_csv=None, n_resamples: int = 10_000) -> pd.DataFrame:
     """Every stored screen (:data:`SCREEN_NAME`; ℓ, aggregate and stuck files left out) read again
-    (:data:`REREAD_COLUMNS`). ValueError, one line naming the screen, when its name asks for candidate seeds that
-    are not stored, or its inputs cannot be read together
+    (:data:`REREAD_COLUMNS`). A screen whose evaluation files are not stored, or whose spread has too few seeds
+    for the test, gets one row saying so. ValueError, one line naming the screen, when its name asks for
+    candidate seeds that are not stored, or its inputs cannot be read together
     (:func:`~egosearch.report.spread_sides.check_screen_inputs`)."""
     frames = []
     for path in sorted(Path(compare_dir).glob("screen_*.csv")):
@@ -112,6 +114,12 @@ def reread_screens(compare_dir: Path, eval_dir: Path, out_csv=None, n_resamples:
         try:
             check_screen_inputs(reference, candidate, spread)
             new = compare_report(reference, candidate, n_resamples=n_resamples, spread_files=spread)
+        except SeedSpreadUnknown as err:  # too few spread seeds for this screen: said in its row, the rest read
+            frames.append(pd.DataFrame([{"screen": path.stem, "candidate": m["cand"], "reference": m["ref"],
+                                         "candidate_seeds": _seeds_text(seeds), "spread_from": spread_variant,
+                                         "spread_seeds": _seeds_text(spread_seeds),
+                                         "verdict": f"not re-read: {str(err).split(': ')[-1]}"}]))
+            continue
         except ValueError as err:
             raise ValueError(f"{path.name}: {err}") from None
         frame = pd.DataFrame({

@@ -464,7 +464,7 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
             try:
                 res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed, spreads=spreads)
             except ValueError as e:
-                raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
+                raise type(e)(f"compare: cell {_cell_name(cell)}: {e}") from None
             homes = "+".join(sorted({_home_of(x) for x in ref["scenario_set"]}))
             rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res, "homes": homes})
     return holm_and_write(pd.DataFrame(rows), COMPARE_COLUMNS, out_csv)
