@@ -433,3 +433,16 @@ def test_the_stored_calibration_holds_its_claim_and_screen_seeds_is_its_recommen
     assert summary["level_claim"] == 0.06 and summary["level_holds"]
     assert rates["rate"].max() <= 0.06 and rates["highest_cell_rate"].max() <= 0.06
     assert summary["worst_setting"]["rate"] == rates["rate"].max()
+
+
+def test_a_spread_that_did_not_run_the_screens_scenarios_is_one_line(tmp_path):
+    rng = np.random.default_rng(15)
+    vectors = _seeds(rng, 60, [0.7] * 4)
+    ref = _cells_of(*(_write(tmp_path, "ref", s, vectors[s]) for s in range(3)))
+    cand = _cells_of(_write(tmp_path, "cand", 0, vectors[3]))
+    # the same variant's seeds on other scenarios (fewer of them): not the screen's sets
+    other_sets = _cells_of(*(_write(tmp_path / "other", "ref", s, vectors[s][:40]) for s in range(3)))
+    with pytest.raises(ValueError) as err:
+        compare_report(ref, cand, n_resamples=100, spread_files=other_sets)
+    assert "spread (ref) seeds were not all evaluated on these scenarios" in str(err.value)
+    assert "\n" not in str(err.value)
