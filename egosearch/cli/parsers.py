@@ -347,8 +347,8 @@ def add_report(sub) -> None:
     r.add_argument("--candidate", nargs="+", required=True, help="the candidate variant's evaluation CSVs")
     r.add_argument("--aggregate", help="also write the aggregate over seeds and cells (interquartile mean, "
                    "probability of improvement) to this CSV")
-    r.add_argument("--spread", nargs="+", help="every stored seed's evaluation CSVs of the reference variant: a side "
-                   "with fewer than 3 seeds (a screen) counts their seed variance (docs/statistics.md)")
+    r.add_argument("--spread", nargs="+", help="every stored seed's evaluation CSVs of the reference variant: a "
+                   "screen, read with the seed-spread test on their spread (docs/statistics.md)")
     r.add_argument("--out", help="write the comparison to this CSV (and the split by shortest path ℓ, every cell "
                                  "pooled, to <out stem>_by_length.csv) as well as printing them")
     add_force(r, "; also compares a candidate file with the same content as a reference file (refused without it: "
@@ -440,15 +440,17 @@ def add_report(sub) -> None:
     add_force(r)
 
     r = reports.add_parser("null-screen", help="the reference's seeds screened against each other, before and after "
-                                             "the seed spread counts; its summary (docs/statistics.md)")
+                                             "the seed spread counts (a consistency check, the spread held out); "
+                                             "its summary with the test's simulated level (docs/statistics.md)")
     r.add_argument("files", nargs="+", help="every spread seed's evaluation CSVs of one variant")
     r.add_argument("--out", required=True, help="the null screen's CSV")
     r.add_argument("--summary", required=True, help="the seed spread, false-positive rates and power, as JSON")
-    r.add_argument("--simulations", type=int, default=400, help="simulated null screens per setting (default 400)")
+    r.add_argument("--simulations", type=int, help="simulated screens per setting of the false-positive rate "
+                   "(default: the stored record's, egosearch.report.calibration.SIMULATIONS)")
     add_force(r)
 
-    r = reports.add_parser("reread-screens", help="every stored one-seed screen read again with the seed spread "
-                                                "counted, beside its old verdict (docs/ablations.md)")
+    r = reports.add_parser("reread-screens", help="every stored screen read again with the seed-spread test, beside "
+                                                "its stored verdict (docs/ablations.md)")
     r.add_argument("--profile", **profile)
     r.add_argument("--out", required=True, help="the re-read's CSV")
     add_force(r)

@@ -543,6 +543,7 @@ def _memory_window(args) -> None:
 def _null_screen(args) -> None:
     import json
 
+    from egosearch.report.calibration import SIMULATIONS
     from egosearch.report.data import cells_from_paths
     from egosearch.report.null_screen import null_screen, seed_spread_summary
 
@@ -550,16 +551,24 @@ def _null_screen(args) -> None:
     variants = _variants(args.files, parse_eval_path)
     if len(variants) != 1:
         raise ValueError(f"null-screen: the files are of {len(variants)} variants ({', '.join(variants)}); give one")
+    if args.simulations is not None and args.simulations < 1:
+        raise ValueError(f"--simulations={args.simulations}: must be 1 or more")
     # results/<profile>/eval/<variant>/seed<N>/<home>/<placement>/h<height>.csv
     results = Path(args.files[0]).resolve().parents[5]
     record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
-    summary = seed_spread_summary(files, record, variants[0], n_sims=args.simulations)  # first: it refuses < 2 seeds
+    summary = seed_spread_summary(files, record, variants[0], n_sims=args.simulations or SIMULATIONS)
     df = null_screen(files, args.out)
     called = df[(df["metric"] == "success")]
-    print(f"null screen of {variants[0]} ({summary['n_seeds']} seeds, {df['screen'].nunique()} screens): "
+    print(f"null screen of {variants[0]} ({summary['n_seeds']} seeds, {df['screen'].nunique()} screens, each pair's "
+          f"spread from the seeds on neither side: a consistency check): "
           f"{int((called['scenarios_verdict'].isin(['lower', 'higher'])).sum())} success cells called different "
           f"before the seed spread counted, {int(called['verdict'].isin(['lower', 'higher']).sum())} after; "
-          f"seed sd {summary['pooled_seed_sd']:.3f}; wrote {args.out}")
+          f"wrote {args.out}")
+    worst = summary["worst_setting"]
+    print(f"simulated false-positive rate of the screen's test ({summary['simulations']:,} screens per setting): "
+          f"highest {worst['rate']:.3f} ({worst['law']} seeds, {worst['truth']} spread, rho {worst['rho']:g}, "
+          f"{worst['n_candidate']} candidate seed(s)); every setting and cell at or below "
+          f"{summary['level_claim']:g}: {'yes' if summary['level_holds'] else 'NO'}")
     Path(args.summary).write_text(json.dumps(summary, indent=1, default=float) + "\n", encoding="utf-8")
     print(f"recommended screen_seeds: {summary['recommended_screen_seeds']} (detects "
           f"{summary['detectable_at_recommended']:.3f} at {summary['power_cell'][0]} m with 80% power; "

@@ -223,9 +223,10 @@ def print_screen_power(profile: str, reference: str, n_seeds: int) -> None:
         summary = json.loads(path.read_text(encoding="utf-8"))
         detectable = detectable_from_summary(summary, n_seeds)
         print(f"a screen of {n_seeds} seed(s) against {reference}'s {summary['n_seeds']} spread seeds detects a "
-              f"success difference of {detectable:.3f} at {POWER_CELL[0]} m with 80% power (seed sd "
-              f"{summary['pooled_seed_sd']:.3f}; the recommended screen_seeds={summary['recommended_screen_seeds']} "
-              f"detects {summary['detectable_at_recommended']:.3f}; {path})", file=sys.stderr)
+              f"success difference of {detectable:.3f} at {POWER_CELL[0]} m with 80% power (one seed's mean spreads "
+              f"by sd {summary['power_cell_seed_mean_sd']:.3f} there; the recommended "
+              f"screen_seeds={summary['recommended_screen_seeds']} detects {summary['detectable_at_recommended']:.3f}; "
+              f"{path})", file=sys.stderr)
     except (OSError, ValueError, KeyError) as err:
         print(f"(no power line: {path}: {err})", file=sys.stderr)
 

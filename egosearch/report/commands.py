@@ -17,8 +17,7 @@ from egosearch.report.data import cells_from_paths, group_eval_paths, output_bas
 from egosearch.report.figures import PLANNER_TITLES, figure6, figure7
 from egosearch.report.pathlength import by_length_path, compare_by_length, format_by_length, pathlength_report
 from egosearch.report.provenance import check_stored
-from egosearch.report.spread_sides import comparison_spreads
-from egosearch.report.stats import METRICS
+from egosearch.report.spread_sides import check_screen_inputs, comparison_spreads
 from egosearch.report.tables import (
     bound_names,
     compare_report,
@@ -104,7 +103,8 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
     Refuses (:class:`~egosearch.report.provenance.StoredFileError`) a stored file that differs from
     the sha256 its results folder's provenance recorded; files the record does not list (a new
     candidate's) are used as they are. ``spread_files``: every stored seed's files of the reference
-    variant, whose seed variance a side with too few seeds borrows (a screen; docs/statistics.md)."""
+    variant, whose spread a screen's test counts (docs/statistics.md); inputs that cannot be read together
+    are refused first, one line each (:func:`~egosearch.report.spread_sides.check_screen_inputs`)."""
     reference_list, candidate_list = (_flat(side.values()) if isinstance(side, Mapping) else list(side)
                                       for side in (reference_files, candidate_files))
     # A file on both sides (a variant compared with itself) gives differences of 0 that read as a result.
@@ -116,15 +116,17 @@ def cmd_compare(reference_files: Mapping | Iterable[PathLike], candidate_files: 
                          "different variants (is the candidate the reference itself?)")
     spread_list = [] if spread_files is None else (
         _flat(spread_files.values()) if isinstance(spread_files, Mapping) else list(spread_files))
-    check_stored([*reference_list, *candidate_list, *spread_list], require_record=False)
     if not isinstance(reference_files, Mapping):
         reference_files = cells_from_paths(reference_files)
     if not isinstance(candidate_files, Mapping):
         candidate_files = cells_from_paths(candidate_files)
     if spread_files is not None and not isinstance(spread_files, Mapping):
         spread_files = cells_from_paths(spread_files)
+    if spread_files is not None:  # from the paths alone, before a file is read
+        check_screen_inputs(reference_files, candidate_files, spread_files)
+    check_stored([*reference_list, *candidate_list, *spread_list], require_record=False)
     # the seed spreads first: a screen against a one-seed reference is refused before any table is drawn
-    spreads = {m: comparison_spreads(reference_files, candidate_files, spread_files, m) for m in METRICS}
+    spreads = comparison_spreads(reference_files, candidate_files, spread_files)
     df = compare_report(reference_files, candidate_files, out_csv, spread_files=spread_files)
     print(format_compare(df, reference_name, candidate_name))
     if out_csv is not None:

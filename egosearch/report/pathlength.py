@@ -315,7 +315,7 @@ def _pooled(files: Mapping | Iterable[PathLike]) -> pd.DataFrame:
 
 def compare_by_length(reference_files: Mapping | Iterable[PathLike], candidate_files: Mapping | Iterable[PathLike],
                       out_csv: PathLike | None = None, metrics: Iterable[str] = METRICS, n_resamples: int = 10_000,
-                      seed: int = 0, spreads: Mapping | None = None) -> pd.DataFrame:
+                      seed: int = 0, spreads=None) -> pd.DataFrame:
     """Candidate − reference per ℓ bin (:data:`LENGTH_BINS`) and metric, every evaluated cell pooled.
 
     Each side: ``{cell: [paths]}`` (as ``compare_report`` takes) or a flat list of one variant's evaluation
@@ -323,8 +323,8 @@ def compare_by_length(reference_files: Mapping | Iterable[PathLike], candidate_f
     :func:`~egosearch.report.stats.compare_cells` on the bin's scenarios: seed-averaged difference, paired
     two-level bootstrap interval (the bin's scenarios, then each side's seeds) and the p-value read from
     the same draws; Holm over this table's rows. Bins without scenarios are left out. Columns :data:`BY_LENGTH_COLUMNS`;
-    written to ``out_csv`` when given. ``spreads``: ``{metric: (reference's, candidate's) SeedSpread}`` of
-    the cells (:func:`~egosearch.report.seed_spread.comparison_spreads`), which a screen's bins count as its
+    written to ``out_csv`` when given. ``spreads``: the seeds whose spread a screen counts, of every cell
+    (:func:`~egosearch.report.spread_sides.comparison_spreads`), which a screen's bins count as its
     cells do. ValueError when the two sides disagree on a scenario's ℓ."""
     ref, cand = _pooled(reference_files), _pooled(candidate_files)
     keys = ["scenario_set", "scenario_id"]
@@ -344,7 +344,7 @@ def compare_by_length(reference_files: Mapping | Iterable[PathLike], candidate_f
         for metric in metrics:
             try:
                 res = compare_cells(r, c, metric, n_resamples=n_resamples, seed=seed,
-                                    spreads=(spreads or {}).get(metric))
+                                    spreads=spreads)
             except ValueError as e:
                 raise ValueError(f"compare: ℓ bin {label} m: {e}") from None
             rows.append({"length_bin": label, "length_low": LENGTH_BINS[i], "length_high": LENGTH_BINS[i + 1],

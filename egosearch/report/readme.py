@@ -555,8 +555,8 @@ def _reference(root: Path) -> str:
 
 
 def block_seed_spread(root: Path, profile: str) -> str:
-    """The reference's seed spread, its null screen before and after the spread counts, the simulated
-    false-positive rates and the difference a screen of N seeds detects (``snakemake seed_spread``)."""
+    """The reference's seed spread, its null screen before and after the spread counts, the screen's test's
+    simulated false-positive rates and the difference a screen of N seeds detects (``snakemake seed_spread``)."""
     reference = _reference(root)
     folder = root / "results" / profile / "compare"
     summary_path, null_path = folder / f"seed_spread_{reference}.json", folder / f"null_screen_{reference}.csv"
@@ -568,31 +568,52 @@ def block_seed_spread(root: Path, profile: str) -> str:
     called = ("lower", "higher")
     pairs = succ[~succ["screen"].str.endswith("the_others")]
     rest = succ[succ["screen"].str.endswith("the_others")]
-    lines = [f"`{reference}`, {sm['n_seeds']} seeds ({', '.join(map(str, sm['seeds']))}), both homes, 400 scenarios "
-             f"per cell. Seed spread per cell (sd between training seeds, the scenarios' part removed; the part the "
-             "scenarios alone explain beside it):", "",
-             "| height | placement | seed sd | scenarios' part of a seed's mean (sd) |", "|---|---|---|---|"]
-    lines += [f"| {c['height']:g} | {c['placement']} | {c['seed_sd']:.3f} | {c['scenario_part_sd']:.3f} |"
-              for c in sm["cells"]]
-    lines += ["", f"Pooled over the cells: **sd {sm['pooled_seed_sd']:.3f}** with {sm['pooled_df']} degrees of "
-              "freedom, what every screen of this reference counts.", "",
-              f"**The null screen** (`{null_path.relative_to(root)}`): each seed screened as a candidate against each "
-              "other seed (the one-seed screen's form) and against the rest, success cells:", "",
-              "| screens | cells | called different, scenarios only (before) | called different, seed spread "
-              "counted (now) |", "|---|---|---|---|",
+    lines = [f"`{reference}`, {sm['n_seeds']} seeds ({', '.join(map(str, sm['seeds']))}), both homes, "
+             f"{sm['n_scenarios']} scenarios per cell. Per cell, the spread of one "
+             "seed's cell mean, what a screen's test counts, and its split: the seeds' own part and the part the "
+             "scenarios' draw alone explains:", "",
+             "| height | placement | one seed's mean (sd): the test's | seeds' own part (sd) | scenarios' part (sd) |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {c['height']:g} | {c['placement']} | {c['seed_mean_sd']:.3f} | {c['seed_sd']:.3f} | "
+              f"{c['scenario_part_sd']:.3f} |" for c in sm["cells"]]
+    held_out = pairs["spread_seeds"].astype(str).str.count(r"\+").max() + 1 if len(pairs) else 0
+    lines += ["", f"A seed's means correlate {sm['cell_correlation']:.2f} between cells on average.", "",
+              f"**The null screen, a consistency check** (`{null_path.relative_to(root)}`): each seed screened as a "
+              "candidate against each other seed and against the rest, the spread estimated from the seeds on "
+              f"neither side ({held_out} for a pair). So few seeds, shared by the screens, make it no calibration "
+              "(the simulation below is one); success cells:", "",
+              "| screens | cells | called different, scenarios only (before) | called different, seed-spread test "
+              "(now) |", "|---|---|---|---|",
               f"| one seed against another seed | {len(pairs)} | {int(pairs['scenarios_verdict'].isin(called).sum())} "
               f"| {int(pairs['verdict'].isin(called).sum())} |",
               f"| one seed against the rest | {len(rest)} | {int(rest['scenarios_verdict'].isin(called).sum())} | "
-              f"{int(rest['verdict'].isin(called).sum())} |", "",
-              f"**Simulated false-positive rate** ({sm['simulations']} simulated null screens per row, every cell "
-              f"tested at p < {sm['alpha']} before Holm; seeds drawn from the model fitted to the stored episodes, "
-              "their shift correlated ρ between cells):", "",
-              "| reference seeds | ρ | scenarios only | seed spread counted |", "|---|---|---|---|"]
-    lines += [f"| {f['n_reference']} | {f['rho']:g} | {f['scenarios_only']:.3f} | {f['seed_spread']:.3f} |"
-              for f in sm["false_positive_rate"]]
+              f"{int(rest['verdict'].isin(called).sum())} |", ""]
+    rates = pd.DataFrame(sm["false_positive_rate"])
+    counts = sorted(rates["n_candidate"].unique())
+    lines += [f"**The test's level, simulated** (`egosearch.report.calibration`): {sm['simulations']:,} screens per "
+              f"setting, the candidate the reference's own config, seeds drawn from the model fitted to the stored "
+              f"episodes; the share of success cells called different at p < {sm['alpha']} before Holm, over every "
+              "cell (and in the cell where it is highest), for screens of N candidate seeds against the "
+              f"{sm['n_seeds']} stored:", "",
+              "| seed effects | spread truth | ρ | " + " | ".join(f"N = {n}" for n in counts) + " |",
+              "|---|---|---|" + "---|" * len(counts)]
+    for (law, truth, rho), g in rates.groupby(["law", "truth", "rho"], sort=False):
+        g = g.set_index("n_candidate")
+        lines.append(f"| {'t (3 df)' if law == 't3' else law} | {truth} | {rho:g} | " + " | ".join(
+            f"{g.loc[n, 'rate']:.3f} ({g.loc[n, 'highest_cell_rate']:.3f})" for n in counts) + " |")
+    worst = sm["worst_setting"]
+    plain = rates[rates["n_candidate"] == 1]
+    lines += ["", f"The highest rate is {worst['rate']:.3f} ({'t (3 df)' if worst['law'] == 't3' else worst['law']} "
+              f"seed effects, {worst['truth']} spread, ρ {worst['rho']:g}, N = {worst['n_candidate']}); the highest "
+              f"cell's {rates['highest_cell_rate'].max():.3f}. Every setting and cell at or below "
+              f"{sm['level_claim']:g}: **{'yes' if sm['level_holds'] else 'no'}**. A one-seed screen whose p were "
+              f"not taken 1.5 times (the plain prediction interval) would call up to "
+              f"{plain['rate_without_one_seed_factor'].max():.3f} over the cells and "
+              f"{plain['highest_cell_rate_without_one_seed_factor'].max():.3f} in one cell: why it is.", ""]
     power = pd.DataFrame(sm["detectable_80"])
-    lines += ["", f"**Power**: the success difference a screen of N candidate seeds detects with 80% power (5% level, "
-              f"before Holm) against the {sm['n_seeds']} stored seeds:", "",
+    lines += [f"**Power**: the success difference the test detects with 80% power (5% level, before Holm) in a "
+              f"screen of N candidate seeds against the {sm['n_seeds']} stored seeds, at each cell's stored spread "
+              "(the formula of a screen's `detectable_80`):", "",
               "| height | placement | " + " | ".join(f"N = {n}" for n in sorted(power["n_candidate"].unique())) + " |",
               "|---|---|" + "---|" * power["n_candidate"].nunique()]
     for (h, pl), g in power.groupby(["height", "placement"], sort=False):
@@ -629,24 +650,37 @@ def _called_cells(rows: pd.DataFrame, column: str) -> str:
     return ", ".join(picked) or "none"
 
 
+def _reread_conclusion(before: list[str], now: list[str]) -> str:
+    if before == now:
+        return "unchanged"
+    if not now:
+        return "within the seed spread now"
+    if not before:
+        return "called different now"
+    return "fewer cells" if set(now) < set(before) else "other cells"
+
+
 def block_screens_reread(root: Path, profile: str) -> str:
-    """Every stored one-seed screen, its old verdict and the one that counts the seed spread."""
+    """Every stored screen, its stored verdict and the seed-spread test's (``screens_reread.csv``)."""
     path = root / "results" / profile / "compare" / "screens_reread.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
-    lines = ["| screen (candidate vs reference) | spread counted | called different before (success cells) "
-             "| called different now | conclusion |", "|---|---|---|---|---|"]
+    lines = ["| screen (candidate vs reference) | seeds (candidate / reference) | spread counted | stored test "
+             "| called different as stored (success cells) | called different now | conclusion |",
+             "|---|---|---|---|---|---|---|"]
     for screen, g in df.groupby("screen", sort=True):
         if g["metric"].isna().all():
-            lines.append(f"| `{screen}` | | | | {g['verdict'].iloc[0]} |")
+            lines.append(f"| `{screen}` | | | | | | {g['verdict'].iloc[0]} |")
             continue
         s = g[g["metric"] == "success"]
         before, now = _called_cells(s, "old_verdict"), _called_cells(s, "verdict")
-        changed = "unchanged" if before == now else (
-            "within the seed spread now" if now == "none" else "fewer cells")
-        spread = f"{s['spread_from'].iloc[0]} ({s['spread_seeds'].iloc[0]})"
-        lines.append(f"| `{screen}` | {spread} | {before} | {now} | {changed} |")
+        conclusion = _reread_conclusion([] if before == "none" else before.split(", "),
+                                        [] if now == "none" else now.split(", "))
+        first = s.iloc[0]
+        lines.append(f"| `{screen}` | {first['candidate_seeds']} / {first['reference_seeds']} | "
+                     f"{first['spread_from']} ({first['spread_seeds']}) | {first['old_method']} | {before} | {now} | "
+                     f"{conclusion} |")
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}` (`snakemake seed_spread`).\n"
 
 

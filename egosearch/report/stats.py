@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from egosearch.report.seed_spread import SCENARIOS_ONLY, compare_with_seed_spread
+from egosearch.report.seed_spread import SCENARIOS_ONLY, SpreadSeeds, compare_on_seed_spread
 
 METRICS = ("success", "spl")
 
@@ -266,7 +266,7 @@ def paired_scenarios(reference: pd.DataFrame, candidate: pd.DataFrame, metric: s
 
 def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str = "success",
                   confidence: float = 0.95, n_resamples: int = 10_000, seed: int = 0,
-                  spreads: tuple | None = None) -> dict:
+                  spreads: SpreadSeeds | str | None = None) -> dict:
     """Candidate − reference in the mean of ``metric`` (``success`` or ``spl``) on one evaluation cell.
 
     Both frames hold per-episode rows with ``scenario_id``, ``seed`` and the metric (and optionally
@@ -304,14 +304,17 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
        uncorrected, from the draws' standard deviation (:func:`detectable_from_se`; normal
        approximation), so that it counts the seeds' spread as the test does.
 
-    ``spreads``: ``(reference's, candidate's)`` :class:`~egosearch.report.seed_spread.SeedSpread`, given
-    when a side has too few seeds to show its own spread (a screen): then steps 2-5 are
-    :func:`~egosearch.report.seed_spread.compare_with_seed_spread`'s instead, a t interval and p whose
-    variance adds each side's seed variance to the scenarios' (docs/statistics.md, "Seed spread"), and
-    ``method`` says ``seed spread``; otherwise it says ``bootstrap``.
+    ``spreads``: the seeds whose spread a screen counts
+    (:class:`~egosearch.report.seed_spread.SpreadSeeds`, from
+    :func:`~egosearch.report.spread_sides.comparison_spreads`): then steps 2-5 are
+    :func:`~egosearch.report.seed_spread.seed_spread_test`'s instead, a t interval and p on the seeds' cell
+    means, each side's and the spread seeds' (docs/statistics.md, "Seed spread"), and ``method`` says
+    ``seed spread``; :data:`~egosearch.report.seed_spread.SCENARIOS_ONLY`: the bootstrap, marked so; otherwise
+    ``method`` says ``bootstrap``.
 
     Returns ``{reference, candidate, difference, ci_low, ci_high, p_uncorrected, n_scenarios,
-    n_seeds_ref, n_seeds_cand, detectable_80, method}``.
+    n_seeds_ref, n_seeds_cand, detectable_80, seed_sd, method}`` (``seed_sd``: the spread of one seed's cell
+    mean that the seed-spread test counted; nan otherwise).
     """
     if metric not in (*METRICS, "stuck"):
         raise ValueError(f"metric={metric!r}; allowed: {', '.join((*METRICS, 'stuck'))}")
@@ -321,20 +324,15 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
     diff = float(d.mean())
     common = {"reference": float(r.mean()), "candidate": float(c.mean()), "n_scenarios": int(d.size),
               "n_seeds_ref": n_ref, "n_seeds_cand": n_cand}
-    if spreads == SCENARIOS_ONLY:
+    if isinstance(spreads, str) and spreads == SCENARIOS_ONLY:
         spreads = None
         method = "scenarios only"
     else:
         method = "bootstrap"
-    if spreads is not None and d.size >= 2:
-        try:
-            ref_m, _ = scenario_seed_matrix(reference, metric)
-            cand_m, _ = scenario_seed_matrix(candidate, metric)
-        except ValueError:  # a seed lacks a scenario: the seed-averaged scenarios, one column a side
-            ref_m, cand_m = r[:, None], c[:, None]
-        res = compare_with_seed_spread(ref_m, cand_m, spreads[0], spreads[1], confidence)
+    if isinstance(spreads, SpreadSeeds) and d.size >= 2:
+        res = compare_on_seed_spread(reference, candidate, metric, spreads, confidence)
         return {**common, **{k: res[k] for k in ("difference", "ci_low", "ci_high", "p_uncorrected",
-                                                   "detectable_80")}, "method": "seed spread"}
+                                                   "detectable_80", "seed_sd")}, "method": "seed spread"}
     if d.size < 2:
         lo = hi = detectable = math.nan
         p = 1.0
@@ -355,7 +353,7 @@ def compare_cells(reference: pd.DataFrame, candidate: pd.DataFrame, metric: str 
             p = percentile_p_value(draws)
             detectable = detectable_from_se(float(draws.std(ddof=1)))
     return {**common, "difference": diff, "ci_low": lo, "ci_high": hi, "p_uncorrected": p,
-            "detectable_80": detectable, "method": method}
+            "detectable_80": detectable, "seed_sd": math.nan, "method": method}
 
 
 def holm(p_values) -> np.ndarray:

@@ -394,10 +394,11 @@ COMPARE_COLUMNS = ("height", "placement", "metric", "reference", "candidate", "d
 Holm's adjustment over every row of the file: the only column that says whether a difference is
 significant (never true while the interval holds 0, since Holm only raises p). ``detectable_80``: the
 true difference the cell's test would detect with 80% power (uncorrected), seeds counted; ``homes``:
-the homes whose scenarios the cell pools. ``method``: ``bootstrap`` (each side shows its own seeds' spread:
-the two-level bootstrap) or ``seed spread`` (a side has too few seeds, so the reference variant's seed
-variance is added: :mod:`egosearch.report.seed_spread`); ``seed_sd``: the standard deviation between
-training seeds counted then (blank for the bootstrap); ``verdict``: ``higher`` or ``lower`` when
+the homes whose scenarios the cell pools. ``method``: ``seed spread`` (a screen, or a side with too few seeds
+to show its own spread: the t-test on the seeds' cell means of :mod:`egosearch.report.seed_spread`, its
+interval, p and ``detectable_80`` that test's) or ``bootstrap`` (not a screen, every trained side with 3 seeds
+or more: the two-level bootstrap); ``seed_sd``: the standard deviation of one training seed's cell mean that
+the seed-spread test counted (blank for the bootstrap); ``verdict``: ``higher`` or ``lower`` when
 significant after Holm, else ``within the reference's seed spread`` (seed spread) or ``no difference
 detected`` (bootstrap)."""
 
@@ -433,8 +434,8 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
     path (``.../seed{N}/{layout}/{placement}/h{height}.csv``). Columns :data:`COMPARE_COLUMNS`;
     ``p_holm`` are Holm-adjusted over all rows. Written to ``out_csv`` when given.
 
-    ``spread_files``: every stored seed's files of the reference variant, ``{cell: [paths]}``, whose seed
-    variance a side with too few seeds of its own borrows (:func:`~egosearch.report.seed_spread.comparison_spreads`).
+    ``spread_files``: every stored seed's files of the reference variant, ``{cell: [paths]}``: a screen, whose
+    test counts the spread between those seeds (:func:`~egosearch.report.spread_sides.comparison_spreads`).
     ``count_seed_spread=False``: the comparison as it was read before that (each side's own seeds only, a
     one-seed side's scenarios only): the null screen's "before".
 
@@ -454,29 +455,19 @@ def compare_report(reference_files: Mapping, candidate_files: Mapping, out_csv: 
             paired_scenarios(read_episodes(reference_files[cell]), read_episodes(candidate_files[cell]))
         except ValueError as e:
             raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
-    spreads = {m: comparison_spreads(reference_files, candidate_files, spread_files, m) if count_seed_spread else None
-               for m in metrics}
+    spreads = comparison_spreads(reference_files, candidate_files, spread_files) if count_seed_spread else None
     rows = []
     for cell in sorted_cells(ref_cells):
         ref = read_episodes(reference_files[cell])
         cand = read_episodes(candidate_files[cell])
         for metric in metrics:
             try:
-                res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed, spreads=spreads[metric])
+                res = compare_cells(ref, cand, metric, n_resamples=n_resamples, seed=seed, spreads=spreads)
             except ValueError as e:
-                raise ValueError(f"compare: cell {_cell_name(cell)}: {e}") from None
+                raise type(e)(f"compare: cell {_cell_name(cell)}: {e}") from None
             homes = "+".join(sorted({_home_of(x) for x in ref["scenario_set"]}))
-            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res,
-                         "seed_sd": counted_seed_sd(spreads[metric]), "homes": homes})
+            rows.append({"height": cell[0], "placement": cell[1], "metric": metric, **res, "homes": homes})
     return holm_and_write(pd.DataFrame(rows), COMPARE_COLUMNS, out_csv)
-
-
-def counted_seed_sd(spreads) -> float:
-    """The standard deviation between training seeds that a seed-spread comparison counts: the larger of its
-    two sides' (nan for a bootstrap comparison)."""
-    if not isinstance(spreads, tuple):
-        return math.nan
-    return max(s.sd for s in spreads)
 
 
 def holm_and_write(df: pd.DataFrame, columns: Iterable[str], out_csv: PathLike | None = None) -> pd.DataFrame:

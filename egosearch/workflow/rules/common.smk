@@ -250,10 +250,10 @@ def spread_files(variant):
                   seed=SPREAD_SEEDS, home=HOMES, placement=PLACEMENTS, height=HEIGHTS)
 
 
-def stored_one_seed_screens():
-    """The stored one-seed screens (screen_NAME_seedN_vs_...csv; their ℓ and aggregate files left out), which
-    `screens_reread` reads again."""
-    return sorted(str(p) for p in Path(RESULTS, "compare").glob("screen_*_seed[0-9]*_vs_*.csv")
+def stored_screens():
+    """The stored screens (screen_NAME_seedN_vs_...csv, screen_NAME_seedsA-B_vs_...csv; their ℓ, aggregate and
+    stuck files left out), which `screens_reread` reads again."""
+    return sorted(str(p) for p in Path(RESULTS, "compare").glob("screen_*_seed*_vs_*.csv")
                   if not p.stem.endswith(("_by_length", "_aggregate", "_stuck")))
 
 

@@ -177,10 +177,10 @@ rule compare:
 
 rule screen:
     """A lever's first test: the variant trained on screen_seeds seeds against the mean of the reference's
-    spread seeds on the same stored sets, per cell and per shortest-path bin. Its interval and p count how
-    much training seeds differ (the reference's spread, estimated on those seeds), so a row is "lower" or
-    "higher" only beyond that spread; the aggregate over seeds and cells (interquartile mean, probability
-    of improvement) is written beside it."""
+    spread seeds on the same stored sets, per cell and per shortest-path bin. Whatever its seed count it runs
+    the seed-spread test (a t-test on the seeds' cell means, the reference's spread seeds and the candidate's
+    showing how far one seed's mean strays), so a row is "lower" or "higher" only beyond that spread; the
+    aggregate over seeds and cells (interquartile mean, probability of improvement) is written beside it."""
     input:
         reference=ancient(spread_files(REF)),
         candidate=screen_candidate,
@@ -200,9 +200,10 @@ rule screen:
 
 rule null_screen:
     """The reference screened against itself (outside `all`: it needs the spread seeds): every spread seed
-    as a candidate against each other seed and against the rest, before and after the seed spread counts;
-    the simulated false-positive rate of both verdicts, the seed spread per cell and the difference a
-    screen of 1, 3 and 5 seeds detects (docs/statistics.md)."""
+    as a candidate against each other seed and against the rest, before and after the seed spread counts, the
+    spread held out (from the seeds on neither side: a consistency check); the simulated false-positive rate of
+    the screen's test in every setting (its calibration), the seed spread per cell and the difference a screen
+    of 1, 2, 3 and 6 seeds detects (docs/statistics.md)."""
     input:
         ancient(spread_files(REF)),
     output:
@@ -218,10 +219,10 @@ rule null_screen:
 
 
 rule screens_reread:
-    """Every stored one-seed screen read again with its reference's seed spread counted, beside its old verdict
+    """Every stored screen read again with the seed-spread test every screen runs now, beside its stored verdict
     (it reads the stored evaluation files the screens read; docs/ablations.md)."""
     input:
-        ancient(stored_one_seed_screens()),
+        ancient(stored_screens()),
     output:
         update(f"{RESULTS}/compare/screens_reread.csv"),
     log:
