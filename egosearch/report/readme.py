@@ -644,6 +644,14 @@ def block_failures(root: Path, profile: str) -> str:
     return "\n".join(line for line in lines if not line.startswith("# ")).strip("\n") + "\n"
 
 
+def block_memory_window(root: Path, profile: str) -> str:
+    """How much memory the search asks for (``paper_figs/<profile>/memory_window.md``, rule ``memory_window``)."""
+    path = root / "paper_figs" / profile / "memory_window.md"
+    if not path.exists():
+        return _missing(root, path)
+    return path.read_text(encoding="utf-8").strip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
 def _called_cells(rows: pd.DataFrame, column: str) -> str:
     picked = [f"{h:g} {'excl.' if p == 'no_low_cabinets' else 'every'} {v}" for h, p, v
               in zip(rows["height"], rows["placement"], rows[column]) if v in ("higher", "lower")]
@@ -700,6 +708,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "power": block_power,
     "seed_spread": block_seed_spread,
     "failures": block_failures,
+    "memory_window": block_memory_window,
     "screens_reread": block_screens_reread,
     "reading": block_reading,
     "claims": block_claims,  # the paper's behaviour sentences against the per-step traces

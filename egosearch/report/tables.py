@@ -341,8 +341,9 @@ def table1(episode_files: Mapping, out_prefix: PathLike, confidence: float = 0.9
                           "homes (Section 6) and gives one number per cell. " if BOTH_HOMES in homes else "")
                        + f"SPL and its interval, the {pct} bootstrap over per-seed success rates and every searcher's "
                        f"stuck share (episodes failed with {STUCK_COLLISIONS} or more collisions) are in "
-                       f"{out_csv.name}; how each fails is in failures.md (`snakemake failures`). Paper: Table 1 of "
-                       "Sorokin et al. 2021.", ""]
+                       f"{out_csv.name}; how each fails is in failures.md (`snakemake failures`); how much memory the "
+                       "search asks for (the tuned searcher held to its last K steps, beside the policy's 5 frames) is "
+                       "in memory_window.md (`snakemake memory_window`). Paper: Table 1 of Sorokin et al. 2021.", ""]
     suffixed(base, ".md").write_text("\n".join(md_all).rstrip("\n") + "\n", encoding="utf-8")
     suffixed(base, ".tex").write_text("\n".join(tex_all), encoding="utf-8")
     return df
