@@ -50,7 +50,8 @@ rule all:
 
 
 onstart:
-    # before a real run's first job: the cost of its plan (rules/common.smk)
+    # before a real run's first job: its stored inputs as recorded, then the cost of its plan (rules/common.smk)
+    refuse_damaged_inputs()
     print_the_plans_cost()
 
 

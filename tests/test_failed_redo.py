@@ -30,8 +30,9 @@ def test_a_failed_jobs_reason_is_read_from_its_own_log(tmp_path):
         "rule compare failed"]
 
 
-def _copy(dest: Path) -> Path:
-    """The workflow, the variants and the stored files table1 and compare read: a clone's, without the rest."""
+def _copy(dest: Path, record: bool) -> Path:
+    """The workflow, the variants and the stored files table1 and compare read: a clone's, without the rest;
+    ``record``: with the results' provenance record too."""
     shutil.copy2(REPO / "Snakefile", dest / "Snakefile")
     for name in ("egosearch/workflow", "ablations", "profiles", "paper_figs/cpu", "results/cpu/scenarios",
                  "results/cpu/compare", "results/cpu/bench"):
@@ -41,7 +42,8 @@ def _copy(dest: Path) -> Path:
                  "frontier_tuned_head_off"):
         shutil.copytree(REPO / "results/cpu/eval" / name, dest / "results/cpu/eval" / name,
                         ignore=shutil.ignore_patterns("generated_*"))
-    shutil.copy2(REPO / "results/cpu/provenance.json", dest / "results/cpu/provenance.json")  # what compare checks
+    if record:
+        shutil.copy2(REPO / "results/cpu/provenance.json", dest / "results/cpu/provenance.json")
     return dest
 
 
@@ -52,14 +54,16 @@ def _digests(root: Path) -> dict[str, str]:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("target", [["table1", "-R", "table1"],
-                                    ["compare", "--config", "variant=head_off", "-R", "compare"]],
-                         ids=["table1", "compare"])
-def test_a_forced_redo_that_fails_keeps_every_stored_file_and_says_why(tmp_path, target):
-    """A stored evaluation truncated, then the redo the suite's own hints suggest (`-R`): the job fails, every
-    stored table, figure and comparison is byte for byte what it was (Snakemake removed them before: update()
-    keeps them and restores them on failure), and the console's last lines give the job's own reason."""
-    suite = _copy(tmp_path)
+@pytest.mark.parametrize("target, record", [(["table1", "-R", "table1"], False),
+                                            (["compare", "--config", "variant=head_off", "-R", "compare"], True)],
+                         ids=["table1-job-fails", "compare-refused-at-start"])
+def test_a_forced_redo_of_damaged_inputs_keeps_every_stored_file_and_says_why(tmp_path, target, record):
+    """A stored evaluation truncated, then the redo the suite's own hints suggest (`-R`). Where the results have
+    their provenance record, the run refuses before its first job, in one line naming the file and
+    `git checkout -- FILE`; without it the job runs and fails, and every file it would have replaced is restored
+    (its outputs are update(): Snakemake removed them before), its own reason the console's line. Either way every
+    stored table, figure and comparison is byte for byte what it was."""
+    suite = _copy(tmp_path, record)
     before = _digests(suite)
     damaged = suite / "results/cpu/eval/head_on/seed1/kitchen_living/everywhere/h1.05.csv"
     damaged.write_text("\n".join(damaged.read_text().splitlines()[:50]) + "\n")
@@ -68,6 +72,11 @@ def test_a_forced_redo_that_fails_keeps_every_stored_file_and_says_why(tmp_path,
     said = out.stdout + out.stderr
     assert out.returncode != 0, said[-3000:]
     assert _digests(suite) == before
-    rule = target[0]
-    reasons = [line for line in said.splitlines() if line.startswith(f"rule {rule} failed: ")]
-    assert reasons and ("missing" in reasons[0] or "truncated" in reasons[0]), said[-3000:]
+    if record:
+        refusals = [line for line in said.splitlines() if line.startswith("refusing to start: ")]
+        assert len(refusals) == 1 and "was truncated" in refusals[0], said[-3000:]
+        assert "git checkout -- results/cpu/eval/head_on/seed1/kitchen_living/everywhere/h1.05.csv" in refusals[0]
+        assert f"rule {target[0]}:" not in said  # refused before any job
+    else:
+        reasons = [line for line in said.splitlines() if line.startswith(f"rule {target[0]} failed: ")]
+        assert reasons and "missing" in reasons[0], said[-3000:]

@@ -317,11 +317,10 @@ def file_problem(path: Path, recorded: dict | None, provenance: Path) -> str | N
     return f"{path} was edited: its sha256 differs from the one recorded in {provenance}"
 
 
-def check_stored(paths: Iterable[str | os.PathLike], require_record: bool = True) -> list[str]:
-    """Raise :class:`StoredFileError` (one line) if a file differs from the sha256 that the
-    provenance of its results folder recorded. ``require_record``: a file the record does not list
-    is an error too (a stored result read by a table); else it passes (a comparison's new candidate).
-    Returns the provenance files that vouched for nothing, i.e. results folders without a record."""
+def stored_problems(paths: Iterable[str | os.PathLike], require_record: bool = True) -> tuple[list, list[str]]:
+    """``([(path, problem)...], unrecorded)``: each file that differs from the sha256 its results folder's
+    provenance recorded, with the one-line problem; and the files no record vouches for. ``require_record``: a
+    file its record does not list is a problem too (a stored result read by a table), else it passes."""
     problems, unrecorded, cache = [], [], {}
     for path in map(Path, paths):
         provenance = _provenance_of(path)
@@ -339,10 +338,18 @@ def check_stored(paths: Iterable[str | os.PathLike], require_record: bool = True
             continue
         problem = file_problem(path, files.get(key), provenance)
         if problem:
-            problems.append(problem)
+            problems.append((path, problem))
+    return problems, unrecorded
+
+
+def check_stored(paths: Iterable[str | os.PathLike], require_record: bool = True) -> list[str]:
+    """Raise :class:`StoredFileError` (one line) if a file differs from the sha256 that the
+    provenance of its results folder recorded (:func:`stored_problems`). Returns the files no record vouched
+    for, i.e. in results folders without a record."""
+    problems, unrecorded = stored_problems(paths, require_record)
     if problems:
         more = f" ({len(problems) - 1} more file(s) too)" if len(problems) > 1 else ""
-        raise StoredFileError(f"{problems[0]}{more}; refusing to use stored results that differ from their "
+        raise StoredFileError(f"{problems[0][1]}{more}; refusing to use stored results that differ from their "
                               "record: restore them (git checkout), or rerun the jobs that write them and then "
                               "the `provenance` rule; `egosearch report verify` lists every file")
     return unrecorded

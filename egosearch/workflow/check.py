@@ -186,3 +186,19 @@ def reports_missing_inputs(rules, exists=lambda p: Path(p).exists()) -> list[str
                          f"add `-R {name}` to make them and redo {name}")
     return lines
 
+
+def damaged_inputs_line(input_paths) -> str | None:
+    """One line when a stored file the plan reads differs from the sha256 its provenance recorded (a truncated
+    evaluation, say), naming it and how to restore it; None when every such file matches. Files no record lists
+    (new results, a smoke run's) pass: only what was stored is vouched for."""
+    from egosearch.report.provenance import stored_problems
+
+    existing = sorted({str(p) for p in input_paths if Path(p).is_file()})
+    problems, _ = stored_problems(existing, require_record=False)
+    if not problems:
+        return None
+    path, problem = problems[0]
+    more = f" ({len(problems) - 1} more stored input(s) differ too; `egosearch report verify` lists them)" \
+        if len(problems) > 1 else ""
+    return (f"refusing to start: {problem}{more}; restore it with `git checkout -- {path}`, or rerun the job that "
+            "writes it and then the `provenance` rule")

@@ -61,6 +61,17 @@ wildcard_constraints:
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
 
 
+def refuse_damaged_inputs():
+    """Before a real run's first job: the stored files its jobs read must be the ones their provenance recorded
+    (egosearch.workflow.check.damaged_inputs_line), else one line and exit 1, before anything is written."""
+    from egosearch.workflow.check import damaged_inputs_line
+
+    line = damaged_inputs_line(f for job in workflow.dag.needrun_jobs() for f in job.input)
+    if line:
+        print(line, file=sys.stderr)
+        sys.exit(1)
+
+
 def print_the_plans_cost():
     """The cost of what this invocation runs (egosearch.cost.estimate.print_costs): the jobs of its DAG that
     need to run, counted as Snakemake's job stats count them, trainings and evaluations of the reference
