@@ -50,8 +50,10 @@ rule all:
 
 
 onstart:
-    # before a real run's first job: its stored inputs as recorded, then the cost of its plan (rules/common.smk)
+    # before a real run's first job: its stored inputs as recorded, no other run making its files, then the cost
+    # of its plan (rules/common.smk)
     refuse_damaged_inputs()
+    claim_the_plans_outputs()
     print_the_plans_cost()
 
 

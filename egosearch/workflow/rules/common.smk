@@ -72,6 +72,21 @@ def refuse_damaged_inputs():
         sys.exit(1)
 
 
+def claim_the_plans_outputs():
+    """Before a real run's first job: no other run in this clone is making a file this one makes, else one line
+    naming it and exit 1; the run's record is removed when it ends (egosearch.workflow.run_lock: the suite's own,
+    as a run that ends removes Snakemake's lock folder, the locks of runs still going included)."""
+    import atexit
+
+    from egosearch.workflow.run_lock import claim, release
+
+    line = claim((f for job in workflow.dag.needrun_jobs() for f in job.output), sys.argv)
+    if line:
+        print(line, file=sys.stderr)
+        sys.exit(1)
+    atexit.register(release)
+
+
 def print_the_plans_cost():
     """The cost of what this invocation runs (egosearch.cost.estimate.print_costs): the jobs of its DAG that
     need to run, counted as Snakemake's job stats count them, trainings and evaluations of the reference
