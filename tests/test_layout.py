@@ -297,3 +297,49 @@ def test_a_packages_docstring_that_lists_its_modules_lists_all_of_them():
         assert not missing and not gone, (package, "missing:", sorted(missing), "gone:", sorted(gone))
         checked += 1
     assert checked >= 2  # rl and motion list theirs
+
+
+NOTE_LINE = re.compile(r"^(Imports|Imported by|Packages): (?P<names>[^.]*)\.\s*$", re.MULTILINE)
+
+
+def _third_party(path: Path) -> set[str]:
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        names = [a.name for a in node.names] if isinstance(node, ast.Import) else (
+            [node.module] if isinstance(node, ast.ImportFrom) and not node.level and node.module else [])
+        out |= {n.split(".")[0] for n in names}
+    return out - set(sys.stdlib_module_names) - {"__future__", "egosearch"}
+
+
+def test_each_package_note_says_what_it_imports_what_imports_it_and_which_packages_it_uses():
+    """Each package's docstring has the lines ``Imports:``, ``Imported by:`` and ``Packages:`` (names, or
+    "nothing" / "none"), and they are the import graph's: the stages its modules import (the searchers' registry
+    counts as searchers), the stages and the Snakefile's rules that import one of its modules, and the packages
+    outside the standard library its modules import."""
+    modules = _modules()
+    imports: dict[str, set[str]] = {}
+    imported_by: dict[str, set[str]] = {}
+    packages: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        stage = _stage(name)
+        packages.setdefault(stage, set()).update(_third_party(path))
+        for imported, item in _imports_of(path):
+            other = _stage(_target(imported, item, modules))
+            if other != stage:
+                imports.setdefault(stage, set()).add(other)
+                imported_by.setdefault(other, set()).add(stage)
+    for path in RULE_FILES:
+        for imported, item in _rule_imports(path):
+            imported_by.setdefault(_stage(_target(imported, item, modules)), set()).add("Snakefile")
+    wrong = []
+    for init in sorted(PACKAGE.glob("*/__init__.py")):
+        stage = init.parent.name
+        said = {kind: set() if names.strip() in ("nothing", "none") else {n.strip() for n in names.split(",")}
+                for kind, names in NOTE_LINE.findall(ast.get_docstring(ast.parse(init.read_text())) or "")}
+        true = {"Imports": imports.get(stage, set()), "Imported by": imported_by.get(stage, set()),
+                "Packages": packages.get(stage, set())}
+        for kind, names in true.items():
+            if said.get(kind) != names:
+                wrong.append(f"{init.relative_to(PACKAGE.parent)} {kind}: says {sorted(said.get(kind, {'(no line)'}))}"
+                             f", is {sorted(names)}")
+    assert not wrong, "\n".join(wrong)

@@ -1,5 +1,8 @@
 """``egosearch <command>``: the entry points users and the Snakefile call.
-Imports every stage, each only when its command runs; nothing in the package imports it.
+Imports: core, cost, envs, motion, report, rl, runs, scene, searchers, sim, variants, workflow.
+Imported by: nothing.
+Packages: pandas, torch.
+Each stage is imported only when its command runs.
 
 One module per command (``egosearch/cli/<command>.py``, with ``run(args)``) and its parser in
 :mod:`egosearch.cli.parsers`; ``main`` imports only the command that runs.

@@ -1,6 +1,10 @@
 """The cost model: how long a run of the workflow, a comparison or one training takes on a machine.
-Imports core, rl (the env step units; the learner benchmark, to calibrate), variants, the workflow's DAG and
-report's readers of the workflow and its runs; imported by the CLI (``estimate``, ``train``) and the Snakefile.
+Imports: core, report, rl, variants, workflow.
+Imported by: cli, Snakefile.
+Packages: none.
+rl for the env step units and the learner benchmark (to calibrate), the workflow for the DAG it simulates, the
+report for its readers of the workflow's config and stored jobs; the CLI for ``estimate`` and ``train``, the
+Snakefile for the cost line before a run.
 
 - :mod:`~egosearch.cost.schedule`: a DAG's jobs laid out on N cores as Snakemake's scheduler starts them,
   at the durations a provenance record gives

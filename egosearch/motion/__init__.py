@@ -1,5 +1,8 @@
 """Full-body characters for the abstract search policy (paper section 5): motion generators and Algorithm 1.
-Imports core/, scene/, sim/ and runs/ (the policy comes in as a callable); imported by the CLI only.
+Imports: core, runs, scene, sim.
+Imported by: cli.
+Packages: PIL, imageio, numpy, pybullet_data, pyrender, tqdm, trimesh.
+The policy comes in as a callable.
 
 - :mod:`~egosearch.motion.mocap`: DeepMimic clips from pybullet_data;
 - :mod:`~egosearch.motion.humanoid` (1.65 m DeepMimic humanoid), :mod:`~egosearch.motion.fetch`;

@@ -1,8 +1,11 @@
 """The report layer: stored CSVs and JSON in; tables, figures, studies and the docs' generated blocks out.
-Imports numpy, pandas, scipy, matplotlib, yaml and ``egosearch.core`` only (``searches`` also ``egosearch.scene``,
-when it draws); never torch, the simulator or gymnasium. Imported by the CLI (which passes Table 2's rows in),
-the Snakefile's rules (``workflow_jobs``: the bound files in the DAG's order) and the cost model (``egosearch.cost``:
-``workflow_jobs``' config readers and job costs, ``data``'s reading of a stored training).
+Imports: core, scene, searchers.
+Imported by: cli, cost, workflow, Snakefile.
+Packages: matplotlib, numpy, pandas, scipy, yaml.
+Never torch, the simulator or gymnasium: scene only where ``searches`` draws a home, searchers only its registry
+(the names, labels and bound rows of the searchers). The CLI passes Table 2's rows in; the Snakefile's rules and
+the workflow read ``workflow_jobs`` (the bound files in the DAG's order), the cost model its config readers and
+job costs and ``data``'s reading of a stored training.
 """
 
 from egosearch.report.data import (

@@ -1,6 +1,9 @@
 """The search policy's learners (paper 4.2, Table 2), their training loop and their actor files.
-Imports core/, scene/, sim/, searchers/ (the teacher) and runs/ (its curve evaluations); imported by variants
-and the CLI.
+Imports: core, envs, runs, scene, searchers, sim.
+Imported by: cli, cost, variants.
+Packages: gymnasium, numpy, torch, tqdm.
+searchers for the teacher, runs for the curve evaluations; the cost model reads the env step units and the
+learner benchmark.
 
 - :mod:`egosearch.rl.config`: ``LearnerConfig`` (the run settings and the learner's own, composed: one
   config class per learner), ``load_config(profile, overrides)``, ``table2_rows(cfg)``, ``departure_rows(cfg)``;

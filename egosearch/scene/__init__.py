@@ -1,5 +1,8 @@
 """Homes as plain data: parts, layouts, target objects and their placement (no engine, no renderer).
-Imports numpy and trimesh only; every other stage may import it."""
+Imports: nothing.
+Imported by: cli, motion, report, rl, runs, sim, variants, Snakefile.
+Packages: matplotlib, numpy, pybullet_data, scipy, trimesh.
+No engine and no renderer: matplotlib only for the top-down drawings, pybullet_data only for the meshes it ships."""
 
 from egosearch.scene.layouts import LAYOUT_NAMES, get_scene, random_home
 from egosearch.scene.objects import TARGET_OBJECTS, get_object

@@ -1,3 +1,6 @@
 """The searchers that are not learned: oracle, random, the classical frontier searcher, and their registry.
-Imports sim/ and core/; imported by runs/, rl/ (a teacher), motion/ and the CLI; its registry, plain data that
-imports nothing, by every stage (``registry``: the one place a searcher is added)."""
+Imports: core, sim.
+Imported by: cli, envs, report, rl, runs, variants, workflow, Snakefile.
+Packages: gymnasium, numpy, scipy.
+Its registry (``registry``: the one place a searcher is added) is plain data that imports only core's registry
+helper, so that the report, the workflow and the variants read it without the simulator."""

@@ -1,2 +1,4 @@
 """The simulation: the pybullet world, depth+mask sensor, pictures, navigation grid, floor map, scenarios, env.
-Imports scene/ and core/; imported by searchers/, rl/, runs/, motion/ and the CLI."""
+Imports: core, scene.
+Imported by: cli, envs, motion, rl, runs, searchers, variants.
+Packages: embreex, gymnasium, matplotlib, numpy, pyrender, scipy, tqdm, trimesh."""

@@ -1,2 +1,4 @@
 """The Snakemake workflow: rules, config and schemas, and the checks the Snakefile runs before the DAG is built.
-Imports variants and core/; imported by the Snakefile and the CLI only."""
+Imports: core, report, searchers, variants.
+Imported by: cli, cost, Snakefile.
+Packages: jsonschema, snakemake, snakemake_executor_plugin_slurm."""
