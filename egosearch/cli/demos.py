@@ -14,9 +14,14 @@ def run(args) -> None:
     check_suffix("--out", args.out, (".replay.npz",), "a demonstrations file (git-ignored: hundreds of MB)")
     check_outputs(files={"--out": args.out})
     check_overwrites(files={"--out": args.out, "--out (summary)": str(summary_path(args.out))}, force=args.force)
-    at_least("--episodes", args.episodes, 1, "a number of episodes")
+    if args.episodes is not None:
+        at_least("--episodes", args.episodes, 1, "a number of episodes")
     check_seed("--seed", args.seed)
     resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed})
+    episodes = args.episodes if args.episodes is not None else resolved.config.demo_episodes
+    if episodes < 1:
+        raise ValueError(f"--variant={args.variant} at the {args.profile} profile learns from no demonstrations "
+                         "(its demo_episodes is 0): give --episodes N to collect them anyway")
     if resolved.config.modular_searcher:
         # its training could not read them (demo_episodes must be 0 there), and collecting them fails
         # half-way with numpy's reshape error: a decision is not a body step
@@ -24,6 +29,6 @@ def run(args) -> None:
                          "is a decision, not a body step): demonstrations are the frontier searcher's body steps, "
                          "which it cannot learn from; give a variant that acts at every body step (e.g. "
                          "head_on_from_scratch)")
-    summary = collect_demonstrations(resolved.env_id, resolved.config, resolved.train_env, args.episodes, args.out,
+    summary = collect_demonstrations(resolved.env_id, resolved.config, resolved.train_env, episodes, args.out,
                                      seed=args.seed, variant=resolved.name)
     print(json.dumps(summary))

@@ -125,7 +125,8 @@ def add_demos(sub) -> None:
                                                     "training homes, heights and observation")
     p.add_argument("--profile", default="cpu", help="learner profile whose observation is stored: smoke, cpu or "
                                                     "paper (default: cpu)")
-    p.add_argument("--episodes", type=int, required=True, help="demonstration episodes")
+    p.add_argument("--episodes", type=int, help="demonstration episodes (default: the variant's demo_episodes at "
+                   "--profile, what its training collects)")
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes (default 0)")
     p.add_argument("--out", required=True, metavar="FILE.replay.npz",
                    help="the transitions (git-ignored); a summary goes beside it as FILE.json")

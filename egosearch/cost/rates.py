@@ -16,7 +16,7 @@ from pathlib import Path
 from egosearch.cost.schedule import TRAIN, env_steps_of, machine_key
 from egosearch.report.data import counts_decisions
 from egosearch.report.workflow_jobs import job_cost_s
-from egosearch.rl.config import BODY_STEPS, DECISIONS, load_config
+from egosearch.rl.config import BODY_STEPS, DECISIONS, field_defaults, load_config
 
 
 def steps_of_profile(profile: str) -> str:
@@ -70,7 +70,9 @@ def cpu_s_outside_rl(run_dir: Path) -> float | None:
             if per_update is None:
                 return None
             config = done["config"]
-            imitation = per_update * config["bc_updates"] * (1 + config.get("dagger_rounds", 0))
+            # a run recorded before the field existed had its declared default (no DAgger round)
+            rounds = config.get("dagger_rounds", field_defaults()["dagger_rounds"])
+            imitation = per_update * config["bc_updates"] * (1 + rounds)
         else:
             imitation = 0.0  # demonstrations in replay, no cloning
         return float(done["demonstrations"]["cpu_s"]) + imitation

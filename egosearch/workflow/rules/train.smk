@@ -26,7 +26,8 @@ rule train:
 
 rule demos:
     """The frontier searcher's transitions in the variant's training homes (demonstrations for imitation and
-    RL): the head-moving searcher for a body with a head, the head-fixed one otherwise. The transitions are
+    RL), as many episodes as the variant's demo_episodes: the head-moving searcher for a body with a head, the
+    head-fixed one otherwise. The transitions are
     git-ignored (*.replay.npz); the summary beside them records episodes, success and CPU time."""
     output:
         transitions="results/{profile}/demos/{variant}/seed{seed}.replay.npz",
@@ -37,10 +38,9 @@ rule demos:
         "results/{profile}/benchmarks/demos/{variant}/seed{seed}.tsv"
     params:
         learner=lambda wc: config["profiles"][wc.profile]["learner"],
-        episodes=lambda wc: config["demo_episodes"],
     threads: 1
     conda:
         CONDA_ENV
     shell:
         "egosearch demos --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--episodes {params.episodes} --out {output.transitions} > {log} 2>&1"
+        "--out {output.transitions} > {log} 2>&1"
