@@ -74,7 +74,7 @@ def job_study(job: dict, config: dict | None = None, profile: str | None = None)
     list has no known seeds: every seed counts). A policy's job (``train``, ``eval``, ``eval_start``:
     ``variant/seedN/...``) is of ``all`` only for a variant of ``all`` (:func:`variants_of_all`) at one
     of those seeds; a start's evaluation (``eval_start``, what learning adds) is of ``all`` for those
-    variants alone, never of ``generalise``."""
+    variants alone, never of ``generalise``; a searcher's (``bound``) only for Table 1's bound rows."""
     config = config or workflow_config()
     of_all = set(variants_of_all(config))
     generalise_only = set(config.get("generalise", {}).get("variants", [])) - of_all
@@ -85,6 +85,8 @@ def job_study(job: dict, config: dict | None = None, profile: str | None = None)
         return REPORTS_OUTSIDE_ALL.get(parts[0], "all")
     if any(part in GENERATED_GROUPS for part in parts):
         return "generalise"
+    if rule == "bound":  # a Table 1 bound's evaluation is of all; another searcher's (a memory window, a floor) not
+        return "all" if parts[0] in searchers.bounds() else "other"
     if rule in ("train", "eval", "eval_start"):
         if (profile or config["profile"]) in config["profiles"]:
             seeds = {f"seed{seed}" for seed in profile_seeds(config, profile)}
