@@ -319,12 +319,10 @@ def killed_job_lines(log_paths, checkpoint_of: Callable[[str, list[str]], Path |
     """:func:`killed_job_line` for each job that Slurm killed in the run whose Snakemake log is ``log_paths`` (the
     path, or the list the Snakefile's ``onerror`` gets); ``checkpoint_of(rule, outputs)`` names the file a job of
     the rule resumes from, None for a rule that keeps none."""
+    from egosearch.workflow.failures import run_log_texts
+
     lines = []
-    for path in [log_paths] if isinstance(log_paths, (str, Path)) else list(log_paths or ()):
-        try:
-            text = read(path)
-        except OSError:
-            continue
+    for text in run_log_texts(log_paths, read):
         for job in killed_jobs(text, read):
             lines.append(killed_job_line(job, checkpoint_of(job["rule"], job["outputs"])))
     return lines

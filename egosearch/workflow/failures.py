@@ -49,16 +49,25 @@ def last_line(path: str | Path, read: Callable[[str | Path], str] = lambda p: Pa
     return None
 
 
+def run_log_texts(log_paths: str | Path | Iterable[str | Path] | None,
+                  read: Callable[[str | Path], str] = lambda p: Path(p).read_text(errors="replace")) -> list[str]:
+    """The texts of a run's Snakemake logs: ``log_paths`` is a path or the list the Snakefile's ``onerror`` gets;
+    a log that cannot be read is left out."""
+    texts = []
+    for path in [log_paths] if isinstance(log_paths, (str, Path)) else list(log_paths or ()):
+        try:
+            texts.append(read(path))
+        except OSError:
+            continue
+    return texts
+
+
 def failed_job_lines(log_paths: str | Path | Iterable[str | Path],
                      read: Callable[[str | Path], str] = lambda p: Path(p).read_text(errors="replace")) -> list[str]:
     """One line per failed job of the run whose Snakemake log is ``log_paths`` (the path, or the list the
     Snakefile's ``onerror`` gets): ``rule NAME failed: <its log's last line> (log: PATH)``."""
     out = []
-    for path in [log_paths] if isinstance(log_paths, (str, Path)) else list(log_paths or ()):
-        try:
-            text = read(path)
-        except OSError:
-            continue
+    for text in run_log_texts(log_paths, read):
         for rule, logs in failed_jobs(text):
             said = next(((log, line) for log in logs if (line := last_line(log, read))), None)
             if said is None:
