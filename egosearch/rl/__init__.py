@@ -27,10 +27,11 @@ learner benchmark.
 - :mod:`egosearch.rl.common`: what every learner builds from (actor head, layers, crops,
   observation tensors, update metrics, actor weights);
 - :mod:`egosearch.rl.pooled`: what the pooled-depth learners share (``PooledConvEncoder``,
-  ``pool_depth``, ``drq_arch``, ``act_with``, SAC-DrQ's actor file, ``PooledAgent``,
-  ``SacDrqBase``) and ``SacMixin`` (SAC's temperature and actor step);
+  ``pool_depth``, ``drq_arch``, ``act_with``, SAC-DrQ's actor file, ``PooledAgent``) and ``SacMixin``
+  (SAC's temperature and actor step);
 - :mod:`egosearch.rl.sac_curl`: ``SacCurlAgent`` and its networks (the paper's learner);
-- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, SAC with a DrQ-v2-style update (the cpu profile's);
+- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, SAC with a DrQ-v2-style update (the cpu profile's), and
+  ``SacDrqBase``, its SAC set-up and Polyak step, which the recurrent form builds on;
 - :mod:`egosearch.rl.sac_drq_recurrent`: ``SacDrqRecurrentAgent``, SAC-DrQ with a GRU in the actor
   and another in the critic, trained on replayed sequences with burn-in (not the paper's algorithm);
 - :mod:`egosearch.rl.ppo`: ``PpoAgent``, PPO on SAC-DrQ's actor with a separate value network, trained

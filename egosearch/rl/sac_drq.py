@@ -3,9 +3,9 @@
 What it keeps from SAC + CURL (:mod:`egosearch.rl.sac_curl`): the soft actor-critic losses,
 twin critics with Polyak targets, the tanh-Gaussian actor, the automatic temperature, the inputs
 (K depth frames + mask feature + proprioception) and every learning rate and beta. The pooled
-encoder, the actor and its file, and SAC's set-up and steps, which the recurrent form and PPO share,
-live in :mod:`egosearch.rl.pooled` (:class:`egosearch.rl.pooled.SacDrqBase`); layers, crops and the actor
-head in :mod:`egosearch.rl.common`.
+encoder and the actor and its file, which the recurrent form and PPO share, live in :mod:`egosearch.rl.pooled`;
+layers, crops and the actor head in :mod:`egosearch.rl.common`. SAC's set-up around them and the Polyak step
+(:class:`SacDrqBase`, here) are SAC-DrQ's own, which its recurrent form builds on.
 
 What it changes, after DrQ-v2 (Yarats et al. 2021, github.com/facebookresearch/drqv2), to make
 one update several times cheaper:
@@ -37,7 +37,10 @@ learner (registered as "sac_drq" in :mod:`egosearch.rl.registry`).
 
 from __future__ import annotations
 
-from typing import Any
+import copy
+import math
+from abc import abstractmethod
+from typing import Any, ClassVar
 
 import torch
 import torch.nn.functional as F
@@ -54,12 +57,13 @@ from egosearch.rl.common import (
     crop_at,
     gaussian_entropy,
     map_reader,
+    metric_values,
     mlp,
     squashed_sample,
     weight_init,
 )
 from egosearch.rl.config import LearnerConfig
-from egosearch.rl.pooled import DRQ_ACTOR_FORMAT, SacDrqBase
+from egosearch.rl.pooled import DRQ_ACTOR_FORMAT, PooledAgent, SacMixin, pooled_encoder
 from egosearch.sim.observation_options import extra_dims, mask_images
 
 
@@ -187,6 +191,75 @@ class FrameDecoder(nn.Module):
 
     def forward(self, h: torch.Tensor) -> torch.Tensor:
         return self.net(h).view(-1, self.side, self.side)
+
+
+class SacDrqBase(SacMixin, PooledAgent):
+    """The SAC-DrQ learners' common part: one conv ``encoder`` trained by the critic, a ``critic``
+    with a Polyak copy ``critic_target``, an ``actor``, the temperature ``log_alpha`` with target
+    entropy -|A|, and the optimisers ``critic`` (critic + encoder), ``actor`` and ``alpha``. A
+    subclass builds its critic and actor (:meth:`make_critic`, :meth:`make_actor`)."""
+
+    SAC_MODULES: ClassVar[tuple[str, ...]] = ("encoder", "critic", "critic_target", "actor")
+    """The networks in the agent state, in its order (``log_alpha`` follows them)."""
+    critic: nn.Module
+    critic_target: nn.Module
+    critic_opt: torch.optim.Adam
+
+    def __init__(self, cfg: LearnerConfig, action_dim: int, mask_dim: int = 30, proprio_dim: int = 4,
+                 device: str | torch.device | None = None, state_dim: int = 0):
+        self.cfg = cfg.validate()
+        self.set_inputs(device, action_dim, mask_dim, proprio_dim, state_dim)
+        arch = self.arch()
+        self.encoder = pooled_encoder(arch)
+        self.critic = self.make_critic(arch)
+        self.actor = self.make_actor(arch)
+        self.build_sac()
+
+    @abstractmethod
+    def make_critic(self, arch: dict[str, Any]) -> nn.Module:
+        """The critic, on the features of ``encoder`` (built just before)."""
+
+    @abstractmethod
+    def make_actor(self, arch: dict[str, Any]) -> nn.Module:
+        """The actor head, on the features of ``encoder`` (built after the critic)."""
+
+    def build_sac(self) -> None:
+        """SAC's set-up around the ``encoder``, ``critic`` and ``actor`` just built: CURL's init, the
+        device, the target critic, the temperature, the optimisers."""
+        cfg = self.cfg
+        for net in (self.encoder, self.critic, self.actor):
+            net.apply(weight_init)
+            net.to(self.device)
+        if cfg.channels_last:
+            self.encoder.use_channels_last()
+        self.critic_target = copy.deepcopy(self.critic)
+        for p in self.critic_target.parameters():
+            p.requires_grad_(False)
+        self.log_alpha = torch.tensor(math.log(cfg.init_temperature), device=self.device, requires_grad=True)
+        self.target_entropy = -float(self.action_dim)
+        self.num_updates = 0
+        self.critic_opt = adam([{"params": self.critic.parameters(), "lr": cfg.critic_lr},
+                                {"params": self.encoder.parameters(), "lr": cfg.encoder_lr}],
+                               cfg.critic_lr, (cfg.critic_beta1, cfg.critic_beta2))
+        self.actor_opt = adam(self.actor.parameters(), cfg.actor_lr, (cfg.actor_beta1, cfg.actor_beta2))
+        self.alpha_opt = adam([self.log_alpha], cfg.alpha_lr, (cfg.alpha_beta1, cfg.alpha_beta2))
+        self.optimisers = {"critic": self.critic_opt, "actor": self.actor_opt, "alpha": self.alpha_opt}
+
+    # ---- updating ------------------------------------------------------------------------
+    def finish_update(self, out: dict[str, torch.Tensor]) -> dict[str, float]:
+        """The Polyak step when due (every ``critic_target_update_freq`` updates), then the update's
+        metrics."""
+        cfg = self.cfg
+        if self.num_updates % cfg.critic_target_update_freq == 0:
+            with torch.no_grad():
+                torch._foreach_lerp_(list(self.critic_target.parameters()), list(self.critic.parameters()),
+                                     cfg.critic_tau)
+        out["alpha"] = self.log_alpha.detach().exp()
+        return metric_values(out, self.device)
+
+    # ---- persistence -----------------------------------------------------------------------
+    def state_dict(self) -> dict[str, Any]:
+        return self.agent_state(self.SAC_MODULES, ("log_alpha",))
 
 
 class SacDrqAgent(SacDrqBase):

@@ -17,7 +17,7 @@ loss only, read detached by the actor; random-shift augmentation (one shift per 
 that the memory sees a steady camera); pooled uint8 frames in the replay; n-step returns;
 twin Q-heads with a Polyak target (here the target also holds a copy of the critic's GRU);
 the optional privileged critic (the state enters the Q-heads, not the GRU). Its set-up, actor and
-temperature step, Polyak step and agent state are SAC-DrQ's (:class:`egosearch.rl.pooled.SacDrqBase`).
+temperature step, Polyak step and agent state are SAC-DrQ's (:class:`egosearch.rl.sac_drq.SacDrqBase`).
 
 Per step, a network's GRU reads [projected conv features, mask, proprio] and its head reads
 [GRU output, projected conv features, mask, proprio] (the current observation stays one layer
@@ -63,8 +63,9 @@ from egosearch.rl.common import (
 )
 from egosearch.rl.config import LearnerConfig
 from egosearch.rl.learner import demo_column
-from egosearch.rl.pooled import DRQ_ARCH_FIELDS, SacDrqBase, pooled_encoder
+from egosearch.rl.pooled import DRQ_ARCH_FIELDS, pooled_encoder
 from egosearch.rl.replay import MultiReplay, ReplayBuffer, proportional_counts
+from egosearch.rl.sac_drq import SacDrqBase
 from egosearch.rl.training_aids import demonstration_settings
 
 AGENT_FORMAT = "egosearch-sac-drq-recurrent-agent-v1"
