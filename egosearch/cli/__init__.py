@@ -22,7 +22,11 @@ from egosearch.sim import rasterbuild
 
 COMMANDS = ("scenarios", "evaluate", "train", "demos", "tune", "variant", "config", "fullbody", "bench", "estimate",
             "video", "report", "pictures")
-"""In the order ``egosearch --help`` lists them; each has ``parsers.add_<command>`` and a module."""
+"""In the order ``egosearch --help`` lists them; each has ``parsers.add_<command>`` and a module, named as the
+command unless :data:`COMMAND_MODULES` names another."""
+COMMAND_MODULES = {"report": "report_commands"}
+"""A command's module whose name would be a package's of the suite: ``egosearch.cli.report`` read as
+``egosearch.report``, the package that writes the tables, which these commands call."""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -91,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         # local: a command's module loads what it runs (torch, the simulator), so `--help` and the
         # report commands start in a fraction of a second
-        importlib.import_module(f"egosearch.cli.{args.command}").run(args)
+        importlib.import_module(f"egosearch.cli.{COMMAND_MODULES.get(args.command, args.command)}").run(args)
     except (ValueError, FileNotFoundError) as err:
         # Bad input gets one line, not a traceback.
         print(f"egosearch {args.command}: error: {err}", file=sys.stderr)
