@@ -451,7 +451,7 @@ def add_report(sub) -> None:
     add_force(r)
 
     r = reports.add_parser("reread-screens", help="every stored screen read again with the seed-spread test, beside "
-                                                "its stored verdict (docs/ablations.md)")
+                                                "its stored verdict (docs/ablations/reread.md)")
     r.add_argument("--profile", **profile)
     r.add_argument("--out", required=True, help="the re-read's CSV")
     add_force(r)
