@@ -467,5 +467,5 @@ def add_report(sub) -> None:
                                           "stored results")
     r.add_argument("--profile", **profile)
     r.add_argument("--readme", help="the one page whose marked blocks are rewritten (default: README.md and every "
-                                    "docs/*.md page of the current folder)")
+                                    "page under docs/ of the current folder)")
     r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")
