@@ -30,20 +30,24 @@ CPU: dict[str, Any] = {
     # Table 2: 750k. 200k searched as well as 300k (screen_head_on_memory_50px_200k_seed0_vs_head_on_memory_50px_seed0
     # and head_on_from_scratch_vs_head_on_memory_50px in results/cpu/compare/); 300k overran `all`'s budget
     "total_env_steps": 200_000,
-    "num_envs": 8,  # ours: lockstep envs, batched acting
-    "n_step": 3,  # DrQ-v2
+    # cheaper steps, sized by the budget study: lockstep envs with batched acting (ours), batch 64 every 4 env
+    # steps (ours), DrQ-v2's 3-step returns
+    "num_envs": 8,
+    "n_step": 3,
     "batch_size": 64,
-    "update_every": 4,  # ours: one update per 4 env steps
+    "update_every": 4,
     # 100 -> 50 px depth (PointNav learners train from 64 x 64: bps-nav) with the target memory: together they
     # raised success in every Table 1 cell (results/cpu/compare/head_on_memory_50px_vs_head_on_25px.csv); neither
     # alone did
     "obs_downsample": 2,
     "target_memory": True,  # where the target was last seen: a CHANGE OF THE PAPER'S OBSERVATION (as above)
+    # a smaller encoder and nets, for the budget: 2 convs of 32 filters, both stride 2, DrQ-v2's random shift padded
+    # by 1 px (DrQ-v2: 4); 3-layer MLPs of 256 units (CURL's layer count)
     "encoder_num_layers": 2,
     "encoder_stride2_layers": 2,
     "encoder_num_filters": 32,
     "aug_pad": 1,
-    "actor_num_layers": 3,  # CURL's layer count
+    "actor_num_layers": 3,
     "critic_num_layers": 3,
     "actor_hidden_dim": 256,
     "critic_hidden_dim": 256,
@@ -86,7 +90,7 @@ CPU: dict[str, Any] = {
 """The default: a learner that acts at every body step, sized for the 2-core reference CPU: SAC-DrQ with a
 privileged critic, cloned from the tuned frontier searcher and then fine-tuned with its episodes in replay, on 50 px
 depth with the last-seen target memory and a contact signal, 200k env steps. Each value that departs from the
-paper names its source in the comment above it and in its field's docstring (the generated Table 2 lists them);
+paper names its source in the comment beside it and in its field's docstring (the generated Table 2 lists them);
 how each was found, and the profiles before it (``ablations/budget_cpu_curl_24k.yaml``,
 ``ablations/head_on_modular.yaml``, ...), is docs/learner.md ("How the cpu profile was found"). Its throughput:
 ``egosearch bench learner`` (``env_steps_per_core_s_cpu_profile``)."""
