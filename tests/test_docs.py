@@ -55,6 +55,16 @@ def test_every_block_lives_in_some_page():
     assert set(BLOCKS) - names == set()
 
 
+def test_every_stored_comparison_sits_on_its_familys_ablations_page():
+    """A lever's stored comparisons follow its lines to ``docs/ablations/<family>.md``: none waits on the index."""
+    from egosearch.report.readme import ABLATION_FAMILIES, block_compare
+
+    assert block_compare(REPO, "cpu", unfiled=True).startswith("*None:")
+    for family in ABLATION_FAMILIES:
+        page = (REPO / "docs" / "ablations" / f"{family}.md").read_text(encoding="utf-8")
+        assert f"<!-- egosearch:begin compare_{family} -->" in page, family
+
+
 def test_the_departures_are_one_link_from_the_readme():
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     assert "docs/learner.md#departures-from-the-paper" in readme
@@ -268,7 +278,7 @@ def _build(config: Path, site: Path) -> subprocess.CompletedProcess:
 def test_mkdocs_builds_the_docs_strictly_with_the_stored_figures(tmp_path):
     run = _build(REPO / "mkdocs.yml", tmp_path / "site")
     assert run.returncode == 0, run.stderr
-    nav_pages = {p.stem for p in (REPO / "docs").glob("*.md")}
+    nav_pages = {p.relative_to(REPO / "docs").with_suffix("").as_posix() for p in (REPO / "docs").rglob("*.md")}
     for stem in nav_pages - {"index"}:
         assert (tmp_path / "site" / stem / "index.html").is_file(), stem
     # the figures the pages show from paper_figs/ are in the site, and the pages point at them

@@ -106,7 +106,7 @@ def test_check_mode_reports_stale_blocks_without_writing(tmp_path):
     assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 2
 
 
-def test_compare_block_lists_every_stored_comparison(tmp_path):
+def test_compare_blocks_list_every_stored_comparison_on_its_familys_page(tmp_path):
     folder = tmp_path / "results" / "p" / "compare"
     folder.mkdir(parents=True)
     row = dict(height=1.05, placement="everywhere", metric="success", reference=0.01, candidate=0.1, difference=0.09,
@@ -115,14 +115,34 @@ def test_compare_block_lists_every_stored_comparison(tmp_path):
     pd.DataFrame([row, {**row, "metric": "spl", "p_uncorrected": 0.03, "p_holm": 0.06,
                         "significant_holm": False}]).to_csv(
         folder / "my_new_variant_vs_head_on.csv", index=False)
-    text = "<!-- egosearch:begin compare -->\n<!-- egosearch:end compare -->"
-    assert "No stored comparison yet" in render_readme(text, tmp_path, "p2")
-    out = render_readme(text, tmp_path, "p")
+    unfiled = "<!-- egosearch:begin compare_unfiled -->\n<!-- egosearch:end compare_unfiled -->"
+    memory = "<!-- egosearch:begin compare_memory -->\n<!-- egosearch:end compare_memory -->"
+    assert "every stored comparison is on its family's page" in render_readme(unfiled, tmp_path, "p2")
+    assert "No stored comparison of these levers yet" in render_readme(memory, tmp_path, "p")
+    out = render_readme(unfiled, tmp_path, "p")                  # a lever no family names waits on the index
     assert "`my_new_variant` vs `head_on` (difference" in out     # no homes column: no homes named
     assert "| 1.05 | everywhere | success | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.0001 | 0.001 * |" in out
     assert "| 1.05 | everywhere | spl | 0.010 | 0.100 | +0.090 [+0.050, +0.130] | 0.03 | 0.06 |" in out
     pd.DataFrame([{**row, "homes": "bedroom_bath"}]).to_csv(folder / "my_new_variant_vs_head_on.csv", index=False)
-    assert "`my_new_variant` vs `head_on` in bedroom_bath (difference" in render_readme(text, tmp_path, "p")
+    assert "`my_new_variant` vs `head_on` in bedroom_bath (difference" in render_readme(unfiled, tmp_path, "p")
+    # a screen of a family's lever, whatever its seeds, sits on that family's page and nowhere else
+    pd.DataFrame([row]).to_csv(folder / "screen_head_on_map_image_seeds0-2_vs_head_on.csv", index=False)
+    assert "`screen_head_on_map_image_seeds0-2` vs `head_on`" in render_readme(memory, tmp_path, "p")
+    assert "head_on_map_image" not in render_readme(unfiled, tmp_path, "p")
+    assert "my_new_variant" not in render_readme(memory, tmp_path, "p")
+
+
+def test_comparison_family_reads_the_candidate_lever():
+    from egosearch.report.readme import comparison_family
+
+    assert comparison_family("screen_head_on_contact_signal_seeds0-1_vs_head_on_imitation_finetune") == "stuck"
+    assert comparison_family("screen_head_on_imitation_seed0_vs_head_on_from_scratch_seed0") == "imitation"
+    assert comparison_family("head_on_from_scratch_vs_head_on_25px") == "resolution"
+    assert comparison_family("head_on_vs_frontier") == "references"
+    assert comparison_family("head_on_vs_head_on_imitation_finetune") == "stuck"   # named on its own
+    assert comparison_family("screen_head_on_paper_homes_seed0_vs_head_on_kitchen_living_seed0_in_bedroom_bath") == \
+        "references"
+    assert comparison_family("my_new_variant_vs_head_on") is None
 
 
 def test_generalise_block_says_when_it_shows_the_one_seed_screen(tmp_path):

@@ -451,7 +451,7 @@ def add_report(sub) -> None:
     add_force(r)
 
     r = reports.add_parser("reread-screens", help="every stored screen read again with the seed-spread test, beside "
-                                                "its stored verdict (docs/ablations.md)")
+                                                "its stored verdict (docs/ablations/reread.md)")
     r.add_argument("--profile", **profile)
     r.add_argument("--out", required=True, help="the re-read's CSV")
     add_force(r)
@@ -467,5 +467,5 @@ def add_report(sub) -> None:
                                           "stored results")
     r.add_argument("--profile", **profile)
     r.add_argument("--readme", help="the one page whose marked blocks are rewritten (default: README.md and every "
-                                    "docs/*.md page of the current folder)")
+                                    "page under docs/ of the current folder)")
     r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")

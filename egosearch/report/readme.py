@@ -267,13 +267,58 @@ def _by_length_line(path: Path, root: Path) -> str | None:
     return f"By shortest path ℓ (success, every cell pooled; `{split.relative_to(root)}`): {bins}."
 
 
-def block_compare(root: Path, profile: str) -> str:
-    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``), and its
-    split by shortest path where stored."""
+ABLATION_FAMILIES: dict[str, tuple[str, ...]] = {
+    "references": ("head_on", "head_off", "head_off_25px", "head_off_from_scratch", "frontier_tuned",
+                   "frontier_tuned_head_off", "head_on_paper_homes"),
+    "resolution": ("head_on_memory_50px", "head_off_memory_50px", "head_on_50px", "head_on_memory_50px_200k",
+                   "head_on_from_scratch", "head_on_encoder_aux", "head_on_ppo", "head_on_ppo_no_entropy"),
+    "memory": ("head_on_target_memory", "head_on_floor_map", "head_on_recurrent", "head_on_recurrent_geodesic",
+               "head_on_map_image", "head_on_strided_history"),
+    "shaping": ("head_on_coverage", "head_on_geodesic", "head_on_geodesic_50px"),
+    "imitation": ("head_on_imitation", "head_on_imitation_map", "head_on_imitation_dagger", "head_on_demo_replay",
+                  "head_on_imitation_finetune", "head_on_imitation_finetune_100k", "head_on_imitation_finetune_map",
+                  "head_on_imitation_finetune_critic_ln", "head_on_imitation_finetune_5k_demos",
+                  "head_on_imitation_finetune_tuned_teacher", "head_on_imitation_finetune_bc_200k"),
+    "modular": ("head_on_modular", "head_off_modular", "head_on_modular_rerun_on_intel_xeon"),
+    "stuck": ("head_on_geodesic_finetune", "head_on_contact_signal", "head_on_cloning_floor",
+              "head_on_recurrent_imitation", "head_on_tuned_teacher_geodesic_contact",
+              "head_off_tuned_teacher_geodesic_contact", "head_on_dagger_contact"),
+}
+"""Each page of ``docs/ablations/`` (its file name's stem) and the candidates whose stored comparisons it shows:
+a comparison sits with the lever it reads, whatever its reference. A candidate no family names is shown on the
+index page, ``docs/ablations.md`` (block ``compare_unfiled``), until a family takes it."""
+
+ABLATION_COMPARISONS: dict[str, str] = {
+    # the redone pair read against the pair it replaced: the stuck student's result, not the reference's
+    "head_on_vs_head_on_imitation_finetune": "stuck",
+    "head_off_vs_head_off_imitation_finetune": "stuck",
+}
+"""Comparisons (file stems) shown on another family's page than their candidate's."""
+
+SCREEN_SEEDS = re.compile(r"_seeds?\d+(-\d+)?$")
+
+
+def comparison_family(stem: str) -> str | None:
+    """The ``docs/ablations/`` page a stored comparison ``<candidate>_vs_<reference>`` is shown on
+    (:data:`ABLATION_FAMILIES`); None when no family claims it."""
+    if stem in ABLATION_COMPARISONS:
+        return ABLATION_COMPARISONS[stem]
+    candidate = SCREEN_SEEDS.sub("", stem.split("_vs_", 1)[0].removeprefix("screen_"))
+    return next((family for family, levers in ABLATION_FAMILIES.items() if candidate in levers), None)
+
+
+def block_compare(root: Path, profile: str, family: str | None = None, unfiled: bool = False) -> str:
+    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``) of one family of
+    levers (:func:`comparison_family`; ``unfiled``: those of none; neither: all), each with its split by shortest
+    path where stored."""
     folder = root / "results" / profile / "compare"
     paths = _cell_comparisons(folder)
+    if family is not None or unfiled:
+        paths = [p for p in paths if comparison_family(p.stem) == family]
     if not paths:
-        return (f"*No stored comparison yet under `{folder.relative_to(root)}/` "
+        if unfiled:
+            return "*None: every stored comparison is on its family's page.*\n"
+        return (f"*No stored comparison of these levers yet under `{folder.relative_to(root)}/` "
                 "(`snakemake --cores 2 compare --config variant=NAME`).*\n")
     parts = []
     for path in paths:
@@ -704,7 +749,10 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "fig7": block_fig7,
     "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
     "provenance": block_provenance,
-    "compare": block_compare,
+    # the stored comparisons, one block per page of docs/ablations/ and the index's for those of no family
+    **{f"compare_{family}": (lambda root, profile, family=family: block_compare(root, profile, family))
+       for family in ABLATION_FAMILIES},
+    "compare_unfiled": lambda root, profile: block_compare(root, profile, unfiled=True),
     "power": block_power,
     "seed_spread": block_seed_spread,
     "failures": block_failures,

@@ -1,4 +1,4 @@
-"""The stored screens read again with the test every screen runs now (docs/ablations.md).
+"""The stored screens read again with the test every screen runs now (docs/ablations/reread.md).
 
 A stored screen (``results/<profile>/compare/screen_<candidate>_seed<N>_vs_<reference>[_seed<N>][_in_<home>].csv``
 or ``screen_<candidate>_seeds<A>-<B>_vs_<reference>.csv``) was read with the test of its day: a one-seed screen's

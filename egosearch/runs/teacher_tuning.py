@@ -1,20 +1,20 @@
-"""The tuned teacher's tuning, as a command that can be run again (``egosearch tune-teacher``, rule
+"""The tuned teacher's tuning, as a command that can be run again (``egosearch tune``, rule
 ``tune_teacher``): the training-side splits, the candidates, the choice on the fit split and the check on
 the held-out one, written as a record.
 
-:mod:`egosearch.searchers.frontier_tuned` gives the parameters and where they came from: two splits of 540
-training-side scenarios, never the stored sets. Each split is, at camera heights 0.45, 1.05 and 1.65 m and
-both placements, the paper's two homes with a scenario seed the stored sets do not use (fit 31, held out 32;
-the stored sets use 2021, the fresh-set check 7), 25 scenarios a home and cell, and 20 generated homes (fit
-300-319, held out 400-419; the project stores 0-19 and 900000-900019), 2 scenarios a home and cell. Every
+:mod:`egosearch.searchers.frontier_tuned` gives the parameters, docs/baselines.md where they came from: two
+splits of 540 training-side scenarios, never the stored sets. Each split is, at camera heights 0.45, 1.05 and
+1.65 m and both placements, the paper's two homes with a scenario seed the stored sets do not use (fit 31, held
+out 32; the stored sets use 2021, the fresh-set check 7), 25 scenarios a home and cell, and 20 generated homes
+(fit 300-319, held out 400-419; the project stores 0-19 and 900000-900019), 2 scenarios a home and cell. Every
 candidate runs the fit split beside the untuned searcher (the same scenarios and episode seeds, so the
-difference is paired by scenario); the best mean over both head modes is chosen, and only it and the
-untuned searcher run the held-out split.
+difference is paired by scenario); the best mean over both head modes is chosen, and only it and the untuned
+searcher run the held-out split.
 
 The nine candidates the shipped parameters were chosen from were not recorded. :data:`CANDIDATES` is the
 shipped parameters and, for each of the four weights that trade path against gain and distance, the same
 with that one weight halved and doubled: the record says whether the shipped parameters still win on the fit
-split, and what they do on the held-out one (the docstring's 0.780 -> 0.856 head moving, 0.674 -> 0.769 head
+split, and what they do on the held-out one (docs/baselines.md's 0.780 -> 0.856 head moving, 0.674 -> 0.769 head
 fixed).
 """
 

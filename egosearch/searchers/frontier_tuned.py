@@ -5,42 +5,23 @@ walk and inputs (the depth frames, the target mask and its own pose: never the t
 free space); it changes only the choices the untuned searcher leaves to its hooks. Table 1's classical rows stay
 the untuned searcher's; this one is a separate row (``frontier_tuned``, ``frontier_tuned_head_off``).
 
-What it changes, and why (every failure of the untuned searcher is a timeout at the 100-step limit; on the tuning
-sets below, two in three never saw the target, the others saw it and did not reach a place to see it from):
+- **Where to explore** (:meth:`FrontierTunedPolicy.choose_frontier`): a frontier cell counts only where the
+  unknown area around it (a square of half side ``GAIN_RADIUS``) is at least ``MIN_GAIN``; the cheapest one
+  wins, its path length minus ``GAIN_WEIGHT`` times that area (information gain against path cost,
+  Gonzalez-Banos & Latombe 2002); the current goal is kept unless another is cheaper by ``HYSTERESIS`` m; a
+  goal the body came within 0.5 m of is dropped for the episode, with the frontier cells within
+  ``REACHED_RADIUS`` of it.
+- **Where to stand for a target seen** (:meth:`FrontierTunedPolicy.choose_approach`): every reachable cell
+  within ``APPROACH_REACH`` of the target counts, one further than the untuned 0.35 m costing
+  ``APPROACH_NEAR_COST`` m of path per m; a place where the body stood 3 steps without success is not chosen
+  again (nor cells within ``TRIED_RADIUS`` of it), and after every third such place it goes 0.1 m closer, as
+  the untuned searcher does.
+- The head sweep is the untuned one.
 
-- **Where to explore** (:meth:`FrontierTunedPolicy.choose_frontier`). The untuned searcher walks to the nearest
-  frontier cell by path and plans again every 3 steps. Two things waste its steps. A frontier it cannot resolve
-  from the floor (unknown cells under furniture or behind an obstacle) stays the nearest one: the body walks
-  there, turns for a farther frontier, and 3 steps later walks back, until the episode ends. And the map built
-  from sparse depth rays has one-cell holes inside seen floor that the nearest-frontier rule takes for
-  frontiers. Here a frontier goal the body came within 0.5 m of is dropped for the episode, with the frontier
-  cells within ``REACHED_RADIUS`` of it; a frontier cell counts only when the unknown area around it (a square
-  of half side ``GAIN_RADIUS``) is at least ``MIN_GAIN``; the searcher takes the lowest cost, the path length
-  minus ``GAIN_WEIGHT`` times that area (information gain against path cost, Gonzalez-Banos & Latombe 2002),
-  and keeps its current goal unless another is cheaper by ``HYSTERESIS`` m.
-- **Where to stand for a target seen** (:meth:`FrontierTunedPolicy.choose_approach`). The untuned searcher walks
-  to the nearest cell with the target 0.35 m from its surface; where the target is not in view from there it
-  goes closer, down to 0.1 m, where a target on a shelf or under a top is hidden by the furniture, and stands
-  there until the episode ends (and where the target is in view but further than its estimate said, it stands
-  there too). Here every reachable cell within ``APPROACH_REACH`` of the target counts (success is 0.5 m), a
-  cell further than the untuned 0.35 m costs ``APPROACH_NEAR_COST`` m of path per m, and a place where the body
-  stood 3 steps without success is not chosen again (nor cells within ``TRIED_RADIUS`` of it); after every third
-  such place it goes 0.1 m closer, as the untuned searcher does.
-- The head sweep is the untuned one: a slower yaw sweep (0.3 rad per step instead of 0.45) did worse.
-
-Where the parameters come from: tuning on training-side sets only, never on the stored ones. Two splits of 540
-scenarios, each at camera heights 0.45, 1.05 and 1.65 m and both placements: the paper's two homes with scenario
-seeds the stored sets do not use (31 to fit, 32 held out; the stored sets use 2021, the fresh-set check 7), 25
-scenarios a home and cell, and generated homes 300-319 (fit) and 400-419 (held out), 40 scenarios a cell, far
-from the generated homes the project stores (0-19, 900000-900019). Nine candidates were read on the fit split,
-paired by scenario against the untuned searcher; the parameters chosen (those above) then did, on the held-out
-split, success 0.780 -> 0.856 with the head moving (+0.076, 95% interval [+0.044, +0.107]) and 0.674 -> 0.769
-with it fixed (+0.094 [+0.056, +0.133]). Its rows on the stored Table 1 sets, run once after that, are
-``results/cpu/eval/frontier_tuned*/`` and ``results/cpu/compare/frontier_tuned*_vs_frontier*.csv``.
-
-Those nine candidates were not recorded. ``egosearch tune`` (rule ``tune_teacher``,
-:mod:`egosearch.runs.teacher_tuning`) runs the tuning again from the splits: the parameters above and each
-weight halved and doubled on the fit split, the best checked on the held-out split, written as a record.
+The parameters come from tuning on training-side sets only, never on the stored ones; ``egosearch tune``
+(:mod:`egosearch.runs.teacher_tuning`) runs it again. docs/baselines.md ("The tuned searcher: why and how it
+was tuned") says which failures of the untuned searcher each change answers, the splits and what the chosen
+parameters did on the held-out one.
 """
 
 from __future__ import annotations

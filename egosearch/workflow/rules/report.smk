@@ -220,7 +220,7 @@ rule null_screen:
 
 rule screens_reread:
     """Every stored screen read again with the seed-spread test every screen runs now, beside its stored verdict
-    (it reads the stored evaluation files the screens read; docs/ablations.md)."""
+    (it reads the stored evaluation files the screens read; docs/ablations/reread.md)."""
     input:
         ancient(stored_screens()),
     output:
