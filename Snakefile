@@ -19,6 +19,10 @@ configfile: "egosearch/workflow/config.yaml"
 # line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
 CHECKED_VARIANTS = checked_variants(config)
 validate(config, "egosearch/workflow/config.schema.json")
+if config.get("allow_long"):
+    # the jobs' `egosearch train` and `demos` allow what the checks above allowed; their command lines stay as
+    # they were, so that no stored job reruns for a changed command (egosearch.rl.run_settings.ALLOW_LONG_ENV)
+    os.environ["EGOSEARCH_ALLOW_LONG"] = "1"
 
 include: "egosearch/workflow/rules/common.smk"
 include: "egosearch/workflow/rules/scenarios.smk"

@@ -19,6 +19,7 @@ from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rule
 from egosearch.searchers import registry as searchers
 from egosearch.variants import (  # noqa: F401  (variant_head: the rules import it from here)
     ABLATIONS_DIR,
+    ALLOW_LONG_WORKFLOW,
     Variant,
     VariantError,
     check_learner_config,
@@ -54,6 +55,8 @@ def coerce_numbers(value, schema: dict, root: dict | None = None):
     kind = schema.get("type")
     if kind in ("number", "integer"):
         return _number(value, kind)
+    if kind == "boolean" and isinstance(value, str) and value.lower() in ("true", "false"):
+        return value.lower() == "true"
     if isinstance(value, list) and "items" in schema:
         return [coerce_numbers(v, schema["items"], root) for v in value]
     if isinstance(value, dict):
@@ -130,7 +133,8 @@ def workflow_variants(config: dict, compare: bool | str = False,
     variants = {}
     for name in names:
         variants[name] = _named_variant(name, named_by[name], directory)
-        check_learner_config(variants[name], learner)
+        check_learner_config(variants[name], learner, allow_long=config.get("allow_long", False),
+                             flag=ALLOW_LONG_WORKFLOW)
     generated = generalise.get("generated_variant")
     if generated is not None and (generated not in generalise["variants"]
                                   or variants[generated].train_env["layout"] != "generated"):
