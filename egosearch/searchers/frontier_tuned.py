@@ -38,7 +38,7 @@ split, success 0.780 -> 0.856 with the head moving (+0.076, 95% interval [+0.044
 with it fixed (+0.094 [+0.056, +0.133]). Its rows on the stored Table 1 sets, run once after that, are
 ``results/cpu/eval/frontier_tuned*/`` and ``results/cpu/compare/frontier_tuned*_vs_frontier*.csv``.
 
-Those nine candidates were not recorded. ``egosearch tune`` (rule ``tune_teacher``,
+Those nine candidates were not recorded. ``egosearch tune --out DIR`` (rule ``tune_teacher``,
 :mod:`egosearch.runs.teacher_tuning`) runs the tuning again from the splits: the parameters above and each
 weight halved and doubled on the fit split, the best checked on the held-out split, written as a record.
 """
