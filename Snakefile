@@ -56,6 +56,7 @@ rule all:
 onstart:
     # before a real run's first job: its stored inputs as recorded, no other run making its files, then the cost
     # of its plan (rules/common.smk)
+    refuse_unwritable_outputs()
     refuse_damaged_inputs()
     claim_the_plans_outputs()
     print_the_plans_cost()

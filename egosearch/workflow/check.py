@@ -206,3 +206,29 @@ def damaged_inputs_line(input_paths) -> str | None:
         if len(problems) > 1 else ""
     return (f"refusing to start: {problem}{more}; restore it with `git checkout -- {path}`, or rerun the job that "
             "writes it and then the `provenance` rule")
+
+
+def unwritable_outputs_line(output_paths) -> str | None:
+    """One line when a folder the plan writes in cannot be written (a read-only results/, mounted so or
+    chmod'ed for another user), naming it and the first file it would hold; None when every one can. Each
+    output's nearest existing folder is tried with a file made and removed there: what the job would do
+    (``os.access`` says yes on a read-only mount for root, and Snakemake failed with a traceback once the
+    run had started)."""
+    import tempfile
+
+    tried: dict[Path, str | None] = {}
+    for path in dict.fromkeys(str(p) for p in output_paths):  # outputs first, as the rule lists them
+        folder = Path(path).parent
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        if folder not in tried:
+            try:
+                with tempfile.TemporaryFile(dir=folder):
+                    pass
+                tried[folder] = None
+            except OSError as err:
+                tried[folder] = err.strerror or type(err).__name__
+        if tried[folder]:
+            return (f"refusing to start: {folder} cannot be written ({tried[folder]}), and this run writes {path} "
+                    "there; make it writable, or run from a checkout that is")
+    return None

@@ -71,6 +71,18 @@ wildcard_constraints:
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
 
 
+def refuse_unwritable_outputs():
+    """Before a real run's first job: every folder its jobs write in (outputs, logs, benchmarks) can be written
+    (egosearch.workflow.check.unwritable_outputs_line), else one line and exit 1."""
+    from egosearch.workflow.check import unwritable_outputs_line
+
+    line = unwritable_outputs_line(f for job in workflow.dag.needrun_jobs()
+                                   for f in [*job.output, *job.log, *([job.benchmark] if job.benchmark else [])])
+    if line:
+        print(line, file=sys.stderr)
+        sys.exit(1)
+
+
 def refuse_damaged_inputs():
     """Before a real run's first job: the stored files its jobs read must be the ones their provenance recorded
     (egosearch.workflow.check.damaged_inputs_line), else one line and exit 1, before anything is written."""
