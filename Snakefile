@@ -17,7 +17,7 @@ min_version("9.0")
 configfile: "egosearch/workflow/config.yaml"
 # A bad key or value, or a typo in a variant's name or file (its learner fields included), is one
 # line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
-CHECKED_VARIANTS = checked_variants(config)
+CHECKED_VARIANTS = checked_variants(config, command_line=workflow.config_settings.overwrite_config)
 validate(config, "egosearch/workflow/config.schema.json")
 if config.get("allow_long"):
     # the jobs' `egosearch train` and `demos` allow what the checks above allowed; their command lines stay as
