@@ -36,10 +36,10 @@ LONG_RUN_BOUNDS = {
     "eval_episodes": (10_000, "episodes a curve point (the most scenarios of one set, `egosearch scenarios --n`)"),
     "demo_episodes": (100_000, "demonstration episodes (about 67x the cpu profile's 1,500)"),
 }
-"""The most a training may ask for without ``--allow-long`` (``egosearch train``, ``demos``, ``evaluate
---curve-of``, ``variant check``) or ``--config allow_long=true`` (the workflow): beyond them a run takes weeks on
-any machine, so a value past one is taken for a typo (an extra zero) and refused before any work
-(:func:`egosearch.variants.check_run_length`)."""
+"""The most a training may ask for (``total_env_steps``, ``eval_episodes``, ``demo_episodes``) without
+``--allow-long`` (``egosearch train``, ``demos``, ``evaluate --curve-of``, ``variant check``) or ``--config
+allow_long=true`` (the workflow): beyond them a run takes weeks on any machine, so a value past one is taken
+for a typo (an extra zero) and refused before any work (:func:`egosearch.variants.check_run_length`)."""
 ALLOW_LONG_ENV = "EGOSEARCH_ALLOW_LONG"
 """Set to 1 in the environment, it allows what ``--allow-long`` allows: the workflow sets it for its jobs under
 ``--config allow_long=true`` (their command lines stay the same, so stored jobs are not rerun)."""
@@ -70,8 +70,7 @@ class RunSettings:
     """Table 2 "Number of training steps" 0.75M: environment steps (simulation samples, paper
     4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` profile trains 200k body
     steps, the 2-core budget's (see :func:`cpu_profile`); a modular searcher (``modular_searcher``) counts
-    decisions of several body steps instead (``head_on_modular``: 30k). At most 20,000,000 unless the run allows
-    more (``--allow-long``; :data:`LONG_RUN_BOUNDS`)."""
+    decisions of several body steps instead (``head_on_modular``: 30k)."""
     batch_size: int = 32
     """Table 2 "Batch-size": transitions per gradient update (also the CURL negatives + 1)."""
 
