@@ -71,8 +71,10 @@ def _resolve(name_or_path: str | Path, directory: Path) -> Path:
     candidate = Path(directory) / f"{name_or_path}.yaml"
     if not candidate.exists():
         names = variant_names(directory)
-        close = difflib.get_close_matches(str(name_or_path), names, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        # case-blind, as a name typed Head_On means head_on
+        lowered = {name.lower(): name for name in names}
+        close = difflib.get_close_matches(str(name_or_path).lower(), lowered, n=1)
+        hint = f" (did you mean {lowered[close[0]]!r}?)" if close else ""
         raise VariantError(f"variant={str(name_or_path)!r} is unknown{hint}; allowed: "
                            f"{', '.join(names)} (files in {_shown(Path(directory))})")
     return _shown(candidate)

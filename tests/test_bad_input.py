@@ -165,7 +165,8 @@ def test_a_bad_config_is_one_line_naming_the_key(suite, monkeypatch, capsys, ent
 @pytest.mark.parametrize("pairs, message", [
     ([["head_on", "head_on"]], "config claims_pairs: ['head_on', 'head_on'] is one searcher twice; a pair is [head "
                                "moving, head fixed]"),
-    ([["head_on", "head_of"]], re.compile(r"config claims_pairs: variant='head_of' is unknown; allowed: .*")),
+    ([["head_on", "head_of"]], re.compile(r"config claims_pairs: variant='head_of' is unknown \(did you mean "
+                                          r"'head_off'\?\); allowed: .*")),
     ([["head_on"]], re.compile(r"config claims_pairs/0: \['head_on'\] is too short")),
 ], ids=["one_searcher_twice", "variant_typo", "one_searcher"])
 def test_a_bad_claims_pair_is_one_line(suite, monkeypatch, capsys, pairs, message):
@@ -315,13 +316,15 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["evaluate", "--scenarios", "s.csv", "--policy", "oracle", "--out", "o.csv"],
          "egosearch evaluate: error: s.csv: no such scenario file"),
         (["train", "--variant", "hed_on", "--out-dir", str(tmp_path / "run")],
-         f"egosearch train: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch train: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
+         "ablations)"),
         (["train", "--variant", "head_on", "--profile", "fast", "--out-dir", str(tmp_path / "run")],
          "egosearch train: error: unknown profile 'fast'; allowed: smoke, cpu, paper"),
         (["train", "--variant", "head_on", "--max-wall-s", "0", "--out-dir", str(tmp_path / "run")],
          "egosearch train: error: --max-wall-s must be a positive number of seconds, got 0.0"),
         (["demos", "--variant", "hed_on", "--episodes", "5", "--out", str(tmp_path / "d.replay.npz")],
-         f"egosearch demos: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch demos: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
+         "ablations)"),
         (["demos", "--variant", "head_on", "--episodes", "0", "--out", str(tmp_path / "d.replay.npz")],
          "egosearch demos: error: --episodes=0: a number of episodes must be >= 1"),
         (["demos", "--variant", "head_on", "--episodes", "5", "--out", str(tmp_path / "d.npz")],
@@ -340,7 +343,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["variant", "new", "head_on"],
          "egosearch variant: error: ablations/head_on.yaml exists already; edit it, or choose another name"),
         (["variant", "check", "hed_on"],
-         f"egosearch variant: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch variant: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} "
+         "(files in ablations)"),
         (["report", "regenerate", "--profile", "fast"],
          "egosearch report: error: --profile='fast'; allowed: smoke, cpu, paper"),
         (["report", "fig6", str(tmp_path / "curve.csv"), "--out-prefix", str(tmp_path / "f6")],
@@ -1551,7 +1555,8 @@ ISSUE57_NEW_CASES = [
     ("variant_check_a_name_with_its_suffix", "clear", ["variant", "check", "head_on.yaml"],
      f"egosearch variant: error: head_on.yaml: no such file; {NOT_A_VARIANT}"),
     ("variant_check_capitalised", "clear", ["variant", "check", "Head_On"],
-     f"egosearch variant: error: variant='Head_On' is unknown; allowed: {ALLOWED} (files in ablations)"),
+     f"egosearch variant: error: variant='Head_On' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files "
+     "in ablations)"),
     ("evaluate_env_id_as_gymnasium_writes_it", "clear", [*EVALUATE, "--policy", "random", "--env-id",
                                                          "egosearch:EgoSearch-v0"],
      f"egosearch evaluate: error: --env-id='egosearch:EgoSearch-v0'; allowed: {ENV_IDS}"),
