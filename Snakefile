@@ -17,8 +17,12 @@ min_version("9.0")
 configfile: "egosearch/workflow/config.yaml"
 # A bad key or value, or a typo in a variant's name or file (its learner fields included), is one
 # line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
-CHECKED_VARIANTS = checked_variants(config)
+CHECKED_VARIANTS = checked_variants(config, command_line=workflow.config_settings.overwrite_config)
 validate(config, "egosearch/workflow/config.schema.json")
+if config.get("allow_long"):
+    # the jobs' `egosearch train` and `demos` allow what the checks above allowed; their command lines stay as
+    # they were, so that no stored job reruns for a changed command (egosearch.rl.run_settings.ALLOW_LONG_ENV)
+    os.environ["EGOSEARCH_ALLOW_LONG"] = "1"
 
 include: "egosearch/workflow/rules/common.smk"
 include: "egosearch/workflow/rules/scenarios.smk"
@@ -52,6 +56,7 @@ rule all:
 onstart:
     # before a real run's first job: its stored inputs as recorded, no other run making its files, then the cost
     # of its plan (rules/common.smk)
+    refuse_unwritable_outputs()
     refuse_damaged_inputs()
     claim_the_plans_outputs()
     print_the_plans_cost()

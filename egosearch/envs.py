@@ -41,12 +41,17 @@ def parse_env_options(pairs: list[str] | None) -> dict[str, bool]:
     """``--env-option key=value`` pairs -> the env's keyword arguments; one clear line for a key not in
     :data:`OBSERVATION_OPTIONS` or a value other than true/false."""
     out: dict[str, bool] = {}
+    given: dict[str, str] = {}
     for pair in pairs or []:
         key, sep, value = pair.partition("=")
         if not sep or key not in OBSERVATION_OPTIONS:
             raise ValueError(f"--env-option {pair!r}: KEY=true|false with KEY one of {', '.join(OBSERVATION_OPTIONS)}")
         if value.lower() not in ("true", "false", "1", "0"):
             raise ValueError(f"--env-option {pair!r}: the value is true or false, not {value!r}")
+        if key in given:
+            # argparse's append would let the last one win without a word
+            raise ValueError(f"--env-option {key} is given twice ({given[key]}, {pair}); give each option once")
+        given[key] = pair
         out[key] = value.lower() in ("true", "1")
     return out
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,8 +21,9 @@ import jsonschema
 import yaml
 
 from egosearch.core.schema_errors import schema_error
-from egosearch.envs import env_options, observed_env_id
+from egosearch.envs import EnvOptions, env_options, observed_env_id
 from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
+from egosearch.rl.run_settings import ALLOW_LONG_ENV, LONG_RUN_BOUNDS
 from egosearch.searchers import registry as searchers
 from egosearch.sim.home_pool import check_home_split
 
@@ -68,8 +70,13 @@ def _resolve(name_or_path: str | Path, directory: Path) -> Path:
                            "of an existing .yaml file")
     candidate = Path(directory) / f"{name_or_path}.yaml"
     if not candidate.exists():
-        raise VariantError(f"variant={str(name_or_path)!r} is unknown; allowed: "
-                           f"{', '.join(variant_names(directory))} (files in {_shown(Path(directory))})")
+        names = variant_names(directory)
+        # case-blind, as a name typed Head_On means head_on
+        lowered = {name.lower(): name for name in names}
+        close = difflib.get_close_matches(str(name_or_path).lower(), lowered, n=1)
+        hint = f" (did you mean {lowered[close[0]]!r}?)" if close else ""
+        raise VariantError(f"variant={str(name_or_path)!r} is unknown{hint}; allowed: "
+                           f"{', '.join(names)} (files in {_shown(Path(directory))})")
     return _shown(candidate)
 
 
@@ -113,9 +120,10 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
                            f"same folders: name the variant otherwise (taken: {', '.join(searchers.names())})")
     _check_objects(data["train_env"].get("objects") or [], path)
     _check_homes(data["train_env"], path)
+    overrides = _learner_overrides(data.get("config") or {}, path)
+    _check_env_id_agrees(data["env_id"], overrides, path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),
-                   config=_learner_overrides(data.get("config") or {}, path),
-                   description=data.get("description", ""), path=str(path))
+                   config=overrides, description=data.get("description", ""), path=str(path))
 
 
 @dataclass(frozen=True)
@@ -156,11 +164,34 @@ def variant_head(variant: str | Path | Variant) -> bool:
     return env_options(variant.env_id).head
 
 
-def check_learner_config(variant: Variant, learner_profile: str) -> None:
+ALLOW_LONG_CLI, ALLOW_LONG_WORKFLOW = "--allow-long", "--config allow_long=true"
+"""What allows a run past :data:`egosearch.rl.run_settings.LONG_RUN_BOUNDS`: the commands' flag, the workflow's."""
+
+
+def long_runs_allowed(flag: bool = False) -> bool:
+    """``--allow-long`` given, or the workflow's jobs under ``--config allow_long=true`` (its environment)."""
+    return bool(flag) or os.environ.get(ALLOW_LONG_ENV) == "1"
+
+
+def check_run_length(config: LearnerConfig, flag: str = ALLOW_LONG_CLI) -> None:
+    """One line (``ValueError``) for a config past a bound of ``LONG_RUN_BOUNDS``, naming ``flag``, which allows
+    more."""
+    for name, (bound, what) in LONG_RUN_BOUNDS.items():
+        value = getattr(config, name, None)
+        if isinstance(value, int) and value > bound:
+            raise ValueError(f"LearnerConfig.{name}={value} is out of range; allowed: <= {bound:,} {what}, the "
+                             f"documented bound; {flag} allows more")
+
+
+def check_learner_config(variant: Variant, learner_profile: str, allow_long: bool = False,
+                         flag: str = ALLOW_LONG_CLI) -> None:
     """The variant's overrides on top of ``learner_profile`` give a valid learner config (ranges and
-    cross-field rules such as ``crop_size <= image_size``), else one-line ``VariantError``."""
+    cross-field rules such as ``crop_size <= image_size``) within the documented bounds of a run's length
+    unless ``allow_long`` (:func:`check_run_length`, naming ``flag``), else one-line ``VariantError``."""
     try:
-        resolve_variant(variant, learner_profile)
+        resolved = resolve_variant(variant, learner_profile)
+        if not long_runs_allowed(allow_long):
+            check_run_length(resolved.config, flag)
     except ValueError as err:
         raise VariantError(f"{variant.path or variant.name}: config (on the {learner_profile} learner profile): "
                            f"{err}") from None
@@ -199,6 +230,34 @@ def _learner_overrides(config: dict, path: Path) -> dict:
             raise VariantError(f"{path}: config: {key}={value!r} is not a finite number")
         out[key] = value
     return out
+
+
+def _check_env_id_agrees(env_id: str, config: dict, path: Path) -> None:
+    """The variant's ``config`` does not turn off what its ``env_id`` names: ``observed_env_id`` adds the memory
+    or the decisions of a field set true, but never takes away those of the id, so a memory id with
+    ``target_memory: false`` trained with the memory while ``config show`` said false."""
+    try:
+        options = env_options(env_id)
+    except ValueError:
+        return  # an env of the user's own: the two fields cannot change it (observed_env_id)
+    memory = options.target_memory or options.floor_map
+    plain = EnvOptions(head=options.head).env_id  # the body env of the same head, with neither
+    contradictions = []
+    if memory and config.get("target_memory") is False:
+        contradictions.append(("target_memory: false", "observes the last-seen target memory",
+                               f"target_memory: true or leave it out, or env_id {plain}"))
+    if memory and config.get("modular_searcher") is True:
+        contradictions.append(("modular_searcher: true", "is a body env (the policy acts at every body step)",
+                               f"leave modular_searcher out, or env_id {plain}"))
+    if options.modular and config.get("modular_searcher") is False:
+        contradictions.append(("modular_searcher: false", "is a modular searcher's decision env",
+                               f"modular_searcher: true or leave it out, or env_id {plain}"))
+    if options.modular and config.get("target_memory") is True:
+        contradictions.append(("target_memory: true", "is a modular searcher's decision env, which has no target "
+                               "memory", "target_memory: false or leave it out"))
+    if contradictions:
+        setting, what, allowed = contradictions[0]
+        raise VariantError(f"{path}: config: {setting} contradicts env_id: {env_id}, which {what}; allowed: {allowed}")
 
 
 def _check_homes(train_env: dict, path: Path) -> None:

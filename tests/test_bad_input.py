@@ -91,10 +91,10 @@ BAD_VARIANT_FILES = [
 
 # (--config entries, the one line) of `snakemake -n all`.
 BAD_CONFIGS = [
-    (["variants=[head_on,hed_off]"], "config variants: variant='hed_off' is unknown; allowed: {allowed} (files in "
-                                     "ablations)"),
-    (["reference_variant=hed_on"], "config reference_variant: variant='hed_on' is unknown; allowed: {allowed} (files "
-                                   "in ablations)"),
+    (["variants=[head_on,hed_off]"], "config variants: variant='hed_off' is unknown (did you mean 'head_off'?); "
+                                     "allowed: {allowed} (files in ablations)"),
+    (["reference_variant=hed_on"], "config reference_variant: variant='hed_on' is unknown (did you mean "
+                                   "'head_on'?); allowed: {allowed} (files in ablations)"),
     (["variant=nope"], "config variant: variant='nope' is unknown; allowed: {allowed} (files in ablations)"),
     (["heights=[7.0]"], "config heights/0: 7.0 is greater than the maximum of 2.0"),
     (["heights=[tall]"], "config heights/0: 'tall' is not of type 'number'"),
@@ -125,7 +125,8 @@ def suite(tmp_path_factory):
     shutil.copytree(REPO / "ablations", dest / "ablations")
     if (REPO / "profiles").is_dir():
         shutil.copytree(REPO / "profiles", dest / "profiles")
-    for stem, text, _ in BAD_VARIANT_FILES + [(stem, text, line) for stem, _, text, line in ISSUE57_VARIANT_FILES]:
+    for stem, text, _ in (BAD_VARIANT_FILES + [(stem, text, line) for stem, _, text, line in ISSUE57_VARIANT_FILES]
+                          + [(stem, text, line) for stem, _, text, line in ISSUE73_VARIANT_FILES]):
         (dest / "ablations" / f"{stem}.yaml").write_text(text.replace("NAME", stem))
     return dest
 
@@ -164,7 +165,8 @@ def test_a_bad_config_is_one_line_naming_the_key(suite, monkeypatch, capsys, ent
 @pytest.mark.parametrize("pairs, message", [
     ([["head_on", "head_on"]], "config claims_pairs: ['head_on', 'head_on'] is one searcher twice; a pair is [head "
                                "moving, head fixed]"),
-    ([["head_on", "head_of"]], re.compile(r"config claims_pairs: variant='head_of' is unknown; allowed: .*")),
+    ([["head_on", "head_of"]], re.compile(r"config claims_pairs: variant='head_of' is unknown \(did you mean "
+                                          r"'head_off'\?\); allowed: .*")),
     ([["head_on"]], re.compile(r"config claims_pairs/0: \['head_on'\] is too short")),
 ], ids=["one_searcher_twice", "variant_typo", "one_searcher"])
 def test_a_bad_claims_pair_is_one_line(suite, monkeypatch, capsys, pairs, message):
@@ -314,13 +316,15 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["evaluate", "--scenarios", "s.csv", "--policy", "oracle", "--out", "o.csv"],
          "egosearch evaluate: error: s.csv: no such scenario file"),
         (["train", "--variant", "hed_on", "--out-dir", str(tmp_path / "run")],
-         f"egosearch train: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch train: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
+         "ablations)"),
         (["train", "--variant", "head_on", "--profile", "fast", "--out-dir", str(tmp_path / "run")],
          "egosearch train: error: unknown profile 'fast'; allowed: smoke, cpu, paper"),
         (["train", "--variant", "head_on", "--max-wall-s", "0", "--out-dir", str(tmp_path / "run")],
          "egosearch train: error: --max-wall-s must be a positive number of seconds, got 0.0"),
         (["demos", "--variant", "hed_on", "--episodes", "5", "--out", str(tmp_path / "d.replay.npz")],
-         f"egosearch demos: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch demos: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
+         "ablations)"),
         (["demos", "--variant", "head_on", "--episodes", "0", "--out", str(tmp_path / "d.replay.npz")],
          "egosearch demos: error: --episodes=0: a number of episodes must be >= 1"),
         (["demos", "--variant", "head_on", "--episodes", "5", "--out", str(tmp_path / "d.npz")],
@@ -339,7 +343,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["variant", "new", "head_on"],
          "egosearch variant: error: ablations/head_on.yaml exists already; edit it, or choose another name"),
         (["variant", "check", "hed_on"],
-         f"egosearch variant: error: variant='hed_on' is unknown; allowed: {ALLOWED} (files in ablations)"),
+         f"egosearch variant: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} "
+         "(files in ablations)"),
         (["report", "regenerate", "--profile", "fast"],
          "egosearch report: error: --profile='fast'; allowed: smoke, cpu, paper"),
         (["report", "fig6", str(tmp_path / "curve.csv"), "--out-prefix", str(tmp_path / "f6")],
@@ -1112,6 +1117,11 @@ def bad(tmp_path_factory):
     copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
          "copy/cand/seed0/kitchen_living/everywhere/h1.05.csv")
     write("seed_in.yaml", (HEAD.replace("NAME", "seed_in") + "config: {seed: 5}\n").encode())
+    # issue 73: variant files past the bounds of a run's length or at odds with their env id, a ';' scenario CSV
+    for stem, _, text, _ in ISSUE73_VARIANT_FILES:
+        write(f"{stem}.yaml", text.replace("NAME", stem).encode())
+    write("semicolon.csv", (REPO / "results/cpu/scenarios/kitchen_living/everywhere/h1.05.csv").read_text()
+          .replace(",", ";").encode())
     write("objects_empty.yaml", HEAD.replace("NAME", "objects_empty").replace("everywhere}", "everywhere, objects: []}")
           .encode())
     # the same scenario ids with other ℓ: another scenario set of the same names
@@ -1545,7 +1555,8 @@ ISSUE57_NEW_CASES = [
     ("variant_check_a_name_with_its_suffix", "clear", ["variant", "check", "head_on.yaml"],
      f"egosearch variant: error: head_on.yaml: no such file; {NOT_A_VARIANT}"),
     ("variant_check_capitalised", "clear", ["variant", "check", "Head_On"],
-     f"egosearch variant: error: variant='Head_On' is unknown; allowed: {ALLOWED} (files in ablations)"),
+     f"egosearch variant: error: variant='Head_On' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files "
+     "in ablations)"),
     ("evaluate_env_id_as_gymnasium_writes_it", "clear", [*EVALUATE, "--policy", "random", "--env-id",
                                                          "egosearch:EgoSearch-v0"],
      f"egosearch evaluate: error: --env-id='egosearch:EgoSearch-v0'; allowed: {ENV_IDS}"),
@@ -1820,3 +1831,359 @@ def test_issue_58s_cluster_rows_are_one_line_before_any_job(case, suite, slurm_p
              if line.strip() and line not in (*NOTICES, SLURM_NOTICE)]
     assert out.returncode == 1 and lines == [message], (out.stdout + out.stderr)[-3000:]
     assert not (suite / "results" / "smoke").exists()      # no job ran
+
+
+# --------------------------------------------------------------------------- issue 73: values that cannot be meant
+# The form of issue 57's tables: (id, what it did before the fix, the input, the one line now). Items 5 and 7: a
+# run past the documented bounds of its length (egosearch.rl.run_settings.LONG_RUN_BOUNDS; --allow-long, --config
+# allow_long=true), a variant whose config contradicts its env id, an env option given twice or to a searcher that
+# ignores it, a ';'-separated scenario file, a config shown for a learner the variant does not train with, an
+# unknown variant's near name. Item 8: claims pairs (Figure 6's and versus_teacher's first pair), the seed spread's
+# and screen's seeds, the budget study, Figure 6's curves and levels.
+STEPS_BOUND = "<= 20,000,000 env steps (about 27x Table 2's 750,000), the documented bound"
+CURVE_BOUND = ("<= 10,000 episodes a curve point (the most scenarios of one set, `egosearch scenarios --n`), the "
+               "documented bound")
+DEMOS_BOUND = "<= 100,000 demonstration episodes (about 67x the cpu profile's 1,500), the documented bound"
+MEMORY_OFF = ("config: target_memory: false contradicts env_id: EgoSearchMemory-v0, which observes the last-seen "
+              "target memory; allowed: target_memory: true or leave it out, or env_id EgoSearch-v0")
+# (file stem, before, text, the one line of the workflow's check with variant=stem): in the `suite` and `bad`
+# fixtures' files
+ISSUE73_VARIANT_FILES = [
+    ("long_steps", "silent", HEAD + "config: {total_env_steps: 1000000000000}\n",  # "about 10205001.1 h", then ran
+     "ablations/long_steps.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=1000000000000 is "
+     f"out of range; allowed: {STEPS_BOUND}; --config allow_long=true allows more"),
+    ("long_curve", "silent", HEAD + "config: {eval_episodes: 20000}\n",
+     "ablations/long_curve.yaml: config (on the cpu learner profile): LearnerConfig.eval_episodes=20000 is out of "
+     f"range; allowed: {CURVE_BOUND}; --config allow_long=true allows more"),
+    ("long_demos", "silent", HEAD + "config: {demo_episodes: 1000000}\n",
+     "ablations/long_demos.yaml: config (on the cpu learner profile): LearnerConfig.demo_episodes=1000000 is out of "
+     f"range; allowed: {DEMOS_BOUND}; --config allow_long=true allows more"),
+    # variant check said valid, config show said False, and the training observed the memory
+    ("memory_off", "silent", HEAD.replace("EgoSearch-v0", "EgoSearchMemory-v0") + "config: {target_memory: false}\n",
+     f"ablations/memory_off.yaml: {MEMORY_OFF}"),
+    ("modular_off", "silent", HEAD.replace("EgoSearch-v0", "EgoSearchModular-v0")
+     + "config: {modular_searcher: false, target_memory: false}\n",
+     "ablations/modular_off.yaml: config: modular_searcher: false contradicts env_id: EgoSearchModular-v0, which is "
+     "a modular searcher's decision env; allowed: modular_searcher: true or leave it out, or env_id EgoSearch-v0"),
+    # a line about target_memory, which the file never set (the cpu profile's), or at smoke the map dropped
+    ("map_modular", "cryptic", HEAD.replace("EgoSearch-v0", "EgoSearchMap-v0") + "config: {modular_searcher: true}\n",
+     "ablations/map_modular.yaml: config: modular_searcher: true contradicts env_id: EgoSearchMap-v0, which is a "
+     "body env (the policy acts at every body step); allowed: leave modular_searcher out, or env_id EgoSearch-v0"),
+]
+F6 = ["report", "fig6", "results/cpu/train/head_on/seed0/curve.csv"]
+LEVEL = "results/cpu/eval_curve/frontier/head_on.csv"
+ISSUE73_CASES = [
+    ("train_past_the_steps_bound", "silent", ["train", "--variant", "{t}/long_steps.yaml", "--out-dir", "{t}/r73"],
+     "egosearch train: error: {t}/long_steps.yaml: config (on the cpu learner profile): "
+     f"LearnerConfig.total_env_steps=1000000000000 is out of range; allowed: {STEPS_BOUND}; --allow-long allows more"),
+    ("demos_past_the_episodes_bound", "silent",
+     ["demos", "--variant", "head_on", "--episodes", "1000000", "--out", "{t}/d73.replay.npz"],
+     f"egosearch demos: error: --episodes=1000000 is out of range; allowed: {DEMOS_BOUND}; --allow-long allows more"),
+    ("demos_of_a_variant_past_the_episodes_bound", "silent",
+     ["demos", "--variant", "{t}/long_demos.yaml", "--out", "{t}/d73.replay.npz"],
+     "egosearch demos: error: {t}/long_demos.yaml: config (on the cpu learner profile): "
+     f"LearnerConfig.demo_episodes=1000000 is out of range; allowed: {DEMOS_BOUND}; --allow-long allows more"),
+    ("evaluate_a_curve_past_the_episodes_bound", "silent",
+     ["evaluate", "--curve-of", "{t}/long_curve.yaml", "--policy", "random", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: {t}/long_curve.yaml: config (on the cpu learner profile): "
+     f"LearnerConfig.eval_episodes=20000 is out of range; allowed: {CURVE_BOUND}; --allow-long allows more"),
+    ("variant_check_a_memory_id_with_the_memory_off", "silent", ["variant", "check", "{t}/memory_off.yaml"],
+     f"egosearch variant: error: {{t}}/memory_off.yaml: {MEMORY_OFF}"),
+    ("config_show_a_memory_id_with_the_memory_off", "silent",
+     ["config", "show", "sac_drq", "--variant", "{t}/memory_off.yaml"],
+     f"egosearch config: error: {{t}}/memory_off.yaml: {MEMORY_OFF}"),
+    ("train_a_memory_id_with_the_memory_off", "silent",
+     ["train", "--variant", "{t}/memory_off.yaml", "--out-dir", "{t}/r73"],
+     f"egosearch train: error: {{t}}/memory_off.yaml: {MEMORY_OFF}"),
+    ("evaluate_env_option_twice", "silent",  # the last one won
+     [*EVALUATE, "--weights", HEAD_ON_ACTOR, "--env-option", "contact_signal=true", "--env-option",
+      "contact_signal=false"],
+     "egosearch evaluate: error: --env-option contact_signal is given twice (contact_signal=true, "
+     "contact_signal=false); give each option once"),
+    ("evaluate_env_option_to_the_oracle", "silent",
+     [*EVALUATE, "--policy", "oracle", "--env-option", "contact_signal=true"],
+     "egosearch evaluate: error: --env-option contact_signal: --policy oracle would ignore it (it reads no "
+     "observation option: it acts on the env's own state, not on the policy's observation); leave --env-option out, "
+     "or give it with --policy actor"),
+    ("evaluate_env_option_to_the_tuned_searcher", "silent",
+     [*EVALUATE, "--policy", "frontier_tuned", "--env-option", "contact_signal=false"],
+     "egosearch evaluate: error: --env-option contact_signal: --policy frontier_tuned would ignore it (it reads no "
+     "observation option: it acts on the env's own state, not on the policy's observation); leave --env-option out, "
+     "or give it with --policy actor"),
+    ("evaluate_scenarios_separated_by_semicolons", "cryptic",  # "missing columns" listed all 13
+     ["evaluate", "--scenarios", "{t}/semicolon.csv", "--policy", "oracle", "--out", "{t}/o.csv"],
+     "egosearch evaluate: error: {t}/semicolon.csv is separated by ';', not ','; a scenario CSV is comma-separated, "
+     "as `egosearch scenarios` writes it"),
+    ("config_show_a_variant_of_another_learner", "silent",  # a SAC+CURL table for a SAC-DrQ training
+     ["config", "show", "sac_curl", "--profile", "cpu", "--variant", "head_on"],
+     "egosearch config: error: --variant head_on trains algorithm sac_drq at the cpu profile (the profile's "
+     "learner), not sac_curl: show that one (egosearch config show sac_drq --profile cpu --variant head_on)"),
+    ("train_a_variant_typo", "clear", ["train", "--variant", "hed_on", "--out-dir", "{t}/r73"],
+     f"egosearch train: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
+     "ablations)"),
+    ("fig6_level_given_twice", "silent", [*F6, "--levels", LEVEL, LEVEL, "--out-prefix", "{t}/f6"],
+     f"egosearch report: error: --levels: {LEVEL} is given twice; give each searcher's level once"),
+    ("fig6_two_levels_of_one_searcher", "silent",
+     [*F6, "--levels", LEVEL, "{t}/lv/eval_curve/frontier/head_on.csv", "--out-prefix", "{t}/f6"],
+     f"egosearch report: error: --levels: {LEVEL} and {{t}}/lv/eval_curve/frontier/head_on.csv are both frontier's "
+     "level; give each searcher's level once"),
+    ("fig6_curve_given_twice", "cryptic",  # "a scenario appears twice for the same seed"
+     [*F6, F6[2], "--levels", LEVEL, "--out-prefix", "{t}/f6"],
+     f"egosearch report: error: the curve files: {F6[2]} is given twice; give each seed's curve once"),
+    ("fig6_level_of_another_variants_curve", "silent",
+     ["report", "fig6", "results/cpu/train/head_off/seed0/curve.csv", "--levels", LEVEL, "--out-prefix", "{t}/f6"],
+     f"egosearch report: error: --levels: {LEVEL} is frontier's level on head_on's curve scenarios, and the curves are "
+     "head_off's; give the level of a variant they draw (.../eval_curve/frontier/head_off.csv)"),
+]
+
+
+def _profile(name: str, **changes) -> dict:
+    """The workflow config's ``profiles`` with ``changes`` in profile ``name`` (``budget`` merged)."""
+    profiles = config()["profiles"]
+    profile = dict(profiles[name])
+    for key, value in changes.items():
+        profile[key] = {**profile.get(key, {}), **value} if key == "budget" else value
+    return {"profiles": {**profiles, name: profile}}
+
+
+BIG = 2**32
+SEED_BOUND = "is out of range; allowed: a training seed <= 2**32 - 1 = 4294967295 (numpy's global seed is 32-bit)"
+# (id, before, --config changes, target, the one line): `checked_variants`, as ISSUE48_CONFIGS
+ISSUE73_CONFIGS = [
+    ("claims_first_pair_classical", "traceback",  # VariantError in common.smk, whatever the target
+     {"profile": "smoke", "claims_pairs": [["frontier", "frontier_head_off"]]}, "versus_teacher",
+     "config claims_pairs: the first pair ['frontier', 'frontier_head_off'] is Figure 6's and versus_teacher's, which "
+     "read its trainings: name variants there (e.g. [head_on, head_off]) and the classical searchers in a later pair"),
+    ("claims_pair_backwards", "silent", {"claims_pairs": [["head_off", "head_on"]]}, "versus_teacher",
+     "config claims_pairs: ['head_off', 'head_on'] is head_off (head fixed), head_on (head moving); a pair is [head "
+     "moving, head fixed]"),
+    ("claims_pair_of_one_head", "silent", {"claims_pairs": [["head_on", "head_on_25px"]]}, "behaviour",
+     "config claims_pairs: ['head_on', 'head_on_25px'] is head_on (head moving), head_on_25px (head moving); a pair "
+     "is [head moving, head fixed]"),
+    ("claims_classical_pair_backwards", "silent",
+     {"claims_pairs": [["head_on", "head_off"], ["frontier_head_off", "frontier"]]}, "behaviour",
+     "config claims_pairs: ['frontier_head_off', 'frontier'] is frontier_head_off (head fixed), frontier (head "
+     "moving); a pair is [head moving, head fixed]"),
+    ("screen_seeds_past_numpys_seed", "cryptic",  # the DAG ran; the fifth training failed in its job
+     {"variant": "head_off", "screen_seed": BIG - 1}, "screen",
+     f"config screen_seed: {BIG - 1} with screen_seeds=5 trains seeds up to {BIG + 3}, which {SEED_BOUND}"),
+    ("profile_seed_past_numpys_seed", "cryptic", _profile("smoke", seeds=[BIG]), "all",
+     f"config profiles/smoke/seeds: {BIG} {SEED_BOUND}"),
+    ("spread_seed_past_numpys_seed", "cryptic", _profile("cpu", spread_seeds=[0, BIG]), "seed_spread",
+     f"config profiles/cpu/spread_seeds: {BIG} {SEED_BOUND}"),
+    ("budget_seed_past_numpys_seed", "cryptic", _profile("cpu", budget={"seeds": [BIG]}), "budget",
+     f"config profiles/cpu/budget/seeds: {BIG} {SEED_BOUND}"),
+    ("budget_reference_among_its_settings", "silent",  # its seed-0 run stood in for the setting's, unsaid
+     _profile("cpu", budget={"variants": ["head_on_from_scratch", "head_on_25px"]}), "budget",
+     "config profiles/cpu/budget/variants: 'head_on_from_scratch' is the study's own setting (budget/reference), "
+     "read against itself; leave it out of variants (its runs are the profile's seeds already)"),
+    ("budget_reference_variant_among_the_settings", "silent",
+     {"profile": "smoke", **_profile("smoke", budget={"variants": ["head_on"]})}, "budget",
+     "config profiles/smoke/budget/variants: 'head_on' is the study's own setting (reference_variant), read against "
+     "itself; leave it out of variants (its runs are the profile's seeds already)"),
+]
+COUNTS_BEFORE_73 = {"clear": 1, "cryptic": 8, "traceback": 2, "silent": 27, "damage": 0}
+"""What the rows above did before the fix (with the Slurm and read-only rows below); after it each is one clear
+line before any work."""
+
+
+def test_issue_73s_counts_before():
+    rows = ([c[:2] for c in ISSUE73_CASES] + [c[:2] for c in ISSUE73_CONFIGS] + [c[:2] for c in ISSUE73_VARIANT_FILES]
+            + [c[:2] for c in ISSUE73_SNAKEMAKE] + [("results_read_only", "traceback"),
+                                                   ("claims_pairs_a_profile_overrides", "silent")])
+    before = dict.fromkeys(BEFORE_KINDS_48, 0)
+    for _, kind in rows:
+        before[kind] += 1
+    assert before == COUNTS_BEFORE_73
+    names = [name for name, _ in rows + issue57_rows()] + [c[0] for c in CLI_CASES + ISSUE58_SNAKEMAKE]
+    assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("case", ISSUE73_CASES, ids=[c[0] for c in ISSUE73_CASES])
+def test_issue_73s_commands_are_one_clear_line(case, bad, capsys, monkeypatch, nothing_runs):
+    monkeypatch.delenv("EGOSEARCH_ALLOW_LONG", raising=False)
+    level = bad / "lv/eval_curve/frontier/head_on.csv"
+    if not level.exists():
+        level.parent.mkdir(parents=True)
+        shutil.copy2(REPO / LEVEL, level)
+    test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, monkeypatch, nothing_runs)
+
+
+@pytest.mark.parametrize("case", ISSUE73_CONFIGS, ids=[c[0] for c in ISSUE73_CONFIGS])
+def test_issue_73s_configs_are_one_line(case, suite, monkeypatch, capsys):
+    test_a_config_naming_no_variant_names_its_key(case, suite, monkeypatch, capsys)
+
+
+@pytest.mark.parametrize("case", ISSUE73_VARIANT_FILES, ids=[c[0] for c in ISSUE73_VARIANT_FILES])
+def test_issue_73s_variant_files_are_one_line_in_the_workflow(case, suite, monkeypatch, capsys):
+    monkeypatch.delenv("EGOSEARCH_ALLOW_LONG", raising=False)
+    test_issue_57s_variant_files_list_the_allowed_keys(case, suite, monkeypatch, capsys)
+
+
+def test_claims_pairs_a_profile_overrides_are_one_line(suite, monkeypatch, capsys):
+    """`--config claims_pairs=...` at the cpu profile, which names its own: they were ignored without a word."""
+    monkeypatch.chdir(suite)
+    pairs = [["head_on", "head_off"]]
+    with pytest.raises(SystemExit) as stop:
+        checked_variants(config(claims_pairs=pairs), argv=["behaviour"], directory=suite / "ablations",
+                         command_line={"claims_pairs": pairs})
+    assert stop.value.code == 1 and capsys.readouterr().err == (
+        "egosearch: error: config claims_pairs: the cpu profile names its own (profiles/cpu/claims_pairs in "
+        "egosearch/workflow/config.yaml), which the run reads instead of the top level's; edit that one, or run "
+        "another profile\n")
+    checked_variants(config(claims_pairs=pairs, profile="smoke"), argv=["behaviour"], directory=suite / "ablations",
+                     command_line={"claims_pairs": pairs})
+
+
+def test_a_long_run_is_taken_when_allowed(suite, bad, monkeypatch, capsys):
+    """--allow-long, --config allow_long=true (as Snakemake hands it over: a string) and the environment the
+    workflow gives its jobs each allow what the bounds refuse."""
+    monkeypatch.delenv("EGOSEARCH_ALLOW_LONG", raising=False)
+    monkeypatch.chdir(suite)
+    assert "long_steps" in checked_variants(config(variant="long_steps", allow_long="true"), argv=["compare"],
+                                            directory=suite / "ablations")
+    monkeypatch.chdir(REPO)
+    long_steps = str(bad / "long_steps.yaml")
+    assert main(["variant", "check", long_steps, "--profile", "cpu", "--allow-long"]) == 0
+    monkeypatch.setenv("EGOSEARCH_ALLOW_LONG", "1")
+    assert main(["variant", "check", long_steps, "--profile", "cpu"]) == 0
+    assert capsys.readouterr().out.count("valid at the cpu learner profile") == 2
+
+
+def test_a_stored_variant_is_within_the_bounds(monkeypatch):
+    """Every variant the suite ships trains within the documented bounds at every profile it runs at."""
+    from egosearch.variants import check_learner_config
+
+    monkeypatch.delenv("EGOSEARCH_ALLOW_LONG", raising=False)
+    for name in variant_names(REPO / "ablations"):
+        check_learner_config(load_variant(name, REPO / "ablations"), "cpu")
+
+
+@pytest.mark.parametrize("doc, first", [
+    ("Paper 4.1: 1.0, i.e. the camera height is drawn from [1.0, 1.8] m. Otherwise more.",
+     "Paper 4.1: 1.0, i.e. the camera height is drawn from [1.0, 1.8] m."),
+    ('Paper eq. 2 text: "distance" = r_d. "progress" = the decrease.', 'Paper eq. 2 text: "distance" = r_d.'),
+    ("PIRLNav (Ramrakhya et al. 2023: the critic first. Then the actor): the first updates. More.",
+     "PIRLNav (Ramrakhya et al. 2023: the critic first. Then the actor): the first updates."),
+    ("A rate of 0.5 per step. The rest.", "A rate of 0.5 per step."),
+    ("No full stop", "No full stop."),
+], ids=["i.e.", "eq.", "et al. in brackets", "decimal point", "no stop"])
+def test_config_show_gives_a_fields_whole_first_sentence(doc, first):
+    from egosearch.rl.config import first_sentence
+
+    assert first_sentence(doc) == first
+
+
+def test_config_show_cuts_no_field_at_an_abbreviation():
+    from egosearch.rl.config import config_sources
+
+    for algorithm in ("sac_drq", "sac_curl"):
+        for row in config_sources(algorithm, "cpu"):
+            assert not row["doc"].endswith(("i.e.", "e.g.", "eq.", "al.")), row
+
+
+# (id, before, the snakemake arguments after -n, how the profile copy is spoiled, the one line): the Slurm profile,
+# copied into the suite and edited, as tests/test_cluster.py runs it
+ISSUE73_SNAKEMAKE = [
+    ("slurm_mem_mb_a_word", "cryptic",  # "Exception ignored in atexit callback ... ResourceConversionError", exit 0
+     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "profile=smoke"],
+     ("mem_mb: 1000", "mem_mb: lots"),
+     "egosearch: error: --default-resources mem_mb=lots: not a number; allowed: a number of megabytes > 0 (e.g. "
+     "mem_mb=1000)"),
+    ("slurm_runtime_zero", "silent",  # the plan's sbatch had no -t
+     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "profile=smoke"], ("runtime: 30", "runtime: 0"),
+     "egosearch: error: --default-resources runtime=0: a job would ask for no time limit (sbatch without -t); "
+     "allowed: a number of minutes > 0"),
+    ("slurm_profile_under_the_default_one", "silent",  # profiles/default's jobs: 2 capped the 100
+     ["table2", "--profile", "profiles/slurm73", "--config", "profile=smoke"], None,
+     "egosearch: error: --profile profiles/slurm73: Snakemake reads the workflow profile profiles/default on top of "
+     "it, and its jobs: 2 overrides the jobs: 100 of profiles/slurm73; use --workflow-profile profiles/slurm73 "
+     "instead (it replaces profiles/default; docs/running.md)"),
+]
+
+
+@pytest.mark.parametrize("case", ISSUE73_SNAKEMAKE, ids=[c[0] for c in ISSUE73_SNAKEMAKE])
+def test_issue_73s_slurm_rows_are_one_line_before_any_job(case, suite, slurm_paths):
+    _, _, args, spoil, message = case
+    profile = suite / "profiles" / "slurm73"
+    shutil.rmtree(profile, ignore_errors=True)
+    shutil.copytree(REPO / "profiles" / "slurm", profile)
+    if spoil:
+        text = (profile / "config.yaml").read_text()
+        assert spoil[0] in text
+        (profile / "config.yaml").write_text(text.replace(spoil[0], spoil[1]))
+    out = subprocess.run([sys.executable, "-m", "snakemake", "-n", *args], cwd=suite, capture_output=True, text=True,
+                         timeout=600, env={**os.environ, "PATH": slurm_paths["no slurm"]})
+    lines = [line for line in (out.stdout + out.stderr).splitlines() if line.strip() and line not in NOTICES
+             and not line.startswith("Using ")]
+    assert out.returncode == 1 and lines == [message], (out.stdout + out.stderr)[-3000:]
+
+
+def test_the_resource_check_passes_what_snakemake_reads():
+    from egosearch.workflow.cluster import resource_problem
+
+    assert resource_problem(["mem_mb=1000", "runtime=30", "tmpdir=system_tmpdir", "slurm_partition=gpu"], {}) is None
+    assert resource_problem(["mem_mb=2 * attempt * 1000", "runtime='1h'"], {"train": {"runtime": 720}}) is None
+    assert resource_problem([], {"train": {"mem_mb": "-5"}}) == (
+        "--set-resources train:mem_mb=-5: a job would ask for no memory (or disk) at all; allowed: a number of "
+        "megabytes > 0")
+
+
+def test_a_profile_given_with_the_workflow_profile_or_clashing_nowhere_passes(tmp_path):
+    from egosearch.workflow.cluster import profile_mix_problem
+
+    (tmp_path / "default").mkdir()
+    (tmp_path / "default" / "config.yaml").write_text("jobs: 2\nrerun-incomplete: true\n")
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "config.yaml").write_text("rerun-incomplete: true\nlatency-wait: 5\n")
+    default = tmp_path / "default"
+    assert profile_mix_problem([str(tmp_path / "mine")], None, default) is None
+    assert profile_mix_problem(["profiles/slurm"], "profiles/slurm", default) is None
+    assert profile_mix_problem(None, None, default) is None
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs /proc (a location nobody may write in)")
+def test_an_output_folder_nobody_may_write_in_is_one_line(tmp_path):
+    """Tried by making a file there: root may write in a folder chmod'ed read-only, never in /proc (nor on a
+    read-only mount, the test below)."""
+    from egosearch.workflow.check import unwritable_outputs_line
+
+    assert unwritable_outputs_line([tmp_path / "results/smoke/x.csv"]) is None
+    line = unwritable_outputs_line(["/proc/results/smoke/scenarios/x.csv", tmp_path / "y.csv"])
+    assert line.startswith("refusing to start: /proc cannot be written (") and line.endswith(
+        "), and this run writes /proc/results/smoke/scenarios/x.csv there; make it writable, or run from a checkout "
+        "that is")
+
+
+def test_a_read_only_results_folder_is_one_line_before_the_first_job(suite, tmp_path):
+    """results/ on a read-only mount (root writes anywhere else): the run used to stop in its first job with
+    Snakemake's "Failed to create output directory ... OSError: [Errno 30] Read-only file system"."""
+    results = suite / "results"
+    results.mkdir(exist_ok=True)
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=1m", "tmpfs", str(results)],
+                             capture_output=True, text=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a read-only folder here: {mounted.stderr.strip()}")
+    try:
+        target = "results/smoke/scenarios/kitchen_living/everywhere/h1.05.csv"
+        out = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", target, "--config", "profile=smoke"],
+                             cwd=suite, capture_output=True, text=True, timeout=600)
+    finally:
+        subprocess.run(["umount", str(results)], check=True)
+    text = out.stdout + out.stderr
+    assert out.returncode == 1 and "Traceback" not in text and "Errno 30" not in text, text[-3000:]
+    assert text.rstrip().splitlines()[-1] == (
+        f"refusing to start: results cannot be written (Read-only file system), and this run writes {target} there; "
+        "make it writable, or run from a checkout that is")
+    assert "localrule scenarios:" not in text  # no job started
+
+
+def test_a_dry_run_with_nothing_to_do_prints_no_sbatch_plan(slurm_paths):
+    """A target whose files are stored: no job, so no "What each job asks sbatch for" block (it listed every job
+    of the DAG, none of which would run)."""
+    out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "table2", "--workflow-profile", "profiles/slurm"],
+                         cwd=REPO, capture_output=True, text=True, timeout=600,
+                         env={**os.environ, "PATH": slurm_paths["no slurm"]})
+    text = out.stdout + out.stderr
+    assert out.returncode == 0 and "Nothing to be done" in text, text[-3000:]
+    assert "asks sbatch for" not in text

@@ -47,6 +47,13 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
                              "drop one of them")
         searcher = searchers.get(kind)
         check_searcher_env(kind, env_id)
+        unread = [name for name in given if name not in searcher.observation_options]
+        if unread:
+            reads = (f"it reads only {', '.join(searcher.observation_options)}" if searcher.observation_options
+                     else "it reads no observation option: it acts on the env's own state, not on the policy's "
+                          "observation")
+            raise ValueError(f"--env-option {unread[0]}: --policy {kind} would ignore it ({reads}); leave "
+                             "--env-option out, or give it with --policy actor")
         return searcher.maker(seed), env_id or searcher.env_id, given
     if kind == searchers.ACTOR:
         if not weights:

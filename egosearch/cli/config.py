@@ -4,7 +4,8 @@ docs/config.md (:mod:`egosearch.rl.config_page`)."""
 
 from __future__ import annotations
 
-from egosearch.rl.config import config_sources
+from egosearch.rl.config import LearnerConfig, config_sources
+from egosearch.rl.profiles import PROFILES
 
 
 def run(args) -> None:
@@ -30,6 +31,12 @@ def run(args) -> None:
         if variant.config.get("algorithm", args.algorithm) != args.algorithm:
             raise ValueError(f"--variant {args.variant} trains algorithm {variant.config['algorithm']}, not "
                              f"{args.algorithm}: show that one")
+        trained = PROFILES[args.profile]().get("algorithm", LearnerConfig.algorithm)
+        if "algorithm" not in variant.config and trained != args.algorithm:
+            # the variant names no learner: it trains the profile's, and this table would pass for its config
+            raise ValueError(f"--variant {args.variant} trains algorithm {trained} at the {args.profile} profile "
+                             f"(the profile's learner), not {args.algorithm}: show that one (egosearch config show "
+                             f"{trained} --profile {args.profile} --variant {args.variant})")
     rows = config_sources(args.algorithm, args.profile, overrides, name)
     files = sorted({row["declared_in"].rsplit(".", 1)[0] for row in rows})
     print(f"{args.algorithm} at profile {args.profile}{f' with variant {name}' if name else ''}: {len(rows)} fields, "

@@ -7,7 +7,8 @@ import json
 from egosearch.cli.checks import at_least, check_seed, check_suffix
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.demos import collect_demonstrations, summary_path
-from egosearch.variants import resolve_variant
+from egosearch.rl.run_settings import LONG_RUN_BOUNDS
+from egosearch.variants import check_learner_config, long_runs_allowed, resolve_variant
 
 
 def run(args) -> None:
@@ -16,8 +17,14 @@ def run(args) -> None:
     check_overwrites(files={"--out": args.out, "--out (summary)": str(summary_path(args.out))}, force=args.force)
     if args.episodes is not None:
         at_least("--episodes", args.episodes, 1, "a number of episodes")
+        bound, what = LONG_RUN_BOUNDS["demo_episodes"]
+        if args.episodes > bound and not long_runs_allowed(args.allow_long):
+            raise ValueError(f"--episodes={args.episodes} is out of range; allowed: <= {bound:,} {what}, the "
+                             "documented bound; --allow-long allows more")
     check_seed("--seed", args.seed)
     resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed})
+    if args.episodes is None:
+        check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long)
     episodes = args.episodes if args.episodes is not None else resolved.config.demo_episodes
     if episodes < 1:
         raise ValueError(f"--variant={args.variant} at the {args.profile} profile learns from no demonstrations "

@@ -25,7 +25,7 @@ def run(args) -> None:
     check_seed("--seed", args.seed)
     if not args.curve_of and args.profile != "cpu":
         raise ValueError(f"--profile={args.profile} is read with --curve-of only (a scenario file needs no profile)")
-    curve = curve_set(args.curve_of, args.profile) if args.curve_of else None
+    curve = curve_set(args.curve_of, args.profile, args.allow_long) if args.curve_of else None
     check_threads(args.threads)
     if args.env_id is not None and args.env_id not in ALL_ENV_IDS:  # '' too: it would read as no --env-id
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
@@ -52,13 +52,14 @@ def run(args) -> None:
 
 
 
-def curve_set(variant: str, profile: str) -> list:
+def curve_set(variant: str, profile: str, allow_long: bool = False) -> list:
     """The scenarios ``variant``'s training curve is evaluated on at ``profile`` (what ``egosearch train``
     hands the learner): its curve homes, its training placement, ``eval_episodes`` of them."""
     # local: resolving a variant loads the learner registry (torch), which a scenario-file run never needs
     from egosearch.sim.home_pool import curve_homes
-    from egosearch.variants import resolve_variant
+    from egosearch.variants import check_learner_config, resolve_variant
 
     resolved = resolve_variant(variant, profile)
+    check_learner_config(resolved.variant, profile, allow_long=allow_long)
     env = resolved.train_env
     return curve_scenarios(curve_homes(env), env["placement"], resolved.config.eval_episodes)

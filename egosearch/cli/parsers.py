@@ -31,6 +31,14 @@ def add_force(p, also: str = "") -> None:
     p.add_argument("--force", action="store_true", help=FORCE + also)
 
 
+def add_allow_long(p) -> None:
+    p.add_argument("--allow-long", action="store_true",
+                   help="allow a run past the documented bounds (total_env_steps 20,000,000, eval_episodes 10,000, "
+                        "demo_episodes 100,000: egosearch.rl.run_settings.LONG_RUN_BOUNDS), refused without it as a "
+                        "likely typo; EGOSEARCH_ALLOW_LONG=1 in the environment does the same (the workflow's "
+                        "--config allow_long=true sets it for its jobs)")
+
+
 def add_scenarios(sub) -> None:
     p = sub.add_parser("scenarios", help="generate a fixed scenario set as CSV")
     p.add_argument("--layout", help=f"home: {LAYOUTS} (default kitchen_living; not with --homes)")
@@ -94,6 +102,7 @@ def add_evaluate(sub) -> None:
                                                         "what the camera's centre looks at, distances) to this "
                                                         "compressed file (egosearch.runs.trace)")
     p.add_argument("--threads", type=int, default=1, help=THREADS)
+    add_allow_long(p)
     add_force(p)
 
 
@@ -114,6 +123,7 @@ def add_train(sub) -> None:
                    help="train these seeds (comma-separated, e.g. 0,1,2) in one process, their updates stacked as one "
                         "model (sac_curl, sac_drq; docs/gpu.md); --out-dir (and --work-dir) must then hold {seed}, "
                         "e.g. results/paper/train/head_on/seed{seed}; replaces --seed")
+    add_allow_long(p)
     add_force(p)
 
 
@@ -130,6 +140,7 @@ def add_demos(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes (default 0)")
     p.add_argument("--out", required=True, metavar="FILE.replay.npz",
                    help="the transitions (git-ignored); a summary goes beside it as FILE.json")
+    add_allow_long(p)
     add_force(p)
 
 
@@ -170,6 +181,7 @@ def add_variant(sub) -> None:
     v.add_argument("names", nargs="+", help="variant names (files in ablations/) or paths of .yaml files")
     v.add_argument("--profile", nargs="+", default=["smoke", "cpu", "paper"],
                    help="learner profiles to check the config against (default: all three)")
+    add_allow_long(v)
 
 
 def add_fullbody(sub) -> None:

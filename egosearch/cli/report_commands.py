@@ -381,7 +381,35 @@ def _table2(args) -> None:
 
 
 def _fig6(args) -> None:
+    check_fig6_files(args.files, args.levels or [])
     report.cmd_fig6(curves_by_variant(args.files), args.out_prefix, level_files=args.levels)
+
+
+def check_fig6_files(curves: list[str], levels: list[str]) -> None:
+    """Each curve and each level once (a level given twice was drawn twice; a curve twice failed as "a scenario
+    appears twice for the same seed"), and each level on the scenarios of a variant the curves draw (its file is
+    ``.../eval_curve/SEARCHER/VARIANT.csv``): another variant's would be read on other episodes."""
+    from egosearch.report.figures import level_searcher
+
+    for option, paths, what in (("the curve files", curves, "each seed's curve once"),
+                                ("--levels", levels, "each searcher's level once")):
+        seen: dict[Path, str] = {}
+        for path in paths:
+            if Path(path).resolve() in seen:
+                raise ValueError(f"{option}: {path} is given twice; give {what}")
+            seen[Path(path).resolve()] = path
+    variants = list(curves_by_variant(curves))
+    searchers_seen: dict[str, str] = {}
+    for path in levels:
+        searcher, variant = level_searcher(path), Path(path).stem
+        if searcher in searchers_seen:
+            raise ValueError(f"--levels: {searchers_seen[searcher]} and {path} are both {searcher}'s level; give "
+                             "each searcher's level once")
+        searchers_seen[searcher] = path
+        if variant not in variants:
+            raise ValueError(f"--levels: {path} is {searcher}'s level on {variant}'s curve scenarios, and the curves "
+                             f"are {', '.join(variants)}'s; give the level of a variant they draw (.../"
+                             f"{CURVE_LEVELS_DIR}/{searcher}/{variants[0]}.csv)")
 
 
 def _fig7(args) -> None:

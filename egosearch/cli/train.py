@@ -15,7 +15,7 @@ from egosearch.rl.train import train
 from egosearch.rl.train_stacked import train_stacked
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.home_pool import curve_homes
-from egosearch.variants import resolve_variant
+from egosearch.variants import check_learner_config, resolve_variant
 
 
 def run(args) -> None:
@@ -30,6 +30,7 @@ def run(args) -> None:
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     overrides = {"seed": args.seed, **({"num_threads": args.threads} if args.threads else {})}
     resolved = resolve_variant(args.variant, args.profile, overrides)
+    check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long)
     env = resolved.train_env
     evaluator = LazyEvaluator(lambda: scenario_evaluator(resolved.env_id, curve_homes(env), env["placement"],
                                                          n=resolved.config.eval_episodes,
@@ -120,6 +121,7 @@ def run_stacked(args) -> None:
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     threads = {"num_threads": args.threads} if args.threads else {}
     resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}) for s in seeds]
+    check_learner_config(resolved[0].variant, args.profile, allow_long=args.allow_long)
     env = resolved[0].train_env
     evaluators = [LazyEvaluator(lambda r=r: scenario_evaluator(r.env_id, curve_homes(env), env["placement"],
                                                                n=r.config.eval_episodes,

@@ -29,5 +29,5 @@ def run(args) -> None:
     for name in args.names:
         variant = load_variant(name)
         for profile in args.profile:
-            check_learner_config(variant, profile)
+            check_learner_config(variant, profile, allow_long=args.allow_long)
         print(f"{variant.path}: valid at the {', '.join(args.profile)} learner profile(s)")

@@ -364,6 +364,27 @@ def declaring_class(name: str, klass: type) -> type:
     raise ValueError(f"{name!r} is no field of {klass.__name__}")
 
 
+ABBREVIATIONS = frozenset({"e.g", "i.e", "eq", "al", "cf", "vs", "fig", "etc", "approx", "resp", "no"})
+"""Words whose dot ends no sentence (``e.g.``, ``et al.``, ``eq. 2``)."""
+
+
+def first_sentence(doc: str) -> str:
+    """``doc``'s whole first sentence: up to the first ". " outside brackets whose word is no abbreviation
+    (:data:`ABBREVIATIONS`) and whose next word does not start with a digit or a small letter (``eq. 2``,
+    ``0.5``); all of ``doc`` when none does."""
+    depth = 0
+    for i, char in enumerate(doc):
+        depth += {"(": 1, "[": 1, ")": -1, "]": -1}.get(char, 0)
+        if char != "." or depth > 0 or doc[i + 1:i + 2] != " ":
+            continue
+        word = doc[:i].rsplit(None, 1)[-1].lstrip("(\"'`").lower() if doc[:i].strip() else ""
+        following = doc[i + 2:i + 3]
+        if word in ABBREVIATIONS or not following or following.isdigit() or following.islower():
+            continue
+        return doc[:i + 1]
+    return doc.rstrip(".") + "." if doc else ""
+
+
 def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, Any] | None = None,
                    variant: str = "") -> list[dict[str, str]]:
     """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top), in
@@ -385,7 +406,7 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
         else:
             source = "default"
         doc = docs.get(name, "")
-        first = doc.split(". ")[0].rstrip(".") + "." if doc else ""
+        first = first_sentence(doc)
         rows.append({"field": name, "value": repr(getattr(cfg, name)), "source": source,
                      "paper": repr(paper[name]), "declared_in": f"{owner.__module__}.{owner.__name__}", "doc": first})
     return rows

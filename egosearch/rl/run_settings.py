@@ -31,6 +31,18 @@ CURRICULUM_END_RADIUS = 12.0
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; ``tests/test_rl_sac.py``'s
 ``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
+LONG_RUN_BOUNDS = {
+    "total_env_steps": (20_000_000, "env steps (about 27x Table 2's 750,000)"),
+    "eval_episodes": (10_000, "episodes a curve point (the most scenarios of one set, `egosearch scenarios --n`)"),
+    "demo_episodes": (100_000, "demonstration episodes (about 67x the cpu profile's 1,500)"),
+}
+"""The most a training may ask for (``total_env_steps``, ``eval_episodes``, ``demo_episodes``) without
+``--allow-long`` (``egosearch train``, ``demos``, ``evaluate --curve-of``, ``variant check``) or ``--config
+allow_long=true`` (the workflow): beyond them a run takes weeks on any machine, so a value past one is taken
+for a typo (an extra zero) and refused before any work (:func:`egosearch.variants.check_run_length`)."""
+ALLOW_LONG_ENV = "EGOSEARCH_ALLOW_LONG"
+"""Set to 1 in the environment, it allows what ``--allow-long`` allows: the workflow sets it for its jobs under
+``--config allow_long=true`` (their command lines stay the same, so stored jobs are not rerun)."""
 DECISIONS, BODY_STEPS = "decisions", "body steps"
 """What one env step of a training counts (:attr:`RunSettings.env_step_unit`)."""
 
@@ -147,7 +159,8 @@ class RunSettings:
     eval_every: int = 10_000
     """Ours: environment steps between evaluations (a row of curve.csv each; the ``cpu`` profile: 20k)."""
     eval_episodes: int = 10
-    """Ours (CURL: 10): deterministic episodes of the default evaluation."""
+    """Ours (CURL: 10): deterministic episodes of the default evaluation. At most 10,000 unless the run allows
+    more (``--allow-long``; :data:`LONG_RUN_BOUNDS`)."""
     log_every: int = 1_000
     """Ours: environment steps between rows of train.csv / progress-bar refreshes."""
     actor_snapshot_every: int = 0

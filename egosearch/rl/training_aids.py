@@ -61,7 +61,8 @@ class DemonstrationSettings:
     seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
     frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
     kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time. The
-    ``cpu`` profile: 1,500 (see :func:`cpu_profile`)."""
+    ``cpu`` profile: 1,500 (see :func:`cpu_profile`). At most 100,000 unless the run allows more
+    (``--allow-long``; ``egosearch.rl.run_settings.LONG_RUN_BOUNDS``)."""
     demo_teacher: str = "frontier"
     """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
     of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's

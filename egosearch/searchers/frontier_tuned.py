@@ -18,7 +18,7 @@ the untuned searcher's; this one is a separate row (``frontier_tuned``, ``fronti
   the untuned searcher does.
 - The head sweep is the untuned one.
 
-The parameters come from tuning on training-side sets only, never on the stored ones; ``egosearch tune``
+The parameters come from tuning on training-side sets only, never on the stored ones; ``egosearch tune --out DIR``
 (:mod:`egosearch.runs.teacher_tuning`) runs it again. docs/baselines.md ("The tuned searcher: why and how it
 was tuned") says which failures of the untuned searcher each change answers, the splits and what the chosen
 parameters did on the held-out one.

@@ -55,7 +55,10 @@ class Searcher:
     trained high level is read against it (the ``decisions_floor`` rule); ``path_style``: its line in
     the path-length figure, (colour, line style, marker), None for its default line; ``fig6_level``: a
     horizontal line in Figure 6, (label, line style, colour), None for none; ``options``: keyword arguments
-    its factory is called with, as ``(name, value)`` pairs (a memory window: ``(("memory_window", 5),)``)."""
+    its factory is called with, as ``(name, value)`` pairs (a memory window: ``(("memory_window", 5),)``);
+    ``observation_options``: the env's observation options (``egosearch evaluate --env-option``) its policy
+    reads, any other given is refused (none of the registered searchers reads one: they act on the env's own
+    state)."""
 
     name: str
     factory: str | Callable[..., Any]
@@ -72,6 +75,7 @@ class Searcher:
     path_style: tuple | None = None
     fig6_level: tuple | None = None
     options: tuple[tuple[str, Any], ...] = ()
+    observation_options: tuple[str, ...] = ()
 
     def policy_factory(self) -> Callable[..., Any]:
         return resolve(self.factory)

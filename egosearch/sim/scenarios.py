@@ -102,6 +102,17 @@ def read_scenarios(path: str | os.PathLike) -> list[Scenario]:
                                 "text); a scenario file is written by `egosearch scenarios`") from None
 
 
+def other_separator(header: list[str]) -> str | None:
+    """The separator a CSV's header line was written with when it is not ',' (';', a tab, '|'): the expected
+    columns found in a header read as one column; None otherwise."""
+    if len(header) != 1:
+        return None
+    for separator in (";", "\t", "|"):
+        if sum(name.strip() in COLUMNS for name in header[0].split(separator)) >= 2:
+            return separator
+    return None
+
+
 def _read_scenarios(path: Path) -> list[Scenario]:
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
@@ -110,6 +121,11 @@ def _read_scenarios(path: Path) -> list[Scenario]:
             raise ScenarioFileError(f"{path}: empty file; a scenario CSV starts with the header line "
                                     f"{','.join(COLUMNS)}")
         missing = [c for c in COLUMNS if c not in header]
+        separator = other_separator(header)
+        if missing and separator:
+            # a spreadsheet's export: the header is one column, and "missing" would list them all
+            raise ScenarioFileError(f"{path} is separated by {separator!r}, not ','; a scenario CSV is comma-"
+                                    "separated, as `egosearch scenarios` writes it")
         if missing:
             raise ScenarioFileError(f"{path}: missing columns {', '.join(missing)}; "
                                     f"expected {', '.join(COLUMNS)}")

@@ -19,6 +19,7 @@ from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rule
 from egosearch.searchers import registry as searchers
 from egosearch.variants import (  # noqa: F401  (variant_head: the rules import it from here)
     ABLATIONS_DIR,
+    ALLOW_LONG_WORKFLOW,
     Variant,
     VariantError,
     check_learner_config,
@@ -54,6 +55,8 @@ def coerce_numbers(value, schema: dict, root: dict | None = None):
     kind = schema.get("type")
     if kind in ("number", "integer"):
         return _number(value, kind)
+    if kind == "boolean" and isinstance(value, str) and value.lower() in ("true", "false"):
+        return value.lower() == "true"
     if isinstance(value, list) and "items" in schema:
         return [coerce_numbers(v, schema["items"], root) for v in value]
     if isinstance(value, dict):
@@ -95,9 +98,70 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
             if list(pair) in [list(p) for p in pairs[:i]]:
                 # the behaviour pages and the failure table would read its traces twice
                 raise ConfigError(f"config {where}: {list(pair)} is given twice; each pair once")
+    check_training_seeds(config)
+    check_budgets(config)
+    for where, pairs in every_claims_pairs(config):
+        first = pairs[0] if pairs else []
+        if first and all(name in searchers.classical() for name in first):
+            # versus_teacher and Figure 6 read the first pair's trainings (their curves, their teachers)
+            raise ConfigError(f"config {where}: the first pair {list(first)} is Figure 6's and versus_teacher's, "
+                              "which read its trainings: name variants there (e.g. [head_on, head_off]) and the "
+                              "classical searchers in a later pair")
     if config.get("fresh_scenario_seed") == config["scenario_seed"]:
         raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
                           "scenario_seed; the fresh-set check needs sets never stored")
+
+
+def check_training_seeds(config: dict) -> None:
+    """Every seed a training of the run takes (each profile's ``seeds``, ``spread_seeds`` and budget seeds, and the
+    screen's ``screen_seed`` on) at most 2**32 - 1: a training seeds numpy's 32-bit global generator, and a
+    larger seed failed in its job, after the DAG had started."""
+    from egosearch.cli.checks import MAX_SEED
+
+    given = [("screen_seed", config.get("screen_seed", 0) + config.get("screen_seeds", 1) - 1)]
+    for name, profile in config.get("profiles", {}).items():
+        given += [(f"profiles/{name}/{key}", max(profile.get(key) or [0])) for key in ("seeds", "spread_seeds")]
+        given.append((f"profiles/{name}/budget/seeds", max((profile.get("budget") or {}).get("seeds") or [0])))
+    for where, seed in given:
+        if seed > MAX_SEED:
+            value = (f"{config['screen_seed']} with screen_seeds={config.get('screen_seeds', 1)} trains seeds up to "
+                     f"{seed}, which" if where == "screen_seed" else f"{seed}")
+            raise ConfigError(f"config {where}: {value} is out of range; allowed: a training seed <= 2**32 - 1 = "
+                              f"{MAX_SEED} (numpy's global seed is 32-bit)")
+
+
+def check_budgets(config: dict) -> None:
+    """Each profile's budget study reads each setting once, the profile's own (its ``reference``, else the
+    reference variant) apart from the others: a setting that is the reference too drew the same runs twice."""
+    for name, profile in config.get("profiles", {}).items():
+        budget = profile.get("budget") or {}
+        reference = budget.get("reference", config.get("reference_variant"))
+        if reference in budget.get("variants", []):
+            named = "budget/reference" if "reference" in budget else "reference_variant"
+            raise ConfigError(f"config profiles/{name}/budget/variants: {reference!r} is the study's own setting "
+                              f"({named}), read against itself; leave it out of variants (its runs are the "
+                              "profile's seeds already)")
+
+
+def command_line_claims_pairs(config: dict, command_line: dict | None) -> None:
+    """``--config claims_pairs=...`` where the run's profile names its own: the profile's are read, and the ones
+    typed would be ignored without a word."""
+    profile = config.get("profile")
+    if command_line and "claims_pairs" in command_line and "claims_pairs" in config["profiles"].get(profile, {}):
+        raise ConfigError(f"config claims_pairs: the {profile} profile names its own (profiles/{profile}/"
+                          "claims_pairs in egosearch/workflow/config.yaml), which the run reads instead of the "
+                          "top level's; edit that one, or run another profile")
+
+
+def check_pair_heads(variants: dict[str, Variant], config: dict) -> None:
+    """Each claims pair is [head moving, head fixed], as the behaviour claims read it: a pair the other way round
+    (or two of one head) would read each claim backwards without a word."""
+    for where, pairs in every_claims_pairs(config):
+        for pair in pairs:
+            heads = [searchers.get(n).head if n in searchers.SEARCHERS else variant_head(variants[n]) for n in pair]
+            if heads != [True, False] and None not in heads:
+                said = ", ".join(f"{n} (head {'moving' if h else 'fixed'})" for n, h in zip(pair, heads))
+                raise ConfigError(f"config {where}: {list(pair)} is {said}; a pair is [head moving, head fixed]")
 
 
 def workflow_variants(config: dict, compare: bool | str = False,
@@ -130,7 +194,9 @@ def workflow_variants(config: dict, compare: bool | str = False,
     variants = {}
     for name in names:
         variants[name] = _named_variant(name, named_by[name], directory)
-        check_learner_config(variants[name], learner)
+        check_learner_config(variants[name], learner, allow_long=config.get("allow_long", False),
+                             flag=ALLOW_LONG_WORKFLOW)
+    check_pair_heads(variants, config)
     generated = generalise.get("generated_variant")
     if generated is not None and (generated not in generalise["variants"]
                                   or variants[generated].train_env["layout"] != "generated"):
@@ -157,12 +223,14 @@ def _named_variant(name: str, key: str, directory: Path) -> Variant:
 
 
 def checked_variants(config: dict, argv: list[str] | None = None,
-                     directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
+                     directory: Path = ABLATIONS_DIR, command_line: dict | None = None) -> dict[str, Variant]:
     """For the Snakefile: check the config and the variants, or print one line and exit 1.
-    ``compare`` or ``screen`` among the command's targets makes ``variant`` required."""
+    ``compare`` or ``screen`` among the command's targets makes ``variant`` required; ``command_line``: the
+    ``--config`` entries as typed."""
     argv = sys.argv[1:] if argv is None else argv
     try:
         check_config(config)
+        command_line_claims_pairs(config, command_line)
         comparing = next((t for t in ("compare", "screen") if t in argv), False)
         return workflow_variants(config, compare=comparing, directory=directory)
     except (ConfigError, VariantError) as err:
@@ -202,3 +270,29 @@ def damaged_inputs_line(input_paths) -> str | None:
         if len(problems) > 1 else ""
     return (f"refusing to start: {problem}{more}; restore it with `git checkout -- {path}`, or rerun the job that "
             "writes it and then the `provenance` rule")
+
+
+def unwritable_outputs_line(output_paths) -> str | None:
+    """One line when a folder the plan writes in cannot be written (a read-only results/, mounted so or
+    chmod'ed for another user), naming it and the first file it would hold; None when every one can. Each
+    output's nearest existing folder is tried with a file made and removed there: what the job would do
+    (``os.access`` says yes on a read-only mount for root, and Snakemake failed with a traceback once the
+    run had started)."""
+    import tempfile
+
+    tried: dict[Path, str | None] = {}
+    for path in dict.fromkeys(str(p) for p in output_paths):  # outputs first, as the rule lists them
+        folder = Path(path).parent
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        if folder not in tried:
+            try:
+                with tempfile.TemporaryFile(dir=folder):
+                    pass
+                tried[folder] = None
+            except OSError as err:
+                tried[folder] = err.strerror or type(err).__name__
+        if tried[folder]:
+            return (f"refusing to start: {folder} cannot be written ({tried[folder]}), and this run writes {path} "
+                    "there; make it writable, or run from a checkout that is")
+    return None

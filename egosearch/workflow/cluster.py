@@ -39,11 +39,45 @@ def snakemake_executor() -> str | None:
 
     Read from the arguments Snakemake's CLI parsed (``snakemake.cli.args_to_api``, which builds the run and,
     through it, parses the Snakefile), so profiles count exactly as Snakemake counts them."""
+    args = snakemake_args()
+    return None if args is None else getattr(args, "executor", None) or "local"
+
+
+def snakemake_args():
+    """The arguments the ``snakemake`` command line reading the Snakefile parsed (its profiles' included), None
+    where the workflow is not run from the command line."""
     frame = sys._getframe(1)
     while frame is not None:
         if frame.f_code.co_name == "args_to_api" and frame.f_globals.get("__name__") == "snakemake.cli":
-            return getattr(frame.f_locals.get("args"), "executor", None) or "local"
+            return frame.f_locals.get("args")
         frame = frame.f_back
+    return None
+
+
+DEFAULT_WORKFLOW_PROFILE = Path("profiles/default")
+"""The workflow profile Snakemake reads whenever no ``--workflow-profile`` is given: on top of a ``--profile``."""
+
+
+def profile_mix_problem(profiles: Iterable[str] | None, workflow_profile: str | None,
+                        default: Path = DEFAULT_WORKFLOW_PROFILE) -> str | None:
+    """The line for a ``--profile`` one of whose settings :data:`DEFAULT_WORKFLOW_PROFILE` overrides without a
+    word (Snakemake reads the workflow profile after it: ``--profile profiles/slurm`` ran 2 jobs at a time, not
+    its 100); None where no ``--profile`` is given, a ``--workflow-profile`` is, or nothing clashes."""
+    import yaml  # local: only a run with --profile reads them
+
+    if not profiles or workflow_profile is not None or not (default / "config.yaml").is_file():
+        return None
+    defaults = yaml.safe_load((default / "config.yaml").read_text()) or {}
+    for profile in profiles:
+        path = Path(profile) / "config.yaml"
+        if not path.is_file():
+            continue  # a profile by name, in Snakemake's own folders: not this workflow's
+        given = yaml.safe_load(path.read_text()) or {}
+        clash = next((key for key in defaults if key in given and given[key] != defaults[key]), None)
+        if clash:
+            return (f"--profile {profile}: Snakemake reads the workflow profile {default} on top of it, and its "
+                    f"{clash}: {defaults[clash]} overrides the {clash}: {given[clash]} of {profile}; use "
+                    f"--workflow-profile {profile} instead (it replaces {default}; docs/running.md)")
     return None
 
 
@@ -90,6 +124,38 @@ def partitions_asked(default_args: Iterable[str], overrides: Mapping[str, Mappin
         if _plain(resources.get("slurm_partition")):
             asked.append((f"rule {rule}'s slurm_partition", _plain(resources["slurm_partition"])))
     return asked
+
+
+SIZED_RESOURCES = {"mem_mb": "megabytes", "mem_mib": "mebibytes", "disk_mb": "megabytes", "disk_mib": "mebibytes",
+                   "runtime": "minutes"}
+"""The resources every job's sbatch call is sized by, as numbers: a word there failed only at exit, in the slurm
+plan's atexit hook (a ResourceConversionError, the run's status 0), and runtime 0 submitted with no -t."""
+
+
+def resource_problem(default_args: Iterable[str], overrides: Mapping[str, Mapping[str, object]]) -> str | None:
+    """The line for the first of :data:`SIZED_RESOURCES` that the run's ``--default-resources`` (a profile's
+    ``default-resources:`` among them) or ``--set-resources`` give as a word, or as a number <= 0; None when
+    none does. An expression (``2 * attempt * 1000``) is Snakemake's to evaluate and passes."""
+    given = [("--default-resources", *str(arg).partition("=")[::2]) for arg in default_args or ()]
+    given += [(f"--set-resources {rule}:", key, value) for rule, resources in sorted((overrides or {}).items())
+              for key, value in resources.items()]
+    for where, key, value in given:
+        key, text = key.strip(), _plain(value)
+        if key not in SIZED_RESOURCES or text is None:
+            continue
+        where = f"{where}{key}" if where.endswith(":") else f"{where} {key}"
+        unit = SIZED_RESOURCES[key]
+        try:
+            number = float(text)
+        except ValueError:
+            if re.fullmatch(r"[A-Za-z_]+", text):
+                return (f"{where}={text}: not a number; allowed: a number of {unit} > 0 (e.g. {key}="
+                        f"{1000 if unit != 'minutes' else 30})")
+            continue
+        if not number > 0:
+            cut = "no time limit (sbatch without -t)" if key == "runtime" else "no memory (or disk) at all"
+            return f"{where}={text}: a job would ask for {cut}; allowed: a number of {unit} > 0"
+    return None
 
 
 def cluster_partitions(run=subprocess.run) -> tuple[list[str], str | None]:
@@ -202,12 +268,13 @@ def sbatch_plan(jobs, overwrite_threads: Mapping[str, int] | None = None, local_
 
 def print_sbatch_plan_at_exit(workflow, file=None) -> None:
     """Print :func:`sbatch_plan` of ``workflow``'s DAG when the process exits: after a dry run has built the DAG
-    and listed its jobs (Snakemake calls no hook after a dry run). Nothing where no DAG was built."""
+    and listed its jobs (Snakemake calls no hook after a dry run). Only the jobs the run would submit: nothing
+    where no DAG was built, or where it has nothing to do."""
     import atexit
 
     def print_plan():
         dag = getattr(workflow, "dag", None)
-        lines = sbatch_plan(dag.jobs, workflow.resource_settings.overwrite_threads,
+        lines = sbatch_plan(dag.needrun_jobs(), workflow.resource_settings.overwrite_threads,
                             getattr(workflow, "_localrules", ())) if dag is not None else []
         if lines:
             print("What each job asks sbatch for (the slurm plugin adds its job name, log and account):", *lines,

@@ -9,7 +9,8 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
-from egosearch.workflow.cluster import is_cluster, partitions_asked, slurm_run_problem, snakemake_executor
+from egosearch.workflow.cluster import (is_cluster, partitions_asked, profile_mix_problem, resource_problem,
+                                       slurm_run_problem, snakemake_args, snakemake_executor)
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
 from egosearch.workflow.check import claims_pairs, variant_head
@@ -19,13 +20,22 @@ from egosearch.workflow.check import claims_pairs, variant_head
 # (egosearch.workflow.cluster). Under a cluster executor each job is a cluster job of its own.
 EXECUTOR = snakemake_executor()
 LOCAL_RUN = not is_cluster(EXECUTOR)
+_args = snakemake_args()
+_mix = _args is not None and workflow.is_main_process and profile_mix_problem(
+    getattr(_args, "profile", None), getattr(_args, "workflow_profile", None))
+if _mix:
+    import sys
+
+    print(f"egosearch: error: {_mix}", file=sys.stderr)
+    sys.exit(1)
 if EXECUTOR == "slurm" and workflow.is_main_process:
-    # sbatch, squeue and sinfo on PATH (a real run), and every slurm_partition the run names on the cluster:
-    # one line here, before the first job, not an sbatch error per job once the run has started
-    _problem = slurm_run_problem(
-        workflow.output_settings.dryrun,
-        partitions_asked(getattr(workflow.resource_settings.default_resources, "args", None) or [],
-                         workflow.resource_settings.overwrite_resources or {}))
+    # every job's memory and time a number > 0, sbatch, squeue and sinfo on PATH (a real run), and every
+    # slurm_partition the run names on the cluster: one line here, before the first job, not an sbatch error per
+    # job once the run has started
+    _default_args = getattr(workflow.resource_settings.default_resources, "args", None) or []
+    _overrides = workflow.resource_settings.overwrite_resources or {}
+    _problem = resource_problem(_default_args, _overrides) or slurm_run_problem(
+        workflow.output_settings.dryrun, partitions_asked(_default_args, _overrides))
     if _problem:
         import sys
 
@@ -59,6 +69,18 @@ wildcard_constraints:
     placement="no_low_cabinets|everywhere",
     layout="kitchen_living|bedroom_bath|studio|home[0-9]+|generated_heldout|generated_train",
     setting="(ours-M[0-9]+|one_step_short|one_step_long|noisy_search)-(humanoid_phase|humanoid_matching|fetch)",
+
+
+def refuse_unwritable_outputs():
+    """Before a real run's first job: every folder its jobs write in (outputs, logs, benchmarks) can be written
+    (egosearch.workflow.check.unwritable_outputs_line), else one line and exit 1."""
+    from egosearch.workflow.check import unwritable_outputs_line
+
+    line = unwritable_outputs_line(f for job in workflow.dag.needrun_jobs()
+                                   for f in [*job.output, *job.log, *([job.benchmark] if job.benchmark else [])])
+    if line:
+        print(line, file=sys.stderr)
+        sys.exit(1)
 
 
 def refuse_damaged_inputs():
