@@ -1,8 +1,4 @@
-<<<<<<< HEAD
-"""The tuned teacher's tuning, as a command that can be run again (``egosearch tune``, rule
-=======
 """The tuned teacher's tuning, as a command that can be run again (``egosearch tune --out DIR``, rule
->>>>>>> bad-input
 ``tune_teacher``): the training-side splits, the candidates, the choice on the fit split and the check on
 the held-out one, written as a record.
 
