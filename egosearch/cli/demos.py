@@ -7,7 +7,7 @@ import json
 from egosearch.cli.checks import at_least, check_seed, check_suffix
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.demos import collect_demonstrations, summary_path
-from egosearch.variants import resolve_variant
+from egosearch.variants import parse_set, resolve_variant
 
 
 def run(args) -> None:
@@ -17,7 +17,7 @@ def run(args) -> None:
     if args.episodes is not None:
         at_least("--episodes", args.episodes, 1, "a number of episodes")
     check_seed("--seed", args.seed)
-    resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed})
+    resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed}, parse_set(args.set))
     episodes = args.episodes if args.episodes is not None else resolved.config.demo_episodes
     if episodes < 1:
         raise ValueError(f"--variant={args.variant} at the {args.profile} profile learns from no demonstrations "
