@@ -24,7 +24,7 @@ rule train:
     # command of a run without a set is the one Snakemake recorded for the stored trainings
     shell:
         "egosearch train --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--threads {threads} --work-dir {params.work_dir} --out-dir {params.out_dir}" + SET_ARGS + " > {log} 2>&1"
+        f"--threads {{threads}} --work-dir {{params.work_dir}} --out-dir {{params.out_dir}}{SET_ARGS} > {{log}} 2>&1"
 
 
 rule demos:
@@ -46,4 +46,4 @@ rule demos:
         CONDA_ENV
     shell:
         "egosearch demos --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--out {output.transitions}" + SET_ARGS + " > {log} 2>&1"
+        f"--out {{output.transitions}}{SET_ARGS} > {{log}} 2>&1"
