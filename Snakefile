@@ -2,6 +2,7 @@
 #   snakemake all                               # everything at the default `cpu` profile (hours: `egosearch estimate all` says how many here)
 #   snakemake table1                            # Table 1 only (trains what it needs)
 #   snakemake compare --config variant=my_variant
+#   snakemake -n results/cpu/train/my_variant/seed0/actor.pt --config set="batch_size=64"   # learner fields, as `egosearch train --set`
 # On 2 cores of this machine (profiles/default/config.yaml); `--cores N` chooses others.
 # Rules call `egosearch` entry points; the experiment list lives in egosearch/workflow/.
 import os
@@ -60,6 +61,12 @@ onstart:
     refuse_damaged_inputs()
     claim_the_plans_outputs()
     print_the_plans_cost()
+
+
+# Once the DAG is built, a dry run's as a real run's: every training takes the config's `set` and none stored was
+# trained with another one (rules/common.smk); wrapped first, so that a refused plan prints no cost line.
+if workflow.is_main_process:
+    check_the_trainings_set_once_built()
 
 
 # A dry run is where a user plans (`snakemake -n screen --config variant=NAME`): it prints the same cost

@@ -22,7 +22,14 @@ import yaml
 
 from egosearch.core.schema_errors import schema_error
 from egosearch.envs import EnvOptions, env_options, observed_env_id
-from egosearch.rl.config import ALGORITHMS, LearnerConfig, field_types, load_config, refuse_foreign_fields
+from egosearch.rl.config import (  # noqa: F401  (format_set: the CLI and the workflow read it from here)
+    ALGORITHMS,
+    LearnerConfig,
+    field_types,
+    format_set,
+    load_config,
+    refuse_foreign_fields,
+)
 from egosearch.rl.run_settings import ALLOW_LONG_ENV, LONG_RUN_BOUNDS
 from egosearch.searchers import registry as searchers
 from egosearch.sim.home_pool import check_home_split
@@ -120,7 +127,7 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
                            f"same folders: name the variant otherwise (taken: {', '.join(searchers.names())})")
     _check_objects(data["train_env"].get("objects") or [], path)
     _check_homes(data["train_env"], path)
-    overrides = _learner_overrides(data.get("config") or {}, path)
+    overrides = learner_overrides(data.get("config") or {}, f"{path}: config")
     _check_env_id_agrees(data["env_id"], overrides, path)
     return Variant(name=data["name"], env_id=data["env_id"], train_env=dict(data["train_env"]),
                    config=overrides, description=data.get("description", ""), path=str(path))
@@ -133,10 +140,14 @@ class ResolvedVariant:
     profile: str
     """The learner profile (smoke, cpu or paper) the config starts from."""
     config: LearnerConfig
-    """The profile's config with the variant's overrides, then the caller's, on top."""
+    """The profile's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top."""
     env_id: str
     """The id the policy trains and is evaluated in: the variant's ``env_id``, or its ``*Memory-v0``
     form when the config's ``target_memory`` changes the observation."""
+    set_overrides: dict = field(default_factory=dict)
+    """The command line's overrides (``egosearch train --set FIELD=VALUE``, the workflow config's ``set``),
+    checked as a variant file's ``config:`` is (:func:`parse_set`); a training records them in its config.json
+    as ``set``, and its resume refuses other ones."""
 
     @property
     def name(self) -> str:
@@ -147,14 +158,61 @@ class ResolvedVariant:
         return self.variant.train_env
 
 
-def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict | None = None) -> ResolvedVariant:
+def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict | None = None,
+                    set_overrides: dict | None = None) -> ResolvedVariant:
     """``variant`` (a name, a path or a loaded :class:`Variant`) at the learner ``profile``, with
-    ``overrides`` (seed, threads, ...) on top of the variant's own config fields."""
+    ``set_overrides`` (the command line's ``--set``, parsed by :func:`parse_set`) on top of the variant's own
+    config fields and ``overrides`` (seed, threads, ...) on top of those. A ``--set`` value out of range (or
+    that breaks a rule between fields) is a one-line ``VariantError`` naming ``--set``."""
     if not isinstance(variant, Variant):
         variant = load_variant(variant)
-    config = load_config(profile, {**variant.config, **(overrides or {})})
+    set_overrides = dict(set_overrides or {})
+    if set_overrides:
+        try:
+            load_config(profile, {**variant.config, **(overrides or {})})
+        except ValueError:
+            pass  # the variant's own problem: reported below as it is without --set
+        else:
+            try:
+                load_config(profile, {**variant.config, **set_overrides, **(overrides or {})})
+            except ValueError as err:
+                raise VariantError(f"--set {format_set(set_overrides)}: {err}") from None
+    config = load_config(profile, {**variant.config, **set_overrides, **(overrides or {})})
     env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
-    return ResolvedVariant(variant, profile, config, env_id)
+    return ResolvedVariant(variant, profile, config, env_id, set_overrides)
+
+
+def parse_set(items: list[str] | tuple[str, ...] | str | None, where: str = "--set") -> dict:
+    """``FIELD=VALUE`` items (``egosearch train --set``, repeatable; the workflow config's ``set``, a
+    comma-separated string or a list) -> {field: value}, each value read as YAML reads a variant file's
+    (``64``, ``1e-4``, ``true``; a str field keeps the text as given) and checked as a variant file's
+    ``config:`` is (:func:`learner_overrides`: a known field, its type, did-you-mean). A bad item is one
+    ``VariantError`` line starting with ``where``. Ranges are checked where the config is built
+    (:func:`resolve_variant`)."""
+    if items is None:
+        return {}
+    if isinstance(items, str):
+        items = [part for part in items.split(",") if part.strip()]
+    kinds, values = field_types(), {}
+    for item in items:
+        key, eq, text = str(item).partition("=")
+        key = key.strip()
+        if not eq or not key:
+            raise VariantError(f"{where} {str(item)!r}: give FIELD=VALUE, e.g. batch_size=64")
+        if key in values:
+            raise VariantError(f"{where}: {key} is given twice ({key}={values[key]!r} and {str(item).strip()}); "
+                               "give it once")
+        if key == "algorithm":
+            raise VariantError(f"{where}: algorithm is the variant's learner (its file's config: algorithm); a set "
+                               "changes the fields of that learner: make a variant to train another one")
+        if kinds.get(key) == "str":
+            values[key] = text.strip()
+            continue
+        try:
+            values[key] = yaml.safe_load(text) if text.strip() else None
+        except yaml.YAMLError:
+            values[key] = text
+    return learner_overrides(values, where)
 
 
 def variant_head(variant: str | Path | Variant) -> bool:
@@ -184,12 +242,13 @@ def check_run_length(config: LearnerConfig, flag: str = ALLOW_LONG_CLI) -> None:
 
 
 def check_learner_config(variant: Variant, learner_profile: str, allow_long: bool = False,
-                         flag: str = ALLOW_LONG_CLI) -> None:
-    """The variant's overrides on top of ``learner_profile`` give a valid learner config (ranges and
-    cross-field rules such as ``crop_size <= image_size``) within the documented bounds of a run's length
-    unless ``allow_long`` (:func:`check_run_length`, naming ``flag``), else one-line ``VariantError``."""
+                         flag: str = ALLOW_LONG_CLI, set_overrides: dict | None = None) -> None:
+    """The variant's overrides (and the command line's ``set_overrides``) on top of ``learner_profile`` give a
+    valid learner config (ranges and cross-field rules such as ``crop_size <= image_size``) within the
+    documented bounds of a run's length unless ``allow_long`` (:func:`check_run_length`, naming ``flag``), else
+    one-line ``VariantError``."""
     try:
-        resolved = resolve_variant(variant, learner_profile)
+        resolved = resolve_variant(variant, learner_profile, None, set_overrides)
         if not long_runs_allowed(allow_long):
             check_run_length(resolved.config, flag)
     except ValueError as err:
@@ -197,26 +256,27 @@ def check_learner_config(variant: Variant, learner_profile: str, allow_long: boo
                            f"{err}") from None
 
 
-def _learner_overrides(config: dict, path: Path) -> dict:
-    """``config`` checked field by field against the fields of every learner's config (and, when the variant
-    names its learner, against that learner's: a field it does not have is one line). PyYAML reads ``1e-4``
-    (no dot) as a string, so a float field also takes a string that reads as a finite number."""
+def learner_overrides(config: dict, where: str) -> dict:
+    """``config`` checked field by field against the fields of every learner's config (and, when it names its
+    learner, against that learner's: a field it does not have is one line); ``where`` starts each error line
+    (a variant file's ``PATH: config``, or ``--set``). PyYAML reads ``1e-4`` (no dot) as a string, so a float
+    field also takes a string that reads as a finite number."""
     kinds = field_types()
     if isinstance(config.get("algorithm"), str) and config["algorithm"] in ALGORITHMS:
         try:
             refuse_foreign_fields(config["algorithm"], config)
         except ValueError as err:
-            raise VariantError(f"{path}: config: {err}") from None
+            raise VariantError(f"{where}: {err}") from None
     out = {}
     for key, value in config.items():
         if key == "seed":
             # every run sets it (egosearch train --seed, the DAG's seeds), so a variant's would never be read
-            raise VariantError(f"{path}: config: seed is set per run (`egosearch train --seed`, the profile's seeds in "
-                               "the workflow config), not by a variant: leave it out")
+            raise VariantError(f"{where}: seed is set per run (`egosearch train --seed`, the profile's seeds in "
+                               "the workflow config), not by a variant or --set: leave it out")
         if key not in kinds:
             close = difflib.get_close_matches(str(key), kinds, n=1)
             hint = f" (did you mean {close[0]}?)" if close else ""
-            raise VariantError(f"{path}: config: {key!r} is not a LearnerConfig field{hint}")
+            raise VariantError(f"{where}: {key!r} is not a LearnerConfig field{hint}")
         kind = kinds[key]
         if kind == "float" and isinstance(value, str):
             try:
@@ -225,9 +285,9 @@ def _learner_overrides(config: dict, path: Path) -> dict:
                 pass
         expected = {"int": int, "float": (int, float), "str": str, "bool": bool}.get(kind)
         if expected is not None and (isinstance(value, bool) and kind != "bool" or not isinstance(value, expected)):
-            raise VariantError(f"{path}: config: {key}={value!r} is not {'an' if kind == 'int' else 'a'} {kind}")
+            raise VariantError(f"{where}: {key}={value!r} is not {'an' if kind == 'int' else 'a'} {kind}")
         if kind == "float" and not math.isfinite(value):
-            raise VariantError(f"{path}: config: {key}={value!r} is not a finite number")
+            raise VariantError(f"{where}: {key}={value!r} is not a finite number")
         out[key] = value
     return out
 

@@ -942,7 +942,7 @@ NEW48_CASES = [
      "egosearch scenarios: error: --layout=studio and --homes=0:2 both name the homes: give one"),
     ("variant_config_sets_the_seed", "silent", ["variant", "check", "{t}/seed_in.yaml"],
      "egosearch variant: error: {t}/seed_in.yaml: config: seed is set per run (`egosearch train --seed`, the "
-     "profile's seeds in the workflow config), not by a variant: leave it out"),
+     "profile's seeds in the workflow config), not by a variant or --set: leave it out"),
     ("variant_objects_empty", "silent", ["variant", "check", "{t}/objects_empty.yaml"],
      "egosearch variant: error: {t}/objects_empty.yaml: train_env/objects: [] should be non-empty"),
     ("variant_check_a_folder", "cryptic", ["variant", "check", "{t}/eval"],

@@ -145,7 +145,8 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
     out = capsys.readouterr().out.splitlines()
     n = len(dataclasses.fields(config_class("sac_drq")))
     assert out[0].startswith(f"sac_drq at profile cpu with variant head_on_contact_signal: {n} fields, declared in ")
-    assert len(out) == 2 + n and sum(line.startswith("contact_signal ") for line in out) == 1
+    # the header, the variant's env_id and train_env, the column heads, then one line a field
+    assert len(out) == 4 + n and sum(line.startswith("contact_signal ") for line in out) == 1
     assert main(["config", "show", "sac_curl", "--variant", "head_on_ppo"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith("--variant head_on_ppo trains algorithm ppo, not sac_curl: show that one")

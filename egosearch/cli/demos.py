@@ -8,7 +8,7 @@ from egosearch.cli.checks import at_least, check_seed, check_suffix
 from egosearch.core.outputs import check_outputs, check_overwrites
 from egosearch.rl.demos import collect_demonstrations, summary_path
 from egosearch.rl.run_settings import LONG_RUN_BOUNDS
-from egosearch.variants import check_learner_config, long_runs_allowed, resolve_variant
+from egosearch.variants import check_learner_config, long_runs_allowed, parse_set, resolve_variant
 
 
 def run(args) -> None:
@@ -22,9 +22,10 @@ def run(args) -> None:
             raise ValueError(f"--episodes={args.episodes} is out of range; allowed: <= {bound:,} {what}, the "
                              "documented bound; --allow-long allows more")
     check_seed("--seed", args.seed)
-    resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed})
+    set_overrides = parse_set(args.set)
+    resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed}, set_overrides)
     if args.episodes is None:
-        check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long)
+        check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
     episodes = args.episodes if args.episodes is not None else resolved.config.demo_episodes
     if episodes < 1:
         raise ValueError(f"--variant={args.variant} at the {args.profile} profile learns from no demonstrations "

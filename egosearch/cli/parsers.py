@@ -106,11 +106,19 @@ def add_evaluate(sub) -> None:
     add_force(p)
 
 
+VARIANT_HELP = ("a variant: a file stem in ablations/ (head_on, head_off, ...) or the path of a variant file "
+                "(e.g. my_variants/x.yaml; its name: must equal the file's stem)")
+SET_HELP = ("override one config field, repeatable (e.g. --set batch_size=64 --set actor_lr=1e-4): checked as a "
+            "variant file's config: is (the field, its type, its range), on top of the variant's values")
+
+
 def add_train(sub) -> None:
     about = f"train a variant's search policy with {LEARNERS} (resumable)"
     p = sub.add_parser("train", help=about, description=about)
-    p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...)")
+    p.add_argument("--variant", required=True, help=VARIANT_HELP)
     p.add_argument("--profile", default="cpu", help="learner profile: smoke, cpu or paper (default: cpu)")
+    p.add_argument("--set", action="append", metavar="FIELD=VALUE",
+                   help=SET_HELP + "; recorded in the run's config.json as `set`, and a resume refuses other ones")
     p.add_argument("--seed", type=int, default=0, help="training seed (default 0)")
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: all cores; default 0)")
     p.add_argument("--out-dir", required=True, help="run folder: actor.pt, curve.csv, train.csv, checkpoint; "
@@ -131,8 +139,9 @@ def add_demos(sub) -> None:
     about = ("run the frontier searcher in a variant's training homes and store its transitions "
              "(demonstrations for imitation and RL)")
     p = sub.add_parser("demos", help=about, description=about)
-    p.add_argument("--variant", required=True, help="a file stem in ablations/ (head_on, head_off, ...): its "
-                                                    "training homes, heights and observation")
+    p.add_argument("--variant", required=True, help=VARIANT_HELP + ": its training homes, heights and observation")
+    p.add_argument("--set", action="append", metavar="FIELD=VALUE",
+                   help=SET_HELP + " (the training's own --set: its demo_episodes, its observation)")
     p.add_argument("--profile", default="cpu", help="learner profile whose observation is stored: smoke, cpu or "
                                                     "paper (default: cpu)")
     p.add_argument("--episodes", type=int, help="demonstration episodes (default: the variant's demo_episodes at "
@@ -152,7 +161,10 @@ def add_config(sub) -> None:
     show.add_argument("algorithm", choices=list(REGISTERED_LEARNERS), help="the learner (LearnerConfig.algorithm)")
     show.add_argument("--profile", default="cpu", choices=list(PROFILES),
                       help="learner profile: smoke, cpu or paper (default: cpu)")
-    show.add_argument("--variant", help="a file stem in ablations/ whose config overrides are shown on top")
+    show.add_argument("--variant", help=VARIANT_HELP + ": its config overrides shown on top, its env_id and "
+                                        "train_env above the fields")
+    show.add_argument("--set", action="append", metavar="FIELD=VALUE", help=SET_HELP + ", shown on top of the variant")
+    show.add_argument("--full", action="store_true", help="each field's whole docstring, not its first sentence")
     about_page = "write docs/config.md: every learner's fields, paper and cpu values, declaring class and docstring"
     page = actions.add_parser("page", help=about_page, description=about_page)
     page.add_argument("--out", default="docs/config.md", metavar="FILE.md", help="where (default: docs/config.md)")

@@ -15,7 +15,7 @@ from egosearch.rl.train import train
 from egosearch.rl.train_stacked import train_stacked
 from egosearch.runs.evaluate import scenario_evaluator
 from egosearch.sim.home_pool import curve_homes
-from egosearch.variants import check_learner_config, resolve_variant
+from egosearch.variants import check_learner_config, parse_set, resolve_variant
 
 
 def run(args) -> None:
@@ -29,8 +29,9 @@ def run(args) -> None:
     check_seed("--seed", args.seed, numpy_legacy=True)
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     overrides = {"seed": args.seed, **({"num_threads": args.threads} if args.threads else {})}
-    resolved = resolve_variant(args.variant, args.profile, overrides)
-    check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long)
+    set_overrides = parse_set(args.set)
+    resolved = resolve_variant(args.variant, args.profile, overrides, set_overrides)
+    check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
     env = resolved.train_env
     evaluator = LazyEvaluator(lambda: scenario_evaluator(resolved.env_id, curve_homes(env), env["placement"],
                                                          n=resolved.config.eval_episodes,
@@ -45,7 +46,8 @@ def run(args) -> None:
         print(line, flush=True)
     try:
         summary = train(resolved.env_id, resolved.config, args.work_dir or args.out_dir, env_kwargs=env,
-                        evaluate_fn=evaluator, variant=resolved.name, max_wall_s=args.max_wall_s)
+                        evaluate_fn=evaluator, variant=resolved.name, max_wall_s=args.max_wall_s,
+                        set_overrides=resolved.set_overrides)
     except CheckpointError as err:
         # another run's folder (variant, profile or seed): the trainer refuses it before writing anything
         raise ValueError(f"{'--work-dir' if args.work_dir else '--out-dir'}: {err}") from None
@@ -66,7 +68,8 @@ def check_published_run(out_dir: Path, resolved) -> None:
         saved = json.loads(done.read_text())
     except (OSError, ValueError) as err:
         raise CheckpointError(f"cannot read {done} ({type(err).__name__})") from None
-    check_same_run("finished run", done, saved, resolved.name, resolved.env_id, resolved.train_env, resolved.config)
+    check_same_run("finished run", done, saved, resolved.name, resolved.env_id, resolved.train_env, resolved.config,
+                   resolved.set_overrides)
 
 
 class LazyEvaluator:
@@ -120,8 +123,9 @@ def run_stacked(args) -> None:
         raise ValueError(f"--max-wall-s must be a positive number of seconds, got {args.max_wall_s}")
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     threads = {"num_threads": args.threads} if args.threads else {}
-    resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}) for s in seeds]
-    check_learner_config(resolved[0].variant, args.profile, allow_long=args.allow_long)
+    set_overrides = parse_set(args.set)
+    resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}, set_overrides) for s in seeds]
+    check_learner_config(resolved[0].variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
     env = resolved[0].train_env
     evaluators = [LazyEvaluator(lambda r=r: scenario_evaluator(r.env_id, curve_homes(env), env["placement"],
                                                                n=r.config.eval_episodes,
@@ -135,7 +139,8 @@ def run_stacked(args) -> None:
                 raise ValueError(f"--out-dir: {err}") from None
     try:
         summaries = train_stacked(resolved[0].env_id, [r.config for r in resolved], works or outs, env_kwargs=env,
-                                  evaluate_fns=evaluators, variant=resolved[0].name, max_wall_s=args.max_wall_s)
+                                  evaluate_fns=evaluators, variant=resolved[0].name, max_wall_s=args.max_wall_s,
+                                  set_overrides=set_overrides)
     except CheckpointError as err:
         raise ValueError(f"{'--work-dir' if works else '--out-dir'}: {err}") from None
     finally:

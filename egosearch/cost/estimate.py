@@ -41,6 +41,7 @@ from egosearch.cost.schedule import (
 )
 from egosearch.report.workflow_jobs import job_cost_s
 from egosearch.rl.config import BODY_STEPS, DECISIONS
+from egosearch.rl.training_aids import demonstration_settings
 from egosearch.workflow.dag import dag_jobs
 
 
@@ -265,7 +266,7 @@ class _Pricing:
             seconds = steps * per_step if per_step else float("nan")
             where = f"the stored trainings' machines (their CPU time per env step, {config.env_step_unit})"
         teacher = ""
-        if getattr(config, "demo_episodes", 0):  # a learner without demonstrations has no such field
+        if demonstration_settings(config).demo_episodes:  # a learner without demonstrations: the aid's default
             # the rates above are the RL phase's: a training that learns from the classical searcher first
             # runs its episodes and clones them (training_time_line adds them the same way)
             extra = teacher_cost_s(config, self.results, self.bench, rate) if rate else None
@@ -362,7 +363,7 @@ def training_time_line(steps: int, profile: str, config=None) -> str | None:
         line = (f"estimate: about {_hours(steps * per_step)} of CPU time for {steps} env steps ({other}), as the "
                 "stored trainings of its kind ran on their machines" if per_step else
                 f"estimate: none (no stored training's env steps are {other}, as this one's)")
-        if getattr(config, "demo_episodes", 0):
+        if demonstration_settings(config).demo_episodes:
             line += f", plus the teacher's {config.demo_episodes} episodes and the cloning (not priced here)"
         return line
     rate = cached_rate()
@@ -372,7 +373,7 @@ def training_time_line(steps: int, profile: str, config=None) -> str | None:
     line = (f"estimate: about {_hours(steps / (k * rate))} of CPU time for {steps} env steps on this machine "
             f"(calibrated at {rate:.0f} {kind} per CPU-second"
             + (f", a training at {k:.2f} x that as in the stored run" if ratio else "") + ")")
-    if config is not None and getattr(config, "demo_episodes", 0):
+    if config is not None and demonstration_settings(config).demo_episodes:
         extra = teacher_cost_s(config, results, bench, rate)
         line += (f", plus about {_hours(extra)} for the teacher's {config.demo_episodes} episodes and the cloning"
                  if extra is not None else

@@ -252,19 +252,23 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
     warm-up and the critic's warm-up: ``bc_updates``, ``critic_warmup_updates``), and for the end of the
     decaying cloning term (``bc_decay_steps``, where it reaches 0 or its ``bc_weight_floor``). Empty for a
     training without a teacher (or no config)."""
+    from egosearch.rl.config import field_defaults  # local: the learner registry, for a curve with a teacher
+
     try:
-        cfg = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))["config"]
+        recorded = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))["config"]
     except (OSError, ValueError, KeyError):
         return []
+    # a field the run's learner does not have, or that did not exist when it was stored: its declared default
+    cfg = {**field_defaults(), **recorded}
     phases = []
     if cfg.get("bc_updates"):
         first_update = -(-max(cfg["init_steps"], 1) // cfg["update_every"]) * cfg["update_every"]
-        warmup_steps = -(-cfg.get("critic_warmup_updates", 0) // cfg["updates_per_step"]) * cfg["update_every"]
+        warmup_steps = -(-cfg["critic_warmup_updates"] // cfg["updates_per_step"]) * cfg["update_every"]
         start = first_update + warmup_steps
         if start <= cfg["total_env_steps"]:
             phases.append((start, "imitation ends: RL steps the actor"))
-    if cfg.get("bc_weight") and cfg.get("bc_decay_steps", 0) <= cfg["total_env_steps"]:
-        floor = cfg.get("bc_weight_floor", 0.0)
+    if cfg.get("bc_weight") and cfg["bc_decay_steps"] <= cfg["total_env_steps"]:
+        floor = cfg["bc_weight_floor"]
         phases.append((int(cfg["bc_decay_steps"]), f"cloning term reaches {floor:g}"))
     return phases
 

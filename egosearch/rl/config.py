@@ -324,6 +324,21 @@ HOUSEKEEPING_FIELDS = frozenset({"eval_every", "eval_episodes", "log_every", "ch
 """Fields that change how a run is watched, saved or placed on the machine, never what it learns."""
 
 
+RESUMABLE_FIELDS = ("device", "num_threads", "compile", "cuda_graph", "keep_checkpoint")
+"""Config fields that may differ between a checkpoint and the run resuming it."""
+
+
+def identity_set(set_overrides: dict[str, Any]) -> dict[str, Any]:
+    """The command line's ``--set`` overrides that make a training another training: all but the fields a resume
+    may change (:data:`RESUMABLE_FIELDS`: ``--set num_threads=2`` on resume is the same run)."""
+    return {k: v for k, v in set_overrides.items() if k not in RESUMABLE_FIELDS}
+
+
+def format_set(set_overrides: dict[str, Any]) -> str:
+    """``--set`` overrides as the command line gives them: ``batch_size=64,actor_lr=0.0001``."""
+    return ",".join(f"{key}={value}" for key, value in set_overrides.items())
+
+
 def field_docs() -> dict[str, str]:
     """Each config field's docstring (the string literal under it in its settings class's source)."""
     import ast
@@ -386,18 +401,21 @@ def first_sentence(doc: str) -> str:
 
 
 def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, Any] | None = None,
-                   variant: str = "") -> list[dict[str, str]]:
-    """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top), in
-    :func:`field_order`: its value, where the value comes from (the field's default, the profile, the
-    variant), the paper's value, the settings class and module that declare it, and its docstring's first
-    sentence. What ``egosearch config show`` prints."""
-    overrides = {**(variant_overrides or {}), "algorithm": algorithm}
+                   variant: str = "", set_overrides: dict[str, Any] | None = None) -> list[dict[str, str]]:
+    """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top, and the command
+    line's ``--set`` overrides on top of those), in :func:`field_order`: its value, where the value comes from
+    (the field's default, the profile, the variant, ``--set``), the paper's value, the settings class and module
+    that declare it, its docstring's first sentence (``doc``) and its whole docstring (``doc_full``). What
+    ``egosearch config show`` prints."""
+    overrides = {**(variant_overrides or {}), **(set_overrides or {}), "algorithm": algorithm}
     cfg = load_config(profile, overrides)
     base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
-        if name in (variant_overrides or {}):
+        if name in (set_overrides or {}):
+            source = "--set"
+        elif name in (variant_overrides or {}):
             source = f"variant {variant}".strip()
         elif name == "algorithm":
             source = "asked"
@@ -408,7 +426,8 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
         doc = docs.get(name, "")
         first = first_sentence(doc)
         rows.append({"field": name, "value": repr(getattr(cfg, name)), "source": source,
-                     "paper": repr(paper[name]), "declared_in": f"{owner.__module__}.{owner.__name__}", "doc": first})
+                     "paper": repr(paper[name]), "declared_in": f"{owner.__module__}.{owner.__name__}", "doc": first,
+                     "doc_full": doc})
     return rows
 
 
@@ -417,6 +436,8 @@ TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(LearnerConfig()))
 
 __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "CURRICULUM_START_RADIUS",
            "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PROFILES",
+           "RESUMABLE_FIELDS",
            "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
-           "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "load_config",
+           "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "first_sentence",
+           "format_set", "identity_set", "load_config",
            "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]

@@ -17,15 +17,11 @@ import numpy as np
 import torch
 
 from egosearch.envs import ALL_ENV_IDS, env_options
-from egosearch.rl.config import LearnerConfig, field_defaults
+from egosearch.rl.config import RESUMABLE_FIELDS, LearnerConfig, field_defaults, format_set, identity_set
 
 CHECKPOINT_FORMAT = "egosearch-sac-curl-checkpoint-v1"
 
 
-
-
-RESUMABLE_FIELDS = ("device", "num_threads", "compile", "cuda_graph", "keep_checkpoint")
-"""Config fields that may differ between a checkpoint and the run resuming it."""
 
 
 class CheckpointError(RuntimeError):
@@ -205,10 +201,19 @@ def env_kwargs_key(env_kwargs: dict) -> str:
 
 
 def check_same_run(what: str, path: Path, saved: dict, variant: str, env_id: str, env_kwargs: dict,
-                    cfg: LearnerConfig) -> None:
+                    cfg: LearnerConfig, set_overrides: dict | None = None) -> None:
+    """A checkpoint or finished run (``saved``) is the run asked for: its variant and env id, its training env, its
+    ``--set`` overrides and its config (but the fields a resume may change), else one-line ``CheckpointError``."""
     if saved.get("variant") != variant or saved.get("env_id") != env_id:
         raise CheckpointError(f"{path} belongs to variant={saved.get('variant')!r} env_id={saved.get('env_id')!r}, "
                               f"not variant={variant!r} env_id={env_id!r}; use another out_dir")
+    theirs_set, mine_set = identity_set(saved.get("set") or {}), identity_set(set_overrides or {})
+    if theirs_set != mine_set:
+        # refused even where the configs agree (a --set of a value the variant already has): the run's record
+        # would name overrides it was not trained with
+        raise CheckpointError(f"{what} {path} was trained with --set {format_set(theirs_set) or 'none'}, not "
+                              f"{format_set(mine_set) or 'none'}; give the same --set to resume it, or use another "
+                              "out_dir")
     if saved.get("env_kwargs") != env_kwargs_key(env_kwargs):
         raise CheckpointError(f"{what} {path} was written with env_kwargs {saved.get('env_kwargs')}, "
                               f"not {env_kwargs_key(env_kwargs)}; use another out_dir")

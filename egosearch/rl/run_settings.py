@@ -25,9 +25,10 @@ Complaint = Callable[[str, str], None]
 """``bad(field, allowed)``: raises the one-line ``ValueError`` of a value out of range."""
 
 CURRICULUM_START_RADIUS = 1.0
-"""Start radius (m) around the target at the first step of a curriculum (``curriculum_steps``)."""
+"""The default of :attr:`RunSettings.curriculum_start_radius` (the name ``curriculum_steps``' docstring, which the
+stored Table 2 pages quote, gives it)."""
 CURRICULUM_END_RADIUS = 12.0
-"""Radius (m) the curriculum reaches at its end: more than any home's extent."""
+"""The default of :attr:`RunSettings.curriculum_end_radius`."""
 DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 """Forms of r_d (the env's ``egosearch.sim.env.DISTANCE_REWARDS``; ``tests/test_rl_sac.py``'s
 ``test_the_configs_forms_of_r_d_are_the_envs`` keeps them equal)."""
@@ -138,6 +139,12 @@ class RunSettings:
     ``CURRICULUM_END_RADIUS`` (12 m, the whole home) over the first this many env steps; after
     that, starts are drawn from the whole home as in the paper. TRAINING ONLY: evaluation always
     uses the stored scenarios."""
+    curriculum_start_radius: float = CURRICULUM_START_RADIUS
+    """Ours (the paper has no curriculum): the radius (m) around the target within which training episodes start
+    at the first env step of a curriculum; read only with ``curriculum_steps`` > 0."""
+    curriculum_end_radius: float = CURRICULUM_END_RADIUS
+    """Ours: the radius (m) the curriculum's start radius has grown to at env step ``curriculum_steps``: more than
+    any home's extent, so that the last starts are the whole home's; read only with ``curriculum_steps`` > 0."""
 
     train_height_min: float = 1.0
     """Paper 4.1: 1.0, i.e. the camera height of a training episode is drawn from [1.0, 1.8] m
@@ -225,6 +232,8 @@ class RunSettings:
         if self.total_env_steps < first_update:
             bad("total_env_steps", f">= {first_update}, the env step of the first update (after init_steps="
                 f"{self.init_steps} random steps, an update every {self.update_every} steps): fewer train no update")
+        if not 0.0 < self.curriculum_start_radius <= self.curriculum_end_radius:
+            bad("curriculum_start_radius", f"(0, curriculum_end_radius={self.curriculum_end_radius}] m")
         if not 0.3 <= self.train_height_min <= 1.8:
             bad("train_height_min", "[0.3, 1.8] m (training heights are drawn from [this, 1.8] m)")
         if not 0.0 < self.gamma <= 1.0:
@@ -240,7 +249,7 @@ class RunSettings:
         if env_steps >= self.curriculum_steps:
             return None
         frac = env_steps / self.curriculum_steps
-        return CURRICULUM_START_RADIUS + frac * (CURRICULUM_END_RADIUS - CURRICULUM_START_RADIUS)
+        return self.curriculum_start_radius + frac * (self.curriculum_end_radius - self.curriculum_start_radius)
 
     @property
     def env_step_unit(self) -> str:

@@ -217,7 +217,7 @@ def torch_threads(requested: int = 0) -> int:
 def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwargs: dict | None = None,
           evaluate_fn: Callable[[Any], dict] | None = None, *, variant: str | None = None,
           progress: bool = True, on_step: Callable[[int], None] | None = None,
-          max_wall_s: float | None = None) -> dict:
+          max_wall_s: float | None = None, set_overrides: dict | None = None) -> dict:
     """Train (or resume, or return at once if ``done.json`` is there) and return the summary.
 
     ``evaluate_fn(policy) -> dict`` with success_rate, spl, episode_return is called every
@@ -229,13 +229,16 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
     past it, with a checkpoint written there (a job inside a cluster's time limit, or a device
     lent for minutes); the summary then has ``"stopped": True`` and no actor is written. The next
     call resumes from that checkpoint.
+
+    ``set_overrides``: the command line's ``--set`` fields, already in ``cfg``; recorded as ``set`` in
+    config.json, the checkpoint and done.json, and compared on resume (another ``--set`` is refused).
     """
     cfg = cfg.validate()
     env_id = observed_env_id(env_id, cfg.target_memory, cfg.modular_searcher)
     env_kwargs = dict(env_kwargs or {})
     out_dir = Path(out_dir)
     variant = variant or env_id
-    done, ckpt = open_run(env_id, cfg, out_dir, env_kwargs, variant)
+    done, ckpt = open_run(env_id, cfg, out_dir, env_kwargs, variant, set_overrides)
     if done is not None:
         return done
 
@@ -247,7 +250,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
         for _ in range(cfg.num_envs):
             envs.append(make_train_env(env_id, train_env_kwargs(cfg, env_kwargs)))
         return _train(envs, env_id, cfg, out_dir, env_kwargs, evaluate_fn, variant, progress, on_step, ckpt,
-                      max_wall_s)
+                      max_wall_s, set_overrides)
     finally:
         for env in envs:
             env.close()
@@ -255,7 +258,7 @@ def train(env_id: str, cfg: LearnerConfig, out_dir: str | os.PathLike, env_kwarg
 
 
 def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
-             variant: str) -> tuple[dict | None, dict | None]:
+             variant: str, set_overrides: dict | None = None) -> tuple[dict | None, dict | None]:
     """A run folder's state, validated before anything is written: (``done.json``'s summary of a
     finished run, None) or (None, the checkpoint to resume, or None for a fresh start)."""
     ckpt_path, done_path = out_dir / CHECKPOINT_NAME, out_dir / "done.json"
@@ -264,7 +267,7 @@ def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
             done = json.loads(done_path.read_text())
         except (OSError, ValueError) as err:
             raise CheckpointError(f"cannot read {done_path} ({describe_error(err)})") from None
-        check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg)
+        check_same_run("finished run", done_path, done, variant, env_id, env_kwargs, cfg, set_overrides)
         return done, None
     ours = {CHECKPOINT_NAME.name, "actor.pt", START_ACTOR_NAME, "done.json", "config.json", "curve.csv",
             "curve_episodes.csv", "train.csv"}
@@ -274,7 +277,7 @@ def open_run(env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict,
             stale.unlink()
     ckpt = load_checkpoint(ckpt_path) if ckpt_path.exists() else None
     if ckpt is not None:
-        check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg)
+        check_same_run("checkpoint", ckpt_path, ckpt, variant, env_id, env_kwargs, cfg, set_overrides)
         if demonstration_settings(cfg).demo_episodes:
             # the demonstrations it resumes with: the run's own, readable, before any env is built
             demos = demos_path_of(ckpt_path)
@@ -311,9 +314,10 @@ def _privileged_state_dim(env, env_id: str, cfg: LearnerConfig) -> int:
 
 
 def _train(envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, evaluate_fn, variant: str,
-           progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None) -> dict:
+           progress: bool, on_step, ckpt: dict | None, max_wall_s: float | None = None,
+           set_overrides: dict | None = None) -> dict:
     """The loop: act, step and store, update, then log / evaluate / checkpoint when their step comes."""
-    run = LiveRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress)
+    run = LiveRun(envs, env_id, cfg, out_dir, env_kwargs, variant, ckpt, progress, set_overrides)
     own_eval = evaluate_fn is None
     evaluate_fn = evaluate_fn or default_evaluator(env_id, {**env_kwargs, **observation_kwargs(cfg.to_dict())},
                                                    cfg.eval_episodes)
@@ -357,8 +361,9 @@ class LiveRun:
     resets, updates), so that a resumed run equals the one that was not stopped."""
 
     def __init__(self, envs: list, env_id: str, cfg: LearnerConfig, out_dir: Path, env_kwargs: dict, variant: str,
-                 ckpt: dict | None, progress: bool = False):
+                 ckpt: dict | None, progress: bool = False, set_overrides: dict | None = None):
         self.envs, self.env_id, self.cfg, self.variant = envs, env_id, cfg, variant
+        self.set_overrides = dict(set_overrides or {})
         self.out_dir, self.env_kwargs = out_dir, env_kwargs
         self.ckpt_path, self.done_path = out_dir / CHECKPOINT_NAME, out_dir / "done.json"
         self.device = resolve_device(cfg.device)
@@ -384,8 +389,11 @@ class LiveRun:
         self.observations = [self.reset(e, sd) for e, sd in zip(envs, reset_seeds)]
         self.stored = [self.to_replay(o) for o in self.observations]  # as the replay stores them, each computed once
         self.ep_returns = [0.0] * len(envs)
+        # `set`: the fields the command line's --set gave (already in `config`), so that a reader tells them
+        # from the variant's, and a resume refuses other ones
         atomic_json(out_dir / "config.json", {"variant": variant, "env_id": env_id,
-                                              "env_kwargs": env_kwargs_key(env_kwargs), "config": cfg.to_dict()})
+                                              "env_kwargs": env_kwargs_key(env_kwargs), "config": cfg.to_dict(),
+                                              "set": self.set_overrides})
         self.policy = AgentPolicy(self.agent)
         self.say = print
         self.means = {"curve": _Mean(), "train": _Mean()}
@@ -670,7 +678,7 @@ class LiveRun:
     def save_checkpoint(self) -> None:
         state = {
             "format": CHECKPOINT_FORMAT, "variant": self.variant, "env_id": self.env_id,
-            "env_kwargs": env_kwargs_key(self.env_kwargs), "config": self.cfg.to_dict(),
+            "env_kwargs": env_kwargs_key(self.env_kwargs), "config": self.cfg.to_dict(), "set": self.set_overrides,
             "env_steps": self.step, "episodes": self.episodes, "wall_s": self.wall(),
             "csv_rows": {"curve": self.curve.rows(), "train": self.train_log.rows(),
                          "curve_episodes": self.curve_episodes.rows()},
@@ -693,7 +701,7 @@ class LiveRun:
         return {"variant": self.variant, "env_id": self.env_id, "env_kwargs": env_kwargs_key(self.env_kwargs),
                 "stopped": True, "env_steps": self.step, "updates": self.agent.num_updates,
                 "episodes": self.episodes, "wall_s": round(self.wall(), 3),
-                "machine": self.machine(), "config": self.cfg.to_dict()}
+                "machine": self.machine(), "config": self.cfg.to_dict(), "set": self.set_overrides}
 
     def actor_meta(self) -> dict:
         """What an actor file of this run records besides its weights."""
@@ -733,7 +741,7 @@ class LiveRun:
                                   for k, v in last_row.items()},
                    # wall_s is core time only on the machine that ran it: the budget study shows which
                    "machine": self.machine(),
-                   "config": cfg.to_dict()}
+                   "config": cfg.to_dict(), "set": self.set_overrides}
         if self.demo_summary is not None:
             summary["demonstrations"] = self.demo_summary
         if self.imitation["dagger"]:

@@ -48,12 +48,14 @@ def same_but_seed(cfgs: list[LearnerConfig]) -> None:
 
 def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | Path], env_kwargs: dict | None = None,
                   evaluate_fns: list[Evaluator] | None = None, *, variant: str | None = None, progress: bool = True,
-                  on_step: Callable[[int], None] | None = None, max_wall_s: float | None = None) -> list[dict]:
+                  on_step: Callable[[int], None] | None = None, max_wall_s: float | None = None,
+                  set_overrides: dict | None = None) -> list[dict]:
     """Train (or resume) seed ``cfgs[k].seed`` into ``out_dirs[k]`` for every k, the updates stacked;
     returns each seed's summary, as :func:`egosearch.rl.train.train` returns it (``"stopped": True``
     after ``max_wall_s``). ``evaluate_fns[k]`` evaluates seed k's policy (default: one
     :func:`egosearch.rl.train.default_evaluator` each). ``on_step(env_steps)`` is called after every
-    round of env steps (tests use it to interrupt the process)."""
+    round of env steps (tests use it to interrupt the process). ``set_overrides``: the command line's ``--set``
+    fields, as :func:`egosearch.rl.train.train` records and checks them."""
     if not cfgs or len(cfgs) != len(out_dirs) or (evaluate_fns is not None and len(evaluate_fns) != len(cfgs)):
         raise ValueError("one config, one out_dir (and one evaluator, if any) per seed")
     cfgs = [cfg.validate() for cfg in cfgs]
@@ -63,7 +65,7 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
     env_kwargs = dict(env_kwargs or {})
     variant = variant or env_id
     dirs = [Path(d) for d in out_dirs]
-    opened = [open_run(env_id, cfg, d, env_kwargs, variant) for cfg, d in zip(cfgs, dirs)]
+    opened = [open_run(env_id, cfg, d, env_kwargs, variant, set_overrides) for cfg, d in zip(cfgs, dirs)]
     summaries: list[dict | None] = [done for done, _ in opened]
     todo = [k for k, (done, _) in enumerate(opened) if done is None]
     if not todo:
@@ -86,7 +88,7 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
             envs.append([make_train_env(env_id, train_env_kwargs(cfg, env_kwargs)) for _ in range(cfg.num_envs)])
         done = _train_stacked([cfgs[k] for k in todo], [dirs[k] for k in todo], envs, env_id, env_kwargs, variant,
                               [opened[k][1] for k in todo], [evaluators[k] for k in todo], on_step, max_wall_s,
-                              progress)
+                              progress, set_overrides)
         for k, summary in zip(todo, done):
             summaries[k] = summary
         return [s for s in summaries if s is not None]
@@ -102,7 +104,8 @@ def train_stacked(env_id: str, cfgs: list[LearnerConfig], out_dirs: list[str | P
 
 def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list], env_id: str, env_kwargs: dict,
                    variant: str, ckpts: list[dict | None], evaluators: list[Evaluator],
-                   on_step: Callable[[int], None] | None, max_wall_s: float | None, progress: bool) -> list[dict]:
+                   on_step: Callable[[int], None] | None, max_wall_s: float | None, progress: bool,
+                   set_overrides: dict | None = None) -> list[dict]:
     """The loop of :func:`egosearch.rl.train.train`'s ``_train``, the seeds in turn for everything
     but the updates, which are stacked."""
     runs: list[LiveRun] = []
@@ -117,7 +120,7 @@ def _train_stacked(cfgs: list[LearnerConfig], dirs: list[Path], envs: list[list]
     for cfg, d, seed_envs, ckpt in zip(cfgs, dirs, envs, ckpts):
         # LiveRun seeds the global generators and builds the agent as a separate run does; what
         # they hold after it (a resumed run: the checkpoint's states) becomes this seed's stream
-        run = LiveRun(seed_envs, env_id, cfg, d, env_kwargs, variant, ckpt)
+        run = LiveRun(seed_envs, env_id, cfg, d, env_kwargs, variant, ckpt, set_overrides=set_overrides)
         run.say = lambda line, seed=cfg.seed: write(f"[seed {seed}] {line}")
         streams = streams or SeedStreams(run.device)
         streams.capture()

@@ -23,7 +23,9 @@ from egosearch.variants import (  # noqa: F401  (variant_head: the rules import 
     Variant,
     VariantError,
     check_learner_config,
+    format_set,
     load_variant,
+    parse_set,
     variant_head,
 )
 
@@ -232,10 +234,64 @@ def checked_variants(config: dict, argv: list[str] | None = None,
         check_config(config)
         command_line_claims_pairs(config, command_line)
         comparing = next((t for t in ("compare", "screen") if t in argv), False)
+        workflow_set(config)
         return workflow_variants(config, compare=comparing, directory=directory)
     except (ConfigError, VariantError) as err:
         print(f"egosearch: error: {err}", file=sys.stderr)
         sys.exit(1)
+
+
+def workflow_set(config: dict) -> dict:
+    """The workflow config's ``set`` (``--config set="FIELD=VALUE,..."``) as {field: value}, each field and
+    value checked as ``egosearch train --set`` checks them (a one-line ``VariantError`` naming ``config set``);
+    the ranges, which depend on the variant, are checked against each training of the DAG
+    (:func:`trainings_set_line`)."""
+    return parse_set(config.get("set"), where="config set")
+
+
+def set_arguments(set_overrides: dict) -> str:
+    """The ``--set FIELD=VALUE`` arguments that hand ``set_overrides`` to ``egosearch train`` / ``egosearch demos``
+    (shell-quoted; empty without a set)."""
+    import shlex
+
+    return "".join(f" --set {shlex.quote(f'{key}={value}')}" for key, value in set_overrides.items())
+
+
+def recorded_set(run_dir: Path) -> dict | None:
+    """The ``set`` a stored training in ``run_dir`` recorded (its config.json, else its done.json): {} for one
+    stored before trainings recorded it; None where no training is stored."""
+    for name in ("config.json", "done.json"):
+        try:
+            return dict(json.loads((Path(run_dir) / name).read_text(encoding="utf-8")).get("set") or {})
+        except (OSError, ValueError, AttributeError):
+            continue
+    return None
+
+
+def trainings_set_line(trainings, set_overrides: dict, learner_of) -> str | None:
+    """One line, or None. ``trainings``: the DAG's training jobs as (variant, run folder). Each must take
+    ``set_overrides`` (their ranges, and only fields its learner has, at ``learner_of(variant)``, the run's
+    learner profile); and a training stored in its folder, whether the plan reuses it or Snakemake would redo
+    it, must have recorded the same set: results under one variant's name take one config."""
+    from egosearch.rl.config import identity_set
+    from egosearch.variants import resolve_variant
+
+    mine = identity_set(set_overrides)
+    checked: set[str] = set()
+    for variant, run_dir in trainings:
+        if set_overrides and variant not in checked:
+            checked.add(variant)
+            try:
+                resolve_variant(variant, learner_of(variant), set_overrides=set_overrides)
+            except VariantError as err:
+                return f"config set={format_set(set_overrides)}: variant {variant}: {str(err).split(': ', 1)[-1]}"
+        recorded = recorded_set(run_dir)
+        if recorded is not None and identity_set(recorded) != mine:
+            return (f"config set={format_set(mine) or 'none'}: the plan reads the stored training {run_dir}, trained "
+                    f"with set {format_set(identity_set(recorded)) or 'none'}; a set applies to the trainings a run "
+                    "makes and a variant's results take one config: keep the overrides as a variant of their own "
+                    "(`egosearch variant new NAME`, its config: holding them), or target trainings not stored yet")
+    return None
 
 
 def reports_missing_inputs(rules, exists=lambda p: Path(p).exists()) -> list[str]:

@@ -13,7 +13,7 @@ from egosearch.workflow.cluster import (is_cluster, partitions_asked, profile_mi
                                        slurm_run_problem, snakemake_args, snakemake_executor)
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
 from egosearch.searchers import registry as searchers
-from egosearch.workflow.check import claims_pairs, variant_head
+from egosearch.workflow.check import claims_pairs, set_arguments, variant_head, workflow_set
 
 # The executor of this run (--executor, or a profile's executor:, as profiles/slurm names slurm): Snakemake
 # parses the Snakefile before it hands the run its executor, so workflow.local_exec cannot tell
@@ -55,6 +55,10 @@ PLACEMENTS = config["placements"]
 FULLBODY = PROF["fullbody"]
 REF = config["reference_variant"]
 RESULTS = f"results/{PROFILE}"
+# `--config set="FIELD=VALUE,..."`: learner fields on top of every variant's, handed to the trainings (and
+# demonstrations) this run makes as `--set` arguments (checked in the Snakefile with the config)
+SET_OVERRIDES = workflow_set(config)
+SET_ARGS = set_arguments(SET_OVERRIDES)
 FIGS = f"paper_figs/{PROFILE}"
 BASELINES = ["one_step_short", "one_step_long", "noisy_search"]
 
@@ -119,6 +123,30 @@ def print_the_plans_cost():
     print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given(),
                 trainings_per_gpu=TRAININGS_PER_GPU, plan=plan_jobs(workflow.dag, PROFILE),
                 whole=whole_dag(workflow.dag))
+
+
+def check_the_trainings_set_once_built():
+    """Once the DAG is built, in a dry run as in a real one and before any job: every training of the plan takes
+    the workflow config's `set`, and none stored in its folder was trained with another set (none, without a
+    `set`) (egosearch.workflow.check.trainings_set_line), else one line and exit 1. Snakemake has no hook
+    between building the DAG and printing a dry run's plan, so its DAG-building step is wrapped (as the cost
+    line's is, print_the_plans_cost_once_built)."""
+    from egosearch.workflow.check import trainings_set_line
+
+    build_dag = getattr(workflow, "_build_dag", None)
+    if build_dag is None:
+        return
+
+    def build_then_check():
+        build_dag()
+        trainings = [(job.wildcards.variant, Path(str(job.output[0])).parent)
+                     for job in workflow.dag.jobs if job.rule.name == "train"]
+        line = trainings_set_line(trainings, SET_OVERRIDES, lambda variant: PROF["learner"])
+        if line:
+            print(f"egosearch: error: {line}", file=sys.stderr)
+            sys.exit(1)
+
+    workflow._build_dag = build_then_check
 
 
 def print_the_plans_cost_once_built():

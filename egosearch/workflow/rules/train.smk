@@ -1,7 +1,8 @@
 rule train:
     """SAC+CURL on the abstract searcher (paper 4.2). Trains in partial/ (checkpoint and growing
     CSVs, which Snakemake does not delete when it reruns a killed job), resumes there if killed, and
-    publishes the outputs only when the run is complete."""
+    publishes the outputs only when the run is complete. The workflow config's `set` reaches it as --set
+    arguments; a stored training recorded with another set stops the run before any job (rules/common.smk)."""
     output:
         actor=update("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
         curve=update("results/{profile}/train/{variant}/seed{seed}/curve.csv"),
@@ -19,9 +20,11 @@ rule train:
         **train_resources(PROFILE),
     conda:
         CONDA_ENV
+    # SET_ARGS: the workflow config's `set` as --set arguments (rules/common.smk), empty without one, so that the
+    # command of a run without a set is the one Snakemake recorded for the stored trainings
     shell:
         "egosearch train --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--threads {threads} --work-dir {params.work_dir} --out-dir {params.out_dir} > {log} 2>&1"
+        f"--threads {{threads}} --work-dir {{params.work_dir}} --out-dir {{params.out_dir}}{SET_ARGS} > {{log}} 2>&1"
 
 
 rule demos:
@@ -43,4 +46,4 @@ rule demos:
         CONDA_ENV
     shell:
         "egosearch demos --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
-        "--out {output.transitions} > {log} 2>&1"
+        f"--out {{output.transitions}}{SET_ARGS} > {{log}} 2>&1"
