@@ -22,16 +22,17 @@ import yaml
 
 from egosearch.core.schema_errors import schema_error
 from egosearch.envs import EnvOptions, env_options, observed_env_id
-from egosearch.rl.config import (  # noqa: F401  (format_set: the CLI and the workflow read it from here)
+from egosearch.rl.config import (  # noqa: F401  (format_set, identity_set: the CLI and the workflow read them here)
     ALGORITHMS,
     LearnerConfig,
     field_types,
     format_set,
+    identity_set,
     load_config,
     refuse_foreign_fields,
 )
 from egosearch.rl.run_settings import ALLOW_LONG_ENV, LONG_RUN_BOUNDS
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.sim.home_pool import check_home_split
 
 #: ``ablations/`` of the working directory (where Snakemake runs), else of this checkout.

@@ -12,7 +12,7 @@ import pytest
 import torch
 
 from egosearch.cli import main
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.variants import VariantError, load_variant, new_variant, variant_names
 from egosearch.workflow.check import ConfigError, check_config, checked_variants, coerce_numbers
 
@@ -505,7 +505,7 @@ def test_a_variant_compared_with_itself_is_one_line(tmp_path, capsys, suite, mon
 
 def _actor_file(path: Path, action_dim: int, metadata: dict) -> Path:
     from egosearch.rl.config import load_config
-    from egosearch.rl.registry import make_agent
+    from egosearch.rl.learner_registry import make_agent
 
     agent = make_agent(load_config("smoke", {"device": "cpu"}), action_dim, 30, 4, torch.device("cpu"))
     torch.save(agent.actor_state(metadata), path)

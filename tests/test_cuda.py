@@ -32,7 +32,7 @@ os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
 
 from egosearch.rl.bench_learner import _filled_replay  # noqa: E402
 from egosearch.rl.config import load_config  # noqa: E402
-from egosearch.rl.registry import make_agent  # noqa: E402
+from egosearch.rl.learner_registry import make_agent  # noqa: E402
 from egosearch.rl.sac_curl import load_actor_net  # noqa: E402
 from egosearch.rl.train import train  # noqa: E402
 from egosearch.sim.env import PRIVILEGED_STATE_DIM  # noqa: E402

@@ -35,7 +35,7 @@ NEW_FILES = {
 """Each extension's file and its own test: toy in tests/extensions/ -> where the copy gets it."""
 
 REGISTRATIONS = {
-    "egosearch/searchers/registry.py": '''
+    "egosearch/searchers/searcher_registry.py": '''
 register("toy_spin", "egosearch.searchers.toy_spin:ToySpin", env_id="EgoSearchNoHead-v0", head=False,
          label="toy searcher that only turns", what="turns on the spot", bound=True)
 ''',
@@ -43,7 +43,7 @@ register("toy_spin", "egosearch.searchers.toy_spin:ToySpin", env_id="EgoSearchNo
 register("toy_step_clock", "egosearch.sim.toy_step_clock:ToyStepClock",
          "egosearch.sim.toy_step_clock:ToyStepClockSettings")
 ''',
-    "egosearch/rl/registry.py": '''
+    "egosearch/rl/learner_registry.py": '''
 register("toy_bc", "toy BC", "egosearch.rl.toy_bc:ToyBcAgent",
          {"toy-bc-actor-v1": "egosearch.rl.toy_bc:load_actor_net"}, settings="egosearch.rl.toy_bc:ToyBcSettings")
 ''',
@@ -104,7 +104,7 @@ def test_four_extensions_are_each_a_file_a_registration_line_and_a_test(tmp_path
                           text=True)
     assert lint.returncode == 0, lint.stdout[-3000:]
     # the copy's package is the one imported (its registries hold the toys)
-    probe = subprocess.run([sys.executable, "-c", "import egosearch, egosearch.rl.registry as r; "
+    probe = subprocess.run([sys.executable, "-c", "import egosearch, egosearch.rl.learner_registry as r; "
                             "print(egosearch.__file__, 'toy_bc' in r.LEARNERS)"], cwd=copy, env=env,
                            capture_output=True, text=True)
     assert probe.stdout.split() == [str(copy / "egosearch" / "__init__.py"), "True"], probe.stderr[-2000:]

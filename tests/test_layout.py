@@ -38,7 +38,7 @@ simulates the workflow's DAG: the env step units of rl, a comparison's variant, 
 the workflow's config and stored jobs) and the CLI on top."""
 
 
-OPEN_MODULES = {"egosearch.searchers.registry", "egosearch.core.registry"}
+OPEN_MODULES = {"egosearch.searchers.searcher_registry", "egosearch.core.named_registry"}
 """Modules every stage may import, whatever their stage: plain data that imports no other module of egosearch
 but another open one, nor any package outside the standard library (checked below), so that reading one loads
 no stage. The searchers' registry: the report's tables and figures, the workflow's checks and rules and the
@@ -249,8 +249,8 @@ def _registered_modules() -> set[str]:
     observation option's classes):
     the registry is their listing, so a plug-in is its file and its registration line, with no drawing or
     docstring to edit."""
-    from egosearch.rl.registry import LEARNERS
-    from egosearch.searchers.registry import SEARCHERS
+    from egosearch.rl.learner_registry import LEARNERS
+    from egosearch.searchers.searcher_registry import SEARCHERS
     from egosearch.sim.observation_options import OPTIONS
 
     targets = [t for e in LEARNERS.values() for t in (e.agent, e.settings, *e.actor_formats.values())]

@@ -18,8 +18,8 @@ from egosearch.rl.config import (
     own_settings,
     shared_fields,
 )
+from egosearch.rl.learner_registry import LEARNERS
 from egosearch.rl.profiles import CPU, PROFILES
-from egosearch.rl.registry import LEARNERS
 from egosearch.rl.run_settings import RunSettings
 from egosearch.variants import VariantError, load_variant
 
@@ -98,7 +98,7 @@ def test_a_variant_naming_its_learner_is_checked_against_it_when_read(tmp_path):
 
 
 def test_a_learner_registered_without_settings_has_the_run_settings_alone():
-    from egosearch.rl.registry import register
+    from egosearch.rl.learner_registry import register
 
     register("toy_settingless", "toy", "somewhere:Agent")
     try:

@@ -136,7 +136,7 @@ def test_sac_drq_reads_the_map_with_convs_of_its_own_in_actor_and_critic():
     the actor file records the image's place, and a policy loaded from it acts on the env's observation. Without it
     the networks are as before (no map reader key)."""
     from egosearch.rl.actor import load_any_actor_net
-    from egosearch.rl.registry import make_agent
+    from egosearch.rl.learner_registry import make_agent
 
     env, log = _map_episode(3)
     dims = {k: env.observation_space[k].shape[0] for k in ("mask", "proprio")}

@@ -643,7 +643,7 @@ def test_report_imports_no_torch_or_simulator():
             "mods = sorted(m for m in sys.modules if m.startswith('egosearch.') "
             "and not m.startswith('egosearch.report') and m not in ('egosearch.core', 'egosearch.core.machine', "
             # the searchers' registry and the registry helper, plain data open to every stage (tests/test_layout.py)
-            "'egosearch.searchers', 'egosearch.searchers.registry', 'egosearch.core.registry'))\n"
+            "'egosearch.searchers', 'egosearch.searchers.searcher_registry', 'egosearch.core.named_registry'))\n"
             "print(bad, mods)\n"
             "assert not bad and not mods, (bad, mods)\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)

@@ -17,7 +17,7 @@ from egosearch.rl.actor import ActorPolicy, AgentPolicy, load_any_actor_net
 from egosearch.rl.common import AgentStateError
 from egosearch.rl.config import load_config
 from egosearch.rl.learner import ActorFileNet, Agent, AgentBase
-from egosearch.rl.registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
+from egosearch.rl.learner_registry import ALGORITHMS, LEARNERS, actor_loader, learner, make_agent, register
 from egosearch.rl.train import train
 from egosearch.rl.training_aids import DemonstrationSettings
 

@@ -257,7 +257,7 @@ def test_stacked_seeds_refuse_every_field_their_update_does_not_implement(algori
     whose names are all the config's) or refused in one line when set away from its default, and a field added to
     the learner's settings is refused until the stacked update implements it: stacked seeds never train without a
     field their learner reads."""
-    from egosearch.rl.registry import learner
+    from egosearch.rl.learner_registry import learner
     from egosearch.rl.stacked import STACKED, update_fields
 
     cfg = load_config("cpu" if algorithm == "sac_drq" else "paper", {"algorithm": algorithm})

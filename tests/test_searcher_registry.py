@@ -1,4 +1,4 @@
-"""The registry of searchers that are not learned (egosearch.searchers.registry): a searcher registered from
+"""The registry of searchers that are not learned (egosearch.searchers.searcher_registry): a searcher registered from
 outside egosearch (a toy defined here, that only turns) is run by ``egosearch evaluate``, tabled by Table 1 as a
 bound row, and refused by name once gone, with no other list to edit; the registered searchers are today's."""
 
@@ -14,7 +14,7 @@ from egosearch.cli import main
 from egosearch.report.commands import cmd_table1, group_bounds
 from egosearch.report.tables import bound_names
 from egosearch.report.workflow_jobs import bound_eval_files
-from egosearch.searchers import registry
+from egosearch.searchers import searcher_registry as registry
 from egosearch.sim.body_envs import ENV_IDS
 from egosearch.sim.scenarios import generate_scenarios, write_scenarios
 from egosearch.variants import VariantError, new_variant
@@ -190,10 +190,10 @@ def test_a_variant_may_not_take_a_registered_searchers_name(toy, tmp_path):
 
 def test_both_registries_are_one_helper_and_answer_alike():
     """The learners' and the searchers' registries keep their entries in the one helper's dict
-    (egosearch.core.registry): an unknown name is the same one line in each, and a name that could not name a
+    (egosearch.core.named_registry): an unknown name is the same one line in each, and a name that could not name a
     folder is refused by both."""
-    from egosearch.core.registry import Registry
-    from egosearch.rl import registry as learners
+    from egosearch.core.named_registry import Registry
+    from egosearch.rl import learner_registry as learners
 
     assert learners.LEARNERS is learners._REGISTRY.entries and registry.SEARCHERS is registry._REGISTRY.entries
     with pytest.raises(ValueError, match=r"^unknown algorithm 'nope'; registered: sac_curl, sac_drq, "):

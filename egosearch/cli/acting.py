@@ -13,7 +13,7 @@ from egosearch.envs import ALL_ENV_IDS, env_options
 from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
 from egosearch.rl.train import torch_threads
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.searchers.decision_envs import BODY_ENV_IDS
 
 
@@ -33,7 +33,7 @@ def check_threads(threads: int) -> None:
 def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None = None, out: str | None = None,
                    env_kwargs: dict | None = None):
     """(make_policy(env), the env id it acts in, the env's observation options): ``env_id`` when given,
-    else the policy's own (a registered searcher's, :mod:`egosearch.searchers.registry`; a trained actor's
+    else the policy's own (a registered searcher's, :mod:`egosearch.searchers.searcher_registry`; a trained actor's
     is the one it was trained in), and the options a trained actor's file records with ``env_kwargs`` (the
     caller's, :data:`egosearch.envs.OBSERVATION_OPTIONS`) on top. An actor that cannot act in the env id
     with those options is refused here, before any episode, and so are weights given to a policy that has

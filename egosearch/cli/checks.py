@@ -10,6 +10,8 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+from egosearch.core.seeds import MAX_SEED
+
 PathLike = str | os.PathLike
 
 IGNORED_CONFIG_FIELDS = ("seed", "device", "num_threads", "compile", "cuda_graph", "keep_checkpoint",
@@ -25,10 +27,6 @@ def at_least(option: str, value: int | float | None, low: int | float, meaning: 
     """``value >= low`` (a None value is an option not given); ``meaning`` says what the value is."""
     if value is not None and not value >= low:
         raise ValueError(f"{option}={_num(value)}: {meaning} must be >= {_num(low)}")
-
-
-MAX_SEED = 2**32 - 1
-"""The largest seed numpy's legacy seeding (``np.random.seed``, which a training calls) takes."""
 
 
 def check_seed(option: str, seed: int | None, numpy_legacy: bool = False) -> None:

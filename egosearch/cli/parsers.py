@@ -6,11 +6,11 @@ body lives in ``egosearch/cli/<command>.py``, imported only when that command ru
 
 from __future__ import annotations
 
+from egosearch.rl.learner_registry import LEARNERS as REGISTERED_LEARNERS
 from egosearch.rl.profiles import PROFILES
-from egosearch.rl.registry import LEARNERS as REGISTERED_LEARNERS
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.sim.body import EVAL_HEIGHTS, HEIGHT_RANGE
 from egosearch.sim.observation_options import option_names
 

@@ -37,7 +37,7 @@ from egosearch.report.workflow_jobs import (
 )
 from egosearch.rl.config import departure_rows, load_config, table2_rows
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 
 def run(args) -> None:

@@ -24,7 +24,7 @@ from pathlib import Path
 import pandas as pd
 
 from egosearch.report.failures import stuck
-from egosearch.searchers.registry import modular_floors
+from egosearch.searchers.searcher_registry import modular_floors
 
 EPISODE_COLUMNS = ("scenario_id", "success", "steps", "path_length", "shortest_path", "spl", "collisions",
                    "episode_return")

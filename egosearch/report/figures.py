@@ -32,7 +32,7 @@ from egosearch.report.data import (
     suffixed,
 )
 from egosearch.report.stats import bootstrap_ci, cluster_bootstrap_mean, scenario_seed_matrix, two_level_ci, wilson_ci
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 PathLike = str | os.PathLike
 
@@ -71,7 +71,7 @@ RANDOM = "random"
 
 def fig6_levels() -> dict[str, tuple]:
     """Figure 6's levels, searchers that do not train (a horizontal line each: label, line style, colour): the
-    registered searchers with a ``fig6_level`` (:mod:`egosearch.searchers.registry`), the floor a policy must
+    registered searchers with a ``fig6_level`` (:mod:`egosearch.searchers.searcher_registry`), the floor a policy must
     rise above and the classical searcher its learning is read against. The row name is the searcher's, read
     from its episodes' path (:func:`level_searcher`)."""
     return {s.name: s.fig6_level for s in searchers.SEARCHERS.values() if s.fig6_level}
@@ -252,14 +252,13 @@ def imitation_phases(curve_path: PathLike) -> list[tuple[int, str]]:
     warm-up and the critic's warm-up: ``bc_updates``, ``critic_warmup_updates``), and for the end of the
     decaying cloning term (``bc_decay_steps``, where it reaches 0 or its ``bc_weight_floor``). Empty for a
     training without a teacher (or no config)."""
-    from egosearch.rl.config import field_defaults  # local: the learner registry, for a curve with a teacher
-
     try:
         recorded = json.loads((Path(curve_path).parent / "config.json").read_text(encoding="utf-8"))["config"]
     except (OSError, ValueError, KeyError):
         return []
-    # a field the run's learner does not have, or that did not exist when it was stored: its declared default
-    cfg = {**field_defaults(), **recorded}
+    # a field that did not exist when the run was stored: the run trained without it, as its off value says (the
+    # report layer reads files, not the learner config: tests/test_layout.py)
+    cfg = {"critic_warmup_updates": 0, "bc_decay_steps": 0, "bc_weight_floor": 0.0, **recorded}
     phases = []
     if cfg.get("bc_updates"):
         first_update = -(-max(cfg["init_steps"], 1) // cfg["update_every"]) * cfg["update_every"]

@@ -2,7 +2,7 @@
 the learned student that sees its last 5 frames.
 
 In: per-episode CSVs of the memory-window searchers (``frontier_tuned_window{K}``, ``..._head_off_window{K}``,
-:data:`egosearch.searchers.registry.MEMORY_WINDOWS`), of the whole-episode searchers and of the students (a
+:data:`egosearch.searchers.searcher_registry.MEMORY_WINDOWS`), of the whole-episode searchers and of the students (a
 variant's seeds), all on Table 1's sets. Out: ``PREFIX.csv`` (one row per body, memory and cell: success with its
 95 % interval, the stuck share), ``PREFIX.md`` (the table) and ``PREFIX.png``/``.pdf`` (success against K).
 
@@ -61,7 +61,7 @@ def memory_window_inputs(searcher_paths: Iterable[str], student_paths: Iterable[
     its body and memory window (read from its registered name and options), the students' by body (from the
     variant's head, which its files' name tells: a ``head_off`` variant is the head-fixed one). ValueError, one
     line, for a file of an unknown searcher or more than one student per body."""
-    from egosearch.searchers import registry
+    from egosearch.searchers import searcher_registry as registry
 
     searchers: dict[str, dict[int | None, list[str]]] = {}
     for path in searcher_paths:

@@ -39,7 +39,7 @@ from egosearch.report.data import HEIGHT_FILE, output_base, parse_eval_path, rea
 from egosearch.report.figures import OKABE_ITO, STYLE, save_figure
 from egosearch.report.stats import METRICS, compare_cells, scenario_seed_matrix, two_level_ci
 from egosearch.report.tables import holm_and_write, searcher_label
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 PathLike = str | os.PathLike
 

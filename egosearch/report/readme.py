@@ -64,7 +64,7 @@ def block_table1_pooled(root: Path, profile: str) -> str:
 def stored_teacher(root: Path, profile: str, variant: str) -> str | None:
     """The searcher a stored variant learned from: its first seed's recorded config's ``demo_teacher`` (its
     done.json), head moving (the reference's body); None when it learned from no demonstrations."""
-    from egosearch.searchers import registry as searchers
+    from egosearch.searchers import searcher_registry as searchers
 
     done = root / "results" / profile / "train" / variant / "seed0" / "done.json"
     if not done.exists():

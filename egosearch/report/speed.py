@@ -18,7 +18,7 @@ from egosearch.core.machine import MACHINE_PLACEHOLDER, machine_folder_name
 from egosearch.report.data import counts_decisions
 from egosearch.report.provenance import WHOLE_RUN_SHARE
 from egosearch.report.workflow_jobs import claims_pairs, variants_of_all, workflow_config
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
 """The issue's one-core targets for the sensor and the env."""

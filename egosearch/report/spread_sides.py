@@ -8,7 +8,7 @@ from collections.abc import Mapping
 
 from egosearch.report.data import parse_eval_path, read_episodes
 from egosearch.report.seed_spread import MIN_SEEDS_OWN_SPREAD, SCENARIOS_ONLY, SeedSpreadUnknown, SpreadSeeds
-from egosearch.searchers.registry import names
+from egosearch.searchers.searcher_registry import names
 
 
 def _listed(paths) -> list:

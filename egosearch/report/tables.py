@@ -24,7 +24,7 @@ from egosearch.report.stats import (
     two_level_ci,
     wilson_ci,
 )
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 PAPER_TABLE1: dict[tuple[float, str], float] = {
     (0.45, "no_low_cabinets"): 0.50, (1.05, "no_low_cabinets"): 0.92, (1.65, "no_low_cabinets"): 0.90,
@@ -48,7 +48,7 @@ BOUND_STATS = ("n_episodes", "success_rate", "wilson_low", "wilson_high", "spl",
 
 def bound_names() -> tuple[str, ...]:
     """The searchers Table 1 sets beside each policy, on the same scenario sets, in its order (the registered
-    bounds, :func:`egosearch.searchers.registry.bounds`): the random searcher (uniform random actions), the
+    bounds, :func:`egosearch.searchers.searcher_registry.bounds`): the random searcher (uniform random actions), the
     classical frontier searcher from the actor's observation and its own pose (head moving, then held fixed:
     ``egosearch.searchers.frontier``), and the privileged oracle (knows the target and walks the shortest path to
     it)."""

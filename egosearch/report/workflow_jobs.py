@@ -11,7 +11,7 @@ from pathlib import Path
 
 import yaml
 
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 
 GENERATED_GROUPS = ("generated_train", "generated_heldout")
 """The generalisation benchmark's groups of generated homes (rules/common.smk's layouts)."""
@@ -32,7 +32,7 @@ def bound_eval_files(results: str | Path, homes, placements, heights, bounds=Non
     """The reference searchers' evaluation CSVs in the DAG's order: bound, seed, home, placement,
     height, as Snakemake's ``expand`` lists them. The rules and ``egosearch report regenerate`` both
     take this list, so the reports read their inputs in one order and write the same bytes. ``bounds``:
-    Table 1's (:func:`egosearch.searchers.registry.bounds`) unless given."""
+    Table 1's (:func:`egosearch.searchers.searcher_registry.bounds`) unless given."""
     bounds = searchers.bounds() if bounds is None else bounds
     return [f"{results}/eval/{bound}/seed{seed}/{home}/{placement}/h{height}.csv" for bound in bounds
             for seed in seeds for home in homes for placement in placements for height in heights]

@@ -18,7 +18,7 @@ learner benchmark.
   :mod:`egosearch.rl.sac_drq_recurrent_settings`, :mod:`egosearch.rl.ppo_settings`: each learner's own
   settings, registered with it in the registry;
 - :mod:`egosearch.rl.profiles`: ``PROFILES`` (smoke / cpu / paper) as data, with their sources;
-- :mod:`egosearch.rl.registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``),
+- :mod:`egosearch.rl.learner_registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``),
   the settings class of each and the actor file formats they write (``actor_loader``); adding a learner
   is one module (and its settings') and one ``register`` line there;
 - :mod:`egosearch.rl.learner`: ``Agent``, the protocol the training loop and ``AgentPolicy`` drive,

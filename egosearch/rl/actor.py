@@ -18,7 +18,7 @@ import torch
 from egosearch.envs import ALL_ENV_IDS, env_options, env_space_dims, observation_kwargs
 from egosearch.rl.common import AgentStateError, obs_to_tensors, resolve_device
 from egosearch.rl.learner import ActorFileNet, Agent
-from egosearch.rl.registry import actor_loader
+from egosearch.rl.learner_registry import actor_loader
 from egosearch.sim.body import IMAGE_SIZE
 
 
@@ -57,7 +57,7 @@ def check_actor_file(state: dict) -> None:
 
 def load_any_actor_net(state: dict, device) -> ActorFileNet:
     """An actor file's network, any registered learner's: the loader its ``format`` is registered
-    with (:func:`egosearch.rl.registry.actor_loader`), once the file holds what a policy reads
+    with (:func:`egosearch.rl.learner_registry.actor_loader`), once the file holds what a policy reads
     (:func:`check_actor_file`)."""
     fmt = state.get("format") if isinstance(state, dict) else None
     loader = actor_loader(fmt) if isinstance(fmt, str) else None

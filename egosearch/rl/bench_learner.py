@@ -47,7 +47,7 @@ from egosearch.core.machine import cpu_seconds_all, cpu_vector_unit, own_cpu_sec
 from egosearch.envs import observation_kwargs
 from egosearch.rl.common import resolve_device
 from egosearch.rl.config import DECISIONS, LearnerConfig, load_config
-from egosearch.rl.registry import make_agent
+from egosearch.rl.learner_registry import make_agent
 from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.train import torch_threads, train
 from egosearch.rl.training_aids import DemonstrationSettings, critic_reads_state, demonstration_settings

@@ -3,7 +3,7 @@ the profiles (smoke, cpu, paper); and Table 2, generated from a config.
 
 A training's config is :class:`LearnerConfig`: the :class:`egosearch.rl.run_settings.RunSettings` (env
 steps, envs, evaluation, checkpoints, device, ...), the observation options' fields, and the settings class
-registered with its learner in :mod:`egosearch.rl.registry` (SAC + CURL's
+registered with its learner in :mod:`egosearch.rl.learner_registry` (SAC + CURL's
 :mod:`egosearch.rl.sac_curl_settings`, SAC-DrQ's :mod:`egosearch.rl.sac_drq_settings`, ..., with the
 training aids it opts into, :mod:`egosearch.rl.training_aids`), composed
 into one flat dataclass per learner (``LearnerConfig(algorithm="sac_drq")`` is a ``SacDrqConfig``). A
@@ -36,9 +36,9 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any
 
+from egosearch.rl.learner_registry import ALGORITHMS, LEARNERS, learner  # the registered learners and their settings
 from egosearch.rl.network_settings import ACTIVATIONS, NetworkSettings, PooledSettings, RandomShiftSettings, SacSettings
 from egosearch.rl.profiles import PROFILES, cpu_profile, paper_profile, smoke_profile
-from egosearch.rl.registry import ALGORITHMS, LEARNERS, learner  # the registered learners and their settings
 from egosearch.rl.run_settings import (
     BODY_STEPS,
     CURRICULUM_END_RADIUS,

@@ -22,8 +22,8 @@ from egosearch.rl.config import (
     own_settings,
     shared_fields,
 )
+from egosearch.rl.learner_registry import LEARNERS
 from egosearch.rl.profiles import PROFILES
-from egosearch.rl.registry import LEARNERS
 
 CONFIG_PAGE = "docs/config.md"
 """Where ``egosearch config page`` writes it by default (git-ignored; the docs build makes its own)."""

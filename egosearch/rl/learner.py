@@ -5,7 +5,7 @@ protocol, :class:`AgentBase` (its optional hooks' default behaviour), and the ac
 :mod:`egosearch.rl.train` (``LiveRun``), :mod:`egosearch.rl.imitation` and
 :class:`egosearch.rl.actor.AgentPolicy` call an agent through :class:`Agent` only, and call every
 hook directly: a learner that subclasses :class:`AgentBase` inherits the hooks it does not need. A
-learner is registered by name in :mod:`egosearch.rl.registry` (one ``register`` line), which
+learner is registered by name in :mod:`egosearch.rl.learner_registry` (one ``register`` line), which
 ``cfg.algorithm`` then picks; :class:`egosearch.rl.actor.ActorPolicy` loads its actor files through
 the loader registered with their ``format``.
 
@@ -245,7 +245,7 @@ class ActorArch(TypedDict):
 class ActorFile(TypedDict):
     """What ``Agent.actor_state`` returns and ``actor.pt`` holds: tensors and plain python types
     only, so that ``torch.load(weights_only=True)`` reads it. ``format`` names the loader registered
-    for it (:func:`egosearch.rl.registry.actor_loader`); ``state_dict`` holds the weights;
+    for it (:func:`egosearch.rl.learner_registry.actor_loader`); ``state_dict`` holds the weights;
     ``metadata`` what the training recorded (variant, env id, config, ...)."""
 
     format: str

@@ -1,6 +1,6 @@
 """PPO's own settings (:mod:`egosearch.rl.ppo`, a lever): SAC-DrQ's pooled input and actor, a value
 network where SAC has its critic (the critic's fields size it), and the on-policy update's settings.
-Registered with the learner in :mod:`egosearch.rl.registry`."""
+Registered with the learner in :mod:`egosearch.rl.learner_registry`."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """SAC + CURL's own settings (the paper's learner, :mod:`egosearch.rl.sac_curl`): Table 2's random crop,
 the key encoder's Polyak step and optimiser, and CURL's contrastive loss; beside them the networks and
 SAC's settings of :mod:`egosearch.rl.network_settings`. Registered with the learner in
-:mod:`egosearch.rl.registry`."""
+:mod:`egosearch.rl.learner_registry`."""
 
 from __future__ import annotations
 

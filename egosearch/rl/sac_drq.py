@@ -32,7 +32,7 @@ one update several times cheaper:
   the actor's loss (TD3+BC's form), the training loop decaying ``bc_weight_now``.
 
 It is an :class:`egosearch.rl.learner.Agent`, so :mod:`egosearch.rl.train` drives it as any other
-learner (registered as "sac_drq" in :mod:`egosearch.rl.registry`).
+learner (registered as "sac_drq" in :mod:`egosearch.rl.learner_registry`).
 """
 
 from __future__ import annotations

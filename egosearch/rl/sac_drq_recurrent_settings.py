@@ -1,6 +1,6 @@
 """Recurrent SAC-DrQ's own settings (:mod:`egosearch.rl.sac_drq_recurrent`, a lever): SAC-DrQ's input,
 networks and SAC settings, and its GRUs and replayed sequences. Registered with the learner in
-:mod:`egosearch.rl.registry`."""
+:mod:`egosearch.rl.learner_registry`."""
 
 from __future__ import annotations
 

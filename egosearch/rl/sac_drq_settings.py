@@ -2,7 +2,7 @@
 random shift, and the two changes of its critic and encoder a lever may make; beside them the networks
 and SAC's settings of :mod:`egosearch.rl.network_settings` and the training aids of
 :mod:`egosearch.rl.training_aids`. Registered with the learner in
-:mod:`egosearch.rl.registry`."""
+:mod:`egosearch.rl.learner_registry`."""
 
 from __future__ import annotations
 

@@ -53,8 +53,8 @@ from torch.func import functional_call, vmap
 
 from egosearch.rl.common import METRIC_KEYS, crop_at, submodule
 from egosearch.rl.cuda_graph import GraphedUpdate
+from egosearch.rl.learner_registry import learner, stacked_algorithms
 from egosearch.rl.network_settings import NetworkSettings, SacSettings
-from egosearch.rl.registry import learner, stacked_algorithms
 from egosearch.rl.run_settings import RunSettings
 from egosearch.rl.sac_curl import (
     SacCurlAgent,

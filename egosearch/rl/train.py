@@ -1,4 +1,4 @@
-"""The training loop: train the learner ``cfg.algorithm`` names (:mod:`egosearch.rl.registry`) on an
+"""The training loop: train the learner ``cfg.algorithm`` names (:mod:`egosearch.rl.learner_registry`) on an
 egosearch env, resumably. Its files are written by :mod:`egosearch.rl.run_files`; the actor it
 leaves is run by :class:`egosearch.rl.actor.ActorPolicy`.
 
@@ -70,7 +70,7 @@ from egosearch.rl.demos import (
 )
 from egosearch.rl.imitation import clone, dagger_round
 from egosearch.rl.learner import Agent
-from egosearch.rl.registry import learner, make_agent
+from egosearch.rl.learner_registry import learner, make_agent
 from egosearch.rl.replay import MultiReplay, rng_from_plain, rng_to_plain
 from egosearch.rl.run_files import (
     CHECKPOINT_FORMAT,

@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from egosearch.core.registry import Registry, resolve
+from egosearch.core.named_registry import Registry, resolve
 
 
 class ObservationOption:

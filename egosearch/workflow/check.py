@@ -16,7 +16,7 @@ from pathlib import Path
 
 from egosearch.core.schema_errors import schema_error
 from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rules import it from here)
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.variants import (  # noqa: F401  (variant_head: the rules import it from here)
     ABLATIONS_DIR,
     ALLOW_LONG_WORKFLOW,
@@ -118,7 +118,7 @@ def check_training_seeds(config: dict) -> None:
     """Every seed a training of the run takes (each profile's ``seeds``, ``spread_seeds`` and budget seeds, and the
     screen's ``screen_seed`` on) at most 2**32 - 1: a training seeds numpy's 32-bit global generator, and a
     larger seed failed in its job, after the DAG had started."""
-    from egosearch.cli.checks import MAX_SEED
+    from egosearch.core.seeds import MAX_SEED
 
     given = [("screen_seed", config.get("screen_seed", 0) + config.get("screen_seeds", 1) - 1)]
     for name, profile in config.get("profiles", {}).items():
@@ -273,8 +273,7 @@ def trainings_set_line(trainings, set_overrides: dict, learner_of) -> str | None
     ``set_overrides`` (their ranges, and only fields its learner has, at ``learner_of(variant)``, the run's
     learner profile); and a training stored in its folder, whether the plan reuses it or Snakemake would redo
     it, must have recorded the same set: results under one variant's name take one config."""
-    from egosearch.rl.config import identity_set
-    from egosearch.variants import resolve_variant
+    from egosearch.variants import identity_set, resolve_variant
 
     mine = identity_set(set_overrides)
     checked: set[str] = set()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pandas as pd
 
 from egosearch.cli import main
-from egosearch.searchers.registry import SEARCHERS
+from egosearch.searchers.searcher_registry import SEARCHERS
 from egosearch.sim.scenarios import generate_scenarios, write_scenarios
 
 

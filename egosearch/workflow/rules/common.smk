@@ -12,7 +12,7 @@ from egosearch.core.gpu_share import resolve_trainings_per_gpu, train_threads
 from egosearch.workflow.cluster import (is_cluster, partitions_asked, profile_mix_problem, resource_problem,
                                        slurm_run_problem, snakemake_args, snakemake_executor)
 from egosearch.report.workflow_jobs import BOUND_SEEDS, bound_eval_files, workflow_heights
-from egosearch.searchers import registry as searchers
+from egosearch.searchers import searcher_registry as searchers
 from egosearch.workflow.check import claims_pairs, set_arguments, variant_head, workflow_set
 
 # The executor of this run (--executor, or a profile's executor:, as profiles/slurm names slurm): Snakemake
@@ -350,7 +350,7 @@ def screen_candidate(wildcards):
 # The floor, the classical searcher and the ceiling of Table 1, on the very scenario sets the policies
 # are evaluated on.
 # Their CSVs sit beside the variants' (eval/random, eval/frontier, ...): a variant may not take those names.
-# BOUNDS (the registered bounds, egosearch.searchers.registry: random, frontier, frontier_head_off,
+# BOUNDS (the registered bounds, egosearch.searchers.searcher_registry: random, frontier, frontier_head_off,
 # oracle). One seed (BOUND_SEEDS): the oracle is deterministic, and the random searcher's spread over 100
 # scenarios per cell is far wider than its spread over seeds. bound_eval_files is the order `egosearch
 # report regenerate` reads them in too.

@@ -47,7 +47,7 @@ rule evaluate_start:
 
 
 # eval/random/... and eval/oracle/... are the bounds' (BOUNDS), not variants; so are those of every other
-# registered searcher (REFERENCE_SEARCHERS, egosearch.searchers.registry), eval/modular_random/... among them (the
+# registered searcher (REFERENCE_SEARCHERS, egosearch.searchers.searcher_registry), eval/modular_random/... among them (the
 # modular searcher's floor, read by the decisions_floor rule).
 ruleorder: bound > evaluate
 

@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from egosearch.core.registry import Registry, resolve
+from egosearch.core.named_registry import Registry, resolve
 
 if TYPE_CHECKING:
     from egosearch.rl.learner import ActorFileNet, Agent, LearnerSettings

@@ -1,5 +1,5 @@
 """Named entries registered in one place: the helper behind both registries of the package, the learners'
-(:mod:`egosearch.rl.registry`) and the searchers' (:mod:`egosearch.searchers.registry`).
+(:mod:`egosearch.rl.learner_registry`) and the searchers' (:mod:`egosearch.searchers.searcher_registry`).
 
 A :class:`Registry` keeps its entries in registration order, refuses a name that would not do as a folder
 name or is taken (unless replaced), and answers an unknown name with one line that lists the registered

@@ -15,9 +15,9 @@ classical reference.
 
 Every stage may read this module, the report layer and the workflow included (tests/test_layout.py
 allows it, and only it, of searchers/): it imports nothing of egosearch but the registry helper
-(:mod:`egosearch.core.registry`, which the learners' registry uses too) and no package outside the standard
+(:mod:`egosearch.core.named_registry`, which the learners' registry uses too) and no package outside the standard
 library, so reading it never loads the simulator. Factories are named ``"module:attribute"`` and imported on
-first use, as :mod:`egosearch.rl.registry` names its learners.
+first use, as :mod:`egosearch.rl.learner_registry` names its learners.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
-from egosearch.core.registry import Registry, resolve
+from egosearch.core.named_registry import Registry, resolve
 
 FLOOR, BESIDE, CEILING = "floor", "beside", "ceiling"
 """Where a bound's rows stand in Table 1: the floor before the policy and the ceiling after every other
