@@ -100,3 +100,33 @@ def test_a_quick_tuning_chooses_on_the_fit_split_and_checks_only_the_choice_held
     stamps = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.csv")}
     assert teacher_tuning.tune(tmp_path, limit=1, progress=False)["held_out"] == record["held_out"]
     assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.csv")} == stamps
+
+
+def test_the_tuning_block_shows_the_records_candidates_choice_and_held_out_check(tmp_path):
+    """docs/baselines.md's teacher_tuning block is the stored record, each number read from it (a hand-made
+    record here: two candidates, one head mode), and says when the choice is not the shipped parameters."""
+    import json
+
+    from egosearch.report.readme import block_teacher_tuning
+
+    def paired(ref, cand, low, high):
+        return {"reference": ref, "candidate": cand, "difference": round(cand - ref, 4), "low": low, "high": high,
+                "scenarios": 540}
+
+    record = {"splits": {"fit": {"scenarios": 540}, "held_out": {"scenarios": 540}},
+              "candidates": {"shipped": {"fit_mean_over_head_modes": 0.85,
+                                         "fit_head_on": paired(0.78, 0.85, 0.04, 0.1)},
+                             "gain_weight_x2": {"fit_mean_over_head_modes": 0.875,
+                                                "fit_head_on": paired(0.78, 0.875, 0.06, 0.13)}},
+              "chosen": "gain_weight_x2", "chosen_is_shipped": False,
+              "held_out": {"head_on": paired(0.77, 0.86, 0.05, 0.12)}}
+    missing = block_teacher_tuning(tmp_path, "cpu")
+    assert missing.startswith("*Not run yet") and "teacher_tuning" in missing
+    path = tmp_path / "results" / "cpu" / "teacher_tuning" / "record.json"
+    path.parent.mkdir(parents=True)
+    path.write_text(json.dumps(record))
+    text = block_teacher_tuning(tmp_path, "cpu")
+    assert "| `gain_weight_x2` **(chosen)** | 0.875 (+0.095 [+0.060, +0.130]) | 0.875 |" in text
+    assert "| `shipped` | 0.850 (+0.070 [+0.040, +0.100]) | 0.850 |" in text
+    assert "**not** the shipped parameters" in text
+    assert "- held out, head_on: untuned 0.770 -> chosen 0.860, +0.090 [+0.050, +0.120] (540 scenarios)" in text

@@ -697,6 +697,36 @@ def block_memory_window(root: Path, profile: str) -> str:
     return path.read_text(encoding="utf-8").strip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
+def block_teacher_tuning(root: Path, profile: str) -> str:
+    """The tuned searcher's tuning run again (``results/<profile>/teacher_tuning/record.json``, rule
+    ``tune_teacher``): each candidate on the fit split against the untuned searcher, the choice, and the choice
+    against the untuned searcher on the held-out split; success paired by scenario, 95% bootstrap intervals."""
+    path = root / "results" / profile / "teacher_tuning" / "record.json"
+    if not path.exists():
+        return (f"*Not run yet: `{path.relative_to(root)}` is missing (`snakemake --cores 1 teacher_tuning`, about "
+                "13,000 episodes).*\n")
+    record = json.loads(path.read_text(encoding="utf-8"))
+    modes = list(record["held_out"])
+    splits = record["splits"]
+    lines = [f"Fit split: {splits['fit']['scenarios']} scenarios a head mode; held-out split: "
+             f"{splits['held_out']['scenarios']}. Success, each candidate minus the untuned searcher on the same "
+             "scenarios [95% interval]:", "",
+             "| candidate | " + " | ".join(f"fit, {mode}" for mode in modes) + " | mean over both |",
+             "|---|" + "---|" * (len(modes) + 1)]
+    for name, row in record["candidates"].items():
+        cells = [f"{row[f'fit_{mode}']['candidate']:.3f} ({row[f'fit_{mode}']['difference']:+.3f} "
+                 f"[{row[f'fit_{mode}']['low']:+.3f}, {row[f'fit_{mode}']['high']:+.3f}])" for mode in modes]
+        mark = " **(chosen)**" if name == record["chosen"] else ""
+        lines.append(f"| `{name}`{mark} | " + " | ".join(cells) + f" | {row['fit_mean_over_head_modes']:.3f} |")
+    lines += ["", f"Chosen on the fit split: `{record['chosen']}`"
+              + (" (the shipped parameters)." if record["chosen_is_shipped"] else
+                 " (**not** the shipped parameters, which the stored runs use).")]
+    for mode, r in record["held_out"].items():
+        lines.append(f"- held out, {mode}: untuned {r['reference']:.3f} -> chosen {r['candidate']:.3f}, "
+                     f"{r['difference']:+.3f} [{r['low']:+.3f}, {r['high']:+.3f}] ({r['scenarios']} scenarios)")
+    return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
+
+
 def _called_cells(rows: pd.DataFrame, column: str) -> str:
     picked = [f"{h:g} {'excl.' if p == 'no_low_cabinets' else 'every'} {v}" for h, p, v
               in zip(rows["height"], rows["placement"], rows[column]) if v in ("higher", "lower")]
@@ -757,6 +787,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "seed_spread": block_seed_spread,
     "failures": block_failures,
     "memory_window": block_memory_window,
+    "teacher_tuning": block_teacher_tuning,
     "screens_reread": block_screens_reread,
     "reading": block_reading,
     "claims": block_claims,  # the paper's behaviour sentences against the per-step traces

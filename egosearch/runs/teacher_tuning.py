@@ -14,8 +14,7 @@ searcher run the held-out split.
 The nine candidates the shipped parameters were chosen from were not recorded. :data:`CANDIDATES` is the
 shipped parameters and, for each of the four weights that trade path against gain and distance, the same
 with that one weight halved and doubled: the record says whether the shipped parameters still win on the fit
-split, and what they do on the held-out one (docs/baselines.md's 0.780 -> 0.856 head moving, 0.674 -> 0.769 head
-fixed).
+split, and what they do on the held-out one (docs/baselines.md shows the stored record).
 """
 
 from __future__ import annotations
