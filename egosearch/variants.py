@@ -28,7 +28,7 @@ from egosearch.rl.config import (  # noqa: F401  (format_set, identity_set: the 
     field_types,
     format_set,
     identity_set,
-    load_config,
+    load_variant_config,
     refuse_foreign_fields,
 )
 from egosearch.rl.run_settings import ALLOW_LONG_ENV, LONG_RUN_BOUNDS
@@ -141,7 +141,9 @@ class ResolvedVariant:
     profile: str
     """The learner profile (smoke, cpu or paper) the config starts from."""
     config: LearnerConfig
-    """The profile's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top."""
+    """The profile's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top; at
+    ``smoke``, the variant's ``cpu`` learner with every size capped
+    (:func:`egosearch.rl.config.load_variant_config`)."""
     env_id: str
     """The id the policy trains and is evaluated in: the variant's ``env_id``, or its ``*Memory-v0``
     form when the config's ``target_memory`` changes the observation."""
@@ -164,21 +166,23 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
     """``variant`` (a name, a path or a loaded :class:`Variant`) at the learner ``profile``, with
     ``set_overrides`` (the command line's ``--set``, parsed by :func:`parse_set`) on top of the variant's own
     config fields and ``overrides`` (seed, threads, ...) on top of those. A ``--set`` value out of range (or
-    that breaks a rule between fields) is a one-line ``VariantError`` naming ``--set``."""
+    that breaks a rule between fields) is a one-line ``VariantError`` naming ``--set``. At ``smoke`` the variant's
+    learner is its ``cpu`` one and every size of the run is capped, whatever the variant or a ``--set`` pins
+    (:func:`egosearch.rl.config.load_variant_config`)."""
     if not isinstance(variant, Variant):
         variant = load_variant(variant)
     set_overrides = dict(set_overrides or {})
     if set_overrides:
         try:
-            load_config(profile, {**variant.config, **(overrides or {})})
+            load_variant_config(profile, variant.config, overrides)
         except ValueError:
             pass  # the variant's own problem: reported below as it is without --set
         else:
             try:
-                load_config(profile, {**variant.config, **set_overrides, **(overrides or {})})
+                load_variant_config(profile, {**variant.config, **set_overrides}, overrides)
             except ValueError as err:
                 raise VariantError(f"--set {format_set(set_overrides)}: {err}") from None
-    config = load_config(profile, {**variant.config, **set_overrides, **(overrides or {})})
+    config = load_variant_config(profile, {**variant.config, **set_overrides}, overrides)
     env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
     return ResolvedVariant(variant, profile, config, env_id, set_overrides)
 

@@ -114,7 +114,7 @@ def learner_profile_of(config: dict, variant: str | None = None) -> tuple[str | 
     overrides when its file is known, differs from it in the fewest fields (runs recorded before a
     field existed are read on the fields they have). None when two profiles are as near."""
     # local: the learner's config module is plain data, but the variants layer loads gymnasium's registry
-    from egosearch.rl.config import PROFILES, load_config
+    from egosearch.rl.config import PROFILES, load_variant_config
     from egosearch.variants import load_variant
 
     overrides: dict = {}
@@ -126,9 +126,9 @@ def learner_profile_of(config: dict, variant: str | None = None) -> tuple[str | 
     distance = {}
     for profile in PROFILES:
         try:
-            wanted = load_config(profile, overrides).to_dict()
+            wanted = load_variant_config(profile, overrides).to_dict()
         except ValueError:
-            wanted = load_config(profile).to_dict()
+            wanted = load_variant_config(profile).to_dict()
         distance[profile] = sum(1 for key, value in config.items()
                                 if key in wanted and key not in IGNORED_CONFIG_FIELDS and wanted[key] != value)
     ranked = sorted(distance, key=distance.get)

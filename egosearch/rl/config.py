@@ -38,7 +38,14 @@ from typing import Any
 
 from egosearch.rl.learner_registry import ALGORITHMS, LEARNERS, learner  # the registered learners and their settings
 from egosearch.rl.network_settings import ACTIVATIONS, NetworkSettings, PooledSettings, RandomShiftSettings, SacSettings
-from egosearch.rl.profiles import PROFILES, cpu_profile, paper_profile, smoke_profile
+from egosearch.rl.profiles import (
+    PROFILES,
+    SMOKE_LEARNER_PROFILE,
+    cpu_profile,
+    paper_profile,
+    smoke_profile,
+    smoke_sized,
+)
 from egosearch.rl.run_settings import (
     BODY_STEPS,
     CURRICULUM_END_RADIUS,
@@ -253,6 +260,22 @@ def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None)
     return klass(**{**{k: v for k, v in base.items() if k in own}, **overrides}).validate()
 
 
+def load_variant_config(profile: str, variant_fields: dict[str, Any] | None = None,
+                        overrides: dict[str, Any] | None = None) -> LearnerConfig:
+    """The config a training of a variant runs at ``profile``: the profile's, with the variant's fields
+    (``variant_fields``, its file's ``config``) on top, then the caller's ``overrides`` (seed, threads).
+
+    At ``smoke`` a variant keeps the learner and levers it has at the ``cpu`` profile (SAC-DrQ for ``head_on``,
+    SAC + CURL where it pins ``sac_curl``), every size of the run capped at the smoke profile's whatever the
+    variant pins (:func:`egosearch.rl.profiles.smoke_sized`): so that a ``cpu`` lever runs at smoke, minutes long.
+    The training, the cost line and the reading of a run's profile all take a variant's config from here."""
+    variant_fields, overrides = dict(variant_fields or {}), dict(overrides or {})
+    if profile != "smoke":
+        return load_config(profile, {**variant_fields, **overrides})
+    sized = smoke_sized(load_config(SMOKE_LEARNER_PROFILE, variant_fields).to_dict())
+    return load_config(profile, {**sized, **overrides})
+
+
 # ---- Table 2 --------------------------------------------------------------------------------
 
 def _num(x: float) -> str:
@@ -439,5 +462,5 @@ __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "
            "RESUMABLE_FIELDS",
            "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
            "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "first_sentence",
-           "format_set", "identity_set", "load_config",
+           "format_set", "identity_set", "load_config", "load_variant_config",
            "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]

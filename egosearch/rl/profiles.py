@@ -112,9 +112,53 @@ SMOKE: dict[str, Any] = {
     "log_every": 50,
     "checkpoint_every": 150,
 }
-"""Finishes a whole training run (warm-up, updates, evaluation, checkpoint, actor.pt) in a few seconds: 100->84
-crops and K = 5 as in the paper, but a 2-layer 8-filter encoder, 64-unit MLPs, 300 env steps, a
-1000-transition replay and 2 evaluation episodes."""
+"""The toy sizes: a whole training run (warm-up, updates, evaluation, checkpoint, actor.pt) in a few seconds, a
+2-layer 8-filter encoder, 64-unit MLPs, 300 env steps, a 1000-transition replay and 2 evaluation episodes.
+
+Alone (``load_config("smoke")``, the unit tests' base) they sit on the fields' defaults: SAC + CURL with 100->84
+crops and K = 5 as in the paper. A variant at the smoke profile (:func:`egosearch.rl.config.load_variant_config`,
+what ``egosearch train``, the DAG and the cost line read) is instead its own ``cpu`` learner and levers with every
+size of the run capped at :data:`SMOKE_CAPS`, so that any ``cpu`` lever can be smoke-tested in minutes."""
+
+SMOKE_CAPS: dict[str, int] = {
+    # what a run's time grows with: its env steps and episodes, its updates and their batches
+    "total_env_steps": SMOKE["total_env_steps"],
+    "init_steps": SMOKE["init_steps"],
+    "num_envs": 2,
+    "batch_size": 32,  # Table 2's, the smoke profile's
+    "replay_capacity": SMOKE["replay_capacity"],
+    "eval_episodes": SMOKE["eval_episodes"],
+    "demo_episodes": 2,
+    "bc_updates": 20,
+    "critic_warmup_updates": 10,
+    "dagger_rounds": 1,
+    "dagger_episodes": 1,
+    "ppo_epochs": 2,
+    "update_every": 64,  # PPO's rollout (env steps per update), which must fit in the capped steps
+    # the schedules, so that each still happens within the capped steps: the plumbing is what a smoke run tests
+    "eval_every": SMOKE["eval_every"],
+    "checkpoint_every": SMOKE["checkpoint_every"],
+    "log_every": SMOKE["log_every"],
+    "actor_snapshot_every": SMOKE["checkpoint_every"],
+    "curriculum_steps": SMOKE["eval_every"],
+    "bc_decay_steps": SMOKE["eval_every"],
+    # the networks
+    "encoder_num_layers": SMOKE["encoder_num_layers"],
+    "encoder_num_filters": SMOKE["encoder_num_filters"],
+    "encoder_latent_dim": SMOKE["encoder_latent_dim"],
+    "curl_latent": SMOKE["curl_latent"],
+    "actor_hidden_dim": SMOKE["actor_hidden_dim"],
+    "critic_hidden_dim": SMOKE["critic_hidden_dim"],
+    "actor_num_layers": SMOKE["actor_num_layers"],
+    "critic_num_layers": SMOKE["critic_num_layers"],
+    "recurrent_hidden_dim": 16,
+    "sequence_length": 4,
+    "burn_in": 2,
+}
+"""The most a smoke run of a variant takes of each size, whatever the variant pins (``head_on_25px`` pins 300,000
+env steps; at smoke it trains 300): a smoke run is plumbing only, minutes long. A size the variant or its ``cpu``
+config sets lower stays lower (a lever that shrinks a network is smoke-tested as it is); a size of 0 (off)
+stays off. :func:`smoke_sized` applies them."""
 
 
 def paper_profile() -> dict[str, Any]:
@@ -131,6 +175,17 @@ def cpu_profile() -> dict[str, Any]:
 def smoke_profile() -> dict[str, Any]:
     """The ``smoke`` profile's values (:data:`SMOKE`)."""
     return dict(SMOKE)
+
+
+SMOKE_LEARNER_PROFILE = "cpu"
+"""Whose learner and levers a variant has at the smoke profile: the default profile's, so that a ``cpu`` lever
+(``bc_weight``, a pooled input, a memory in the observation) runs at smoke as it will run, only smaller."""
+
+
+def smoke_sized(values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` (a learner config's fields) with each size at most its :data:`SMOKE_CAPS` value; the fields
+    the learner does not have are not added."""
+    return {key: min(value, SMOKE_CAPS[key]) if key in SMOKE_CAPS else value for key, value in values.items()}
 
 
 PROFILES: dict[str, Callable[[], dict[str, Any]]] = {
