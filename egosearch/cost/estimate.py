@@ -77,11 +77,32 @@ def print_costs(targets, config: dict, profile: str, seeds: list[int], reference
         target = next((t for t in ("screen", "compare") if t in targets and variant), None)
         what = f"{target} of {variant} against {reference}" if target else " ".join(sorted(map(str, targets)))
         cost = f"the {target}'s cost" if target else "the run's time"
-        print_plan_cost(what, plan, profile, cores, reference, cost_name=cost)
+        print_plan_cost(what, plan, profile, cores, reference, cost_name=cost,
+                        scenarios_per_cell=scenarios_per_cell_of(config))
     if "screen" in targets and variant:
         chosen = list(range(config["screen_seed"], config["screen_seed"] + config.get("screen_seeds", 1)))
         print_screen_power(profile, reference, len(chosen))
 
+
+def scenarios_per_cell_of(config: dict) -> dict[str, int]:
+    """Each budget profile's scenarios per Table 1 cell, from the workflow config (none it does not give)."""
+    return {name: budget["scenarios_per_cell"] for name, budget in (config.get("profiles") or {}).items()
+            if isinstance(budget, dict) and "scenarios_per_cell" in budget}
+
+
+PRICED_FROM = {"smoke": "cpu"}
+"""A profile that stores no run (a smoke run's results are git-ignored: plumbing only) -> the profile whose stored
+run prices its plan: its trainings at this machine's rate for their own env steps and teacher (the smoke config's,
+capped: :func:`egosearch.rl.config.load_variant_config`), its other jobs at that run's times scaled by the
+scenarios a cell has at each profile."""
+
+JOB_START_S = 3.0
+"""CPU seconds an ``egosearch`` job spends before its work (importing torch, pybullet and the package): 2.8 CPU-s
+measured on the 2-core reference machine (AMD EPYC, AVX-512). A job priced from another profile's run keeps it
+whole, however few its scenarios or env steps: at smoke sizes it is most of a job."""
+
+IN_MINUTES = ("smoke",)
+"""Profiles whose cost line gives minutes, not hours: a smoke run is minutes long."""
 
 UNPRICED_RULES = ("all", "provenance")
 """Rules of no cost of their own (a target's inputs, the record): a plan of these alone prints no cost line."""
@@ -146,6 +167,10 @@ def no_record(profile: str, record_path: Path) -> str | None:
 
 def _hours(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds / 60:.1f} min"
 
 
 def estimate_all(record: dict, results: Path, cores: int, profile: str, rate: float | None,
@@ -273,7 +298,8 @@ class _Pricing:
             if extra is not None:
                 seconds += extra
                 teacher = f"the teacher's {config.demo_episodes} episodes and the cloning"
-                teacher = f", of which about {extra / 3600:.1f} h {teacher}"
+                span = _minutes if self.profile in IN_MINUTES else _hours
+                teacher = f", of which about {span(extra)} {teacher}"
             else:
                 teacher = (f", plus the teacher's {config.demo_episodes} episodes and the cloning (no stored "
                            "measurement prices them)")
@@ -281,19 +307,36 @@ class _Pricing:
 
 
 def print_plan_cost(what: str, plan: list, profile: str, cores: int, reference: str,
-                    cost_name: str = "the run's time") -> None:
+                    cost_name: str = "the run's time", scenarios_per_cell: dict[str, int] | None = None) -> None:
     """The cost line of a plan (the jobs a run or dry run will run: :func:`egosearch.workflow.dag.plan_jobs`),
     opened by ``what``: its jobs per rule as Snakemake's job stats count them; its trainings, those of
     ``reference`` counted apart, each at this machine's rate (:class:`_Pricing`); its evaluations at the
     record's time; and the plan laid out on ``cores`` cores (:func:`egosearch.cost.schedule.simulate`, every
-    other job at its recorded time or its rule's median). Never stops the run."""
-    results = Path("results") / profile
+    other job at its recorded time or its rule's median). Never stops the run.
+
+    A profile without a stored run of its own (:data:`PRICED_FROM`: smoke) is priced from another's: its
+    trainings at their own (capped) config, every other job at that run's time scaled by ``scenarios_per_cell``
+    (each profile's, the workflow config's), and the line says so; at :data:`IN_MINUTES` profiles, in minutes."""
+    source = profile
+    if (no_record(profile, Path("results") / profile / "provenance.json") and profile in PRICED_FROM
+            and not no_record(PRICED_FROM[profile], Path("results") / PRICED_FROM[profile] / "provenance.json")):
+        source = PRICED_FROM[profile]
+    results = Path("results") / source
     if no_record(profile, results / "provenance.json"):
         print(f"(no estimate of {cost_name}: {no_record(profile, results / 'provenance.json')})", file=sys.stderr)
         return
+    span = _minutes if profile in IN_MINUTES else _hours
+    cells = scenarios_per_cell or {}
+    # an evaluation's (and a scenario set's) time grows with its scenarios; without both counts, taken as recorded
+    other_scale = cells[profile] / cells[source] if source != profile and profile in cells and source in cells \
+        else 1.0
     try:
         record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
         durations = dict(durations_from_provenance(record, plan))
+        if source != profile:
+            untimed = {_job_id(j) for j in plan if job_rule(j) in UNPRICED_RULES}
+            durations = {job: s if job in untimed or not s else JOB_START_S + max(s - JOB_START_S, 0.0) * other_scale
+                         for job, s in durations.items()}
         trainings = [j for j in plan if job_rule(j) == "train"]
         evaluations = [j for j in plan if job_rule(j) == "evaluate"]
         pricing = _Pricing(profile, results, record) if trainings else None
@@ -302,6 +345,8 @@ def print_plan_cost(what: str, plan: list, profile: str, cores: int, reference: 
             variant = _wildcards(job)["variant"]
             if variant not in prices:
                 prices[variant] = pricing.training(variant)
+                if source != profile:
+                    prices[variant] = (prices[variant][0] + JOB_START_S, *prices[variant][1:])
             durations[_job_id(job)] = prices[variant][0]
         priced = all(math.isfinite(p[0]) for p in prices.values())
         counts = plan_counts(plan)
@@ -309,12 +354,13 @@ def print_plan_cost(what: str, plan: list, profile: str, cores: int, reference: 
                  + ", ".join(f"{n} {rule}" for rule, n in counts.items() if rule != "total") + ")"]
         if trainings:
             of_reference = sum(_wildcards(j).get("variant") == reference for j in trainings)
-            hours_each = sorted({round(p[0] / 360) / 10 for p in prices.values() if math.isfinite(p[0])})
+            spans_each = list(dict.fromkeys(span(s) for s in sorted(p[0] for p in prices.values()
+                                                                    if math.isfinite(p[0]))))
             steps = " or ".join(str(n) for n in sorted({p[3] for p in prices.values()}))
             wheres = list(dict.fromkeys(p[1] for p in prices.values()))
             teachers = list(dict.fromkeys(p[2] for p in prices.values() if p[2]))
-            each = (f"{hours_each[0]:.1f} h" if len(hours_each) == 1 else
-                    f"{hours_each[0]:.1f} to {hours_each[-1]:.1f} h" if hours_each else "an unknown time")
+            each = (spans_each[0] if len(spans_each) == 1 else
+                    f"{spans_each[0].split()[0]} to {spans_each[-1]}" if spans_each else "an unknown time")
             each += "" if priced else " (no calibration, and no stored training of its kind of env step, prices it)"
             parts.append(f"{len(trainings)} training(s)"
                          + (f" ({of_reference} of them {reference}'s, the reference's)" if of_reference else "")
@@ -326,8 +372,12 @@ def print_plan_cost(what: str, plan: list, profile: str, cores: int, reference: 
             parts.append(f"{len(evaluations)} evaluations"
                          + (f" ({of_reference} of them {reference}'s)" if of_reference else "")
                          + f" of about {per_eval:.0f} s")
-        total = (f"about {simulate(plan, cores, durations).makespan / 3600:.1f} h on {cores} core(s)" if priced else
+        total = (f"about {span(simulate(plan, cores, durations).makespan)} on {cores} core(s)" if priced else
                  f"its time on {cores} core(s) unknown")
+        if source != profile:
+            total += (f" (the {profile} profile stores no run: priced from the {source} profile's, its other jobs "
+                      f"at {other_scale:g} x their recorded time for {cells.get(profile, '?')} scenarios a cell, "
+                      f"each job's {JOB_START_S:g} s start kept whole)")
         print(f"{what}: " + ", ".join(parts) + f": {total}", file=sys.stderr)
         if pricing is not None and any(p[1].startswith("this machine") for p in prices.values()) \
                 and cached_busy_line():
