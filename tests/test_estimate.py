@@ -305,3 +305,38 @@ def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatc
                                  "head_on")
         err = capsys.readouterr().err
         assert "this machine (its last calibration)" in err and (f"  {busy}\n" in err) is said, err
+
+
+def test_a_smoke_cost_line_prices_the_capped_config_in_minutes(tmp_path, monkeypatch, capsys):
+    """Issue 73 item 3: head_on_25px pins 300,000 env steps, and a smoke dry run planned them (41 min); at smoke it
+    trains the capped config's steps, and the line prices that config, from the cpu profile's stored run (smoke
+    stores none), in minutes: the training at its env steps plus a job's start, an evaluation at the recorded time
+    scaled to smoke's scenarios a cell."""
+    import egosearch.cost.estimate as estimate
+    from egosearch.cost import calibration
+    from egosearch.variants import resolve_variant
+
+    config = resolve_variant("head_on_25px", "smoke").config
+    assert config.total_env_steps == 300 and not config.demo_episodes
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
+    (tmp_path / "rate.json").write_text(json.dumps({"machine": estimate.machine_key(calibration.this_machine()),
+                                                    "rate": 100.0, "steps": "body steps"}))
+    results = tmp_path / "results" / "cpu"
+    (results / "bench").mkdir(parents=True)
+    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+        {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 53.0}]}))
+    plan = [training_job("head_on_25px"), evaluation_job("head_on_25px", 0, "c1", 1)]
+    estimate.print_plan_cost("screen of head_on_25px against head_on", plan, "smoke", 1, "head_on",
+                             scenarios_per_cell={"smoke": 4, "cpu": 200})
+    line = capsys.readouterr().err.strip()
+    training_s = config.total_env_steps / 100.0 + estimate.JOB_START_S
+    evaluation_s = estimate.JOB_START_S + (53.0 - estimate.JOB_START_S) * 4 / 200
+    assert (f"1 training(s) of {config.total_env_steps} env steps, about {training_s / 60:.1f} min each on this "
+            "machine (its last calibration), 1 evaluations of about 4 s: "
+            f"about {(training_s + evaluation_s) / 60:.1f} min on 1 core(s) (the smoke profile stores no run: priced "
+            "from the cpu profile's") in line, line
+    # without the cpu profile's run either, no estimate, as before
+    (results / "provenance.json").unlink()
+    estimate.print_plan_cost("screen of head_on_25px against head_on", plan, "smoke", 1, "head_on")
+    assert "no estimate of the run's time: the smoke profile has no stored run" in capsys.readouterr().err

@@ -76,4 +76,5 @@ def test_a_resolved_variant_is_the_training_run_the_gpu_check_reads():
 
     run = resolve_variant("head_on", "smoke")
     assert isinstance(run, TrainingRun)
-    assert (run.name, run.env_id, run.train_env["layout"]) == ("head_on", "EgoSearch-v0", "paper_homes")
+    # at smoke, head_on's cpu learner: its observation has the last-seen target memory
+    assert (run.name, run.env_id, run.train_env["layout"]) == ("head_on", "EgoSearchMemory-v0", "paper_homes")

@@ -105,6 +105,20 @@ def test_the_budget_study_reads_its_settings_against_the_profiles_reference():
     assert "--chosen head_on " in smoke.stdout + smoke.stderr
 
 
+def test_a_smoke_screens_cost_line_is_minutes_at_the_capped_steps():
+    """Issue 73 item 3: head_on_25px pins 300,000 env steps; a smoke screen of it plans the capped config's steps
+    (the cost line and the training read one config, resolve_variant's) and costs minutes."""
+    from egosearch.variants import resolve_variant
+
+    steps = resolve_variant("head_on_25px", "smoke").config.total_env_steps
+    out = run(["-n", "screen", "--config", "variant=head_on_25px", "profile=smoke", "screen_seeds=1"])
+    assert out.returncode == 0, out.stderr
+    line = next(x for x in out.stderr.splitlines() if x.startswith("screen of head_on_25px against head_on: "))
+    assert f"3 training(s) (2 of them head_on's, the reference's) of {steps} env steps, about " in line, line
+    minutes = float(re.search(r"about ([0-9.]+) min on \d+ core", line).group(1))
+    assert steps == 300 and 0 < minutes < 30, line
+
+
 def test_dry_run_of_behaviour_traces_every_pair_outside_all():
     out = run(["-n", "-p", "behaviour", "searches", "--config", "profile=smoke"])
     assert out.returncode == 0, out.stderr
