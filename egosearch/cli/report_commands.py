@@ -35,7 +35,7 @@ from egosearch.report.workflow_jobs import (
     workflow_config,
     workflow_heights,
 )
-from egosearch.rl.config import departure_rows, load_config, table2_rows
+from egosearch.rl.config import departure_rows, load_variant_config, table2_rows
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.searchers import searcher_registry as searchers
 
@@ -376,7 +376,7 @@ def _table1(args) -> None:
 
 
 def _table2(args) -> None:
-    cfg = load_config(args.profile)
+    cfg = load_variant_config(args.profile)  # what a variant that pins nothing trains there (smoke: the cpu learner)
     report.cmd_table2(table2_rows(cfg), args.out_prefix, departure_rows(cfg))
 
 
@@ -687,5 +687,5 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
             report.cmd_pathlength(variant_evals, scenarios, success_radius(), figs / f"pathlength_{variant}",
                                   out_csv=results / "pathlength" / f"{variant}.csv", bounds=bounds)
     learner = config["profiles"][profile]["learner"]
-    learner_cfg = load_config(learner)
+    learner_cfg = load_variant_config(learner)
     report.cmd_table2(table2_rows(learner_cfg), figs / "table2", departure_rows(learner_cfg))
