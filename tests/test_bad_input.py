@@ -605,7 +605,10 @@ ISSUE_CASES = [
      CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
     ("train_into_a_run_of_another_profile", "traceback",
      ["train", "--variant", "head_on", "--profile", "smoke", "--out-dir", "{t}/run"],
-     CHECKPOINT.format(t="{t}", variant="'head_on'", env="'EgoSearch-v0'")),
+     # at smoke head_on has its cpu learner and observation (issue 73): what differs is every size of the run
+     "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: "
+     "actor_hidden_dim=256 (now 64), batch_size=64 (now 32), bc_decay_steps=100000 (now 150), bc_updates=12000 "
+     "(now 20) ...; use another out_dir"),
     ("train_into_a_run_of_another_seed", "traceback", ["train", "--variant", "head_on", "--seed", "5", "--out-dir",
                                                        "{t}/run"],
      "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: seed=0 "
@@ -1039,7 +1042,7 @@ def bad(tmp_path_factory):
 
     import numpy as np
 
-    from egosearch.rl.config import load_config
+    from egosearch.rl.config import load_config, load_variant_config
     from egosearch.rl.run_files import env_kwargs_key
     from egosearch.variants import resolve_variant
 
@@ -1136,7 +1139,8 @@ def bad(tmp_path_factory):
         writer.writeheader()
         writer.writerows(episodes)
     # a results folder as the DAG lays it out, whose candidate trained at the smoke profile
-    for variant, config in (("head_on", load_config("cpu").to_dict()), ("cand", load_config("smoke").to_dict())):
+    for variant, config in (("head_on", load_config("cpu").to_dict()),
+                            ("cand", load_variant_config("smoke").to_dict())):
         copy(ref, f"prof/results/cpu/eval/{variant}/seed0/kitchen_living/everywhere/h1.05.csv")
         write(f"prof/results/cpu/train/{variant}/seed0/config.json",
               json.dumps({"variant": variant, "config": config}).encode())
@@ -1147,9 +1151,10 @@ def bad(tmp_path_factory):
 
     wanted = wanted_summary(resolved.env_id, resolved.config, resolved.train_env, "head_on")
     other = resolve_variant("head_off", "cpu", {"seed": 0})
-    smoke = resolve_variant("head_on", "smoke", {"seed": 0})
+    # another profile's: the paper profile's SAC+CURL (at smoke, head_on has its cpu learner since issue 73)
+    paper = resolve_variant("head_on", "paper", {"seed": 0})
     runs = {"dr_variant": (wanted | wanted_summary(other.env_id, other.config, other.train_env, "head_off"), 50, 2),
-            "dr_profile": ({k: v for k, v in (wanted | wanted_summary(smoke.env_id, smoke.config, smoke.train_env,
+            "dr_profile": ({k: v for k, v in (wanted | wanted_summary(paper.env_id, paper.config, paper.train_env,
                                                                     episodes=1500)).items() if k != "variant"}, 100, 2),
             "dr_npz": (wanted, 100, 3), "dr_cut": (wanted, 50, 2), "dr_nosummary": (wanted, 50, 2)}
     for run, (summary, side, transitions) in runs.items():
@@ -1329,9 +1334,9 @@ def test_a_smoke_actor_gets_a_note_naming_its_profile(capsys):
 
     from egosearch.cli.acting import note_profile
     from egosearch.cli.checks import learner_profile_of
-    from egosearch.rl.config import load_config
+    from egosearch.rl.config import load_variant_config
 
-    note_profile("smoke.pt", SimpleNamespace(config=load_config("smoke").to_dict(), variant="head_on"))
+    note_profile("smoke.pt", SimpleNamespace(config=load_variant_config("smoke").to_dict(), variant="head_on"))
     assert capsys.readouterr().err == ("note: smoke.pt was trained at the smoke learner profile (its config is the "
                                        "smoke profile's), not at cpu: do not read its results beside the cpu "
                                        "profile's\n")
