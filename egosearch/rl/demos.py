@@ -65,7 +65,7 @@ MATCHED = ("variant", "env_id", "env_kwargs", "teacher", "seed", "episodes", "fr
 def replay_downsample(cfg) -> int:
     """How the depth frames are pooled where the learner's replay stores them: ``obs_downsample`` for a
     learner whose replay pools them (SAC-DrQ, its recurrent form, PPO: ``egosearch.rl.pooled.PooledAgent``), 1
-    for one that stores the env's frames (SAC+CURL, the smoke and paper profiles' learner, has no such field: its
+    for one that stores the env's frames (SAC+CURL, the paper profile's learner, has no such field: its
     config does not hold it, which is not a second default of it)."""
     return int(cfg.obs_downsample) if "obs_downsample" in cfg.to_dict() else 1
 
