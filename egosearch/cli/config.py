@@ -4,8 +4,7 @@ docs/config.md (:mod:`egosearch.rl.config_page`)."""
 
 from __future__ import annotations
 
-from egosearch.rl.config import LearnerConfig, config_sources
-from egosearch.rl.profiles import PROFILES
+from egosearch.rl.config import config_sources, load_variant_config
 from egosearch.variants import format_set, load_variant, parse_set, resolve_variant
 
 
@@ -30,7 +29,7 @@ def run(args) -> None:
         if variant.config.get("algorithm", args.algorithm) != args.algorithm:
             raise ValueError(f"--variant {args.variant} trains algorithm {variant.config['algorithm']}, not "
                              f"{args.algorithm}: show that one")
-        trained = PROFILES[args.profile]().get("algorithm", LearnerConfig.algorithm)
+        trained = load_variant_config(args.profile).algorithm  # at smoke, the cpu profile's learner
         if "algorithm" not in variant.config and trained != args.algorithm:
             # the variant names no learner: it trains the profile's, and this table would pass for its config
             raise ValueError(f"--variant {args.variant} trains algorithm {trained} at the {args.profile} profile "

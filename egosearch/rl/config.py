@@ -431,19 +431,24 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
     that declare it, its docstring's first sentence (``doc``) and its whole docstring (``doc_full``). What
     ``egosearch config show`` prints."""
     overrides = {**(variant_overrides or {}), **(set_overrides or {}), "algorithm": algorithm}
-    cfg = load_config(profile, overrides)
-    base, paper, docs = PROFILES[profile](), field_defaults(), field_docs()
+    cfg = load_variant_config(profile, overrides)
+    # at smoke a variant has its cpu config, each size capped (load_variant_config): the cpu profile is its base
+    base_profile = SMOKE_LEARNER_PROFILE if profile == "smoke" else profile
+    uncapped = load_config(base_profile, overrides) if profile == "smoke" else cfg
+    base, paper, docs = PROFILES[base_profile](), field_defaults(), field_docs()
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
-        if name in (set_overrides or {}):
+        if getattr(cfg, name) != getattr(uncapped, name):
+            source = "smoke cap"
+        elif name in (set_overrides or {}):
             source = "--set"
         elif name in (variant_overrides or {}):
             source = f"variant {variant}".strip()
         elif name == "algorithm":
             source = "asked"
         elif name in base:
-            source = f"profile {profile}"
+            source = f"profile {base_profile}"
         else:
             source = "default"
         doc = docs.get(name, "")
