@@ -142,7 +142,7 @@ class ResolvedVariant:
     """The learner profile (smoke, cpu or paper) the config starts from."""
     config: LearnerConfig
     """The profile's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top; at
-    ``smoke``, the variant's ``cpu`` learner with every size capped
+    ``smoke``, the variant's ``cpu`` learner with every size its file pins capped
     (:func:`egosearch.rl.config.load_variant_config`)."""
     env_id: str
     """The id the policy trains and is evaluated in: the variant's ``env_id``, or its ``*Memory-v0``
@@ -167,8 +167,9 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
     ``set_overrides`` (the command line's ``--set``, parsed by :func:`parse_set`) on top of the variant's own
     config fields and ``overrides`` (seed, threads, ...) on top of those. A ``--set`` value out of range (or
     that breaks a rule between fields) is a one-line ``VariantError`` naming ``--set``. At ``smoke`` the variant's
-    learner is its ``cpu`` one and every size of the run is capped, whatever the variant or a ``--set`` pins
-    (:func:`egosearch.rl.config.load_variant_config`)."""
+    learner is its ``cpu`` one and every size of the run is capped, whatever the variant pins
+    (:func:`egosearch.rl.config.load_variant_config`); a ``--set``, asked on the command line for this run, is
+    taken as given, as ``overrides`` are."""
     if not isinstance(variant, Variant):
         variant = load_variant(variant)
     set_overrides = dict(set_overrides or {})
@@ -179,10 +180,10 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
             pass  # the variant's own problem: reported below as it is without --set
         else:
             try:
-                load_variant_config(profile, {**variant.config, **set_overrides}, overrides)
+                load_variant_config(profile, variant.config, {**set_overrides, **(overrides or {})})
             except ValueError as err:
                 raise VariantError(f"--set {format_set(set_overrides)}: {err}") from None
-    config = load_variant_config(profile, {**variant.config, **set_overrides}, overrides)
+    config = load_variant_config(profile, variant.config, {**set_overrides, **(overrides or {})})
     env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
     return ResolvedVariant(variant, profile, config, env_id, set_overrides)
 

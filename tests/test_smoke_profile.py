@@ -31,8 +31,10 @@ def test_every_stored_variant_at_smoke_is_its_cpu_learner_with_every_size_capped
     # the stored pair: SAC-DrQ, as at cpu (SAC+CURL before); a variant that pins SAC+CURL keeps it
     assert resolve_variant("head_on", "smoke").config.algorithm == "sac_drq"
     assert resolve_variant("budget_smoke_curl", "smoke").config.algorithm == "sac_curl"
-    # the caller's overrides (a test's, a run's seed) are taken as given, after the caps
+    # the caller's overrides (a test's, a run's seed) and the command line's --set are taken as given, after the caps
     assert resolve_variant("head_on_25px", "smoke", {"total_env_steps": 400}).config.total_env_steps == 400
+    assert resolve_variant("head_on_batch128", "smoke").config.batch_size == SMOKE_CAPS["batch_size"]
+    assert resolve_variant("head_on_batch128", "smoke", None, {"batch_size": 64}).config.batch_size == 64
 
 
 def test_the_smoke_profile_alone_is_still_the_unit_tests_toy_sac_curl():

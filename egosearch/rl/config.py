@@ -431,7 +431,7 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
     that declare it, its docstring's first sentence (``doc``) and its whole docstring (``doc_full``). What
     ``egosearch config show`` prints."""
     overrides = {**(variant_overrides or {}), **(set_overrides or {}), "algorithm": algorithm}
-    cfg = load_variant_config(profile, overrides)
+    cfg = load_variant_config(profile, {**(variant_overrides or {}), "algorithm": algorithm}, set_overrides)
     # at smoke a variant has its cpu config, each size capped (load_variant_config): the cpu profile is its base
     base_profile = SMOKE_LEARNER_PROFILE if profile == "smoke" else profile
     uncapped = load_config(base_profile, overrides) if profile == "smoke" else cfg
