@@ -52,8 +52,8 @@ def test_a_cpu_lever_trains_at_smoke_end_to_end(tmp_path):
     data = yaml.safe_load((ABLATIONS_DIR / "head_on.yaml").read_text())
     variant.write_text(yaml.safe_dump({**data, "name": variant.stem, "config": {"bc_weight": 0.2}}))
     out = tmp_path / "run"
-    assert main(["train", "--variant", str(variant), "--profile", "smoke", "--seed", "0", "--threads", "1",
-                 "--out-dir", str(out)]) == 0
+    args = ["train", "--variant", str(variant), "--profile", "smoke", "--seed", "0", "--threads", "1", "--out-dir"]
+    assert main([*args, str(out)]) == 0
     config = json.loads((out / "config.json").read_text())["config"]
     assert (config["algorithm"], config["bc_weight"], config["total_env_steps"]) == ("sac_drq", 0.2, 300)
     assert (config["demo_episodes"], config["bc_updates"], config["eval_episodes"]) == (2, 20, 2)
