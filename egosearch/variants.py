@@ -214,6 +214,10 @@ def parse_set(items: list[str] | tuple[str, ...] | str | None, where: str = "--s
         if kinds.get(key) == "str":
             values[key] = text.strip()
             continue
+        if not text.strip():
+            # YAML reads nothing as null, and "batch_size=None is not an int" hid that no value was given
+            raise VariantError(f"{where} {str(item).strip()!r}: no value after '='; give FIELD=VALUE, e.g. "
+                               f"{key}=<a value>")
         try:
             values[key] = yaml.safe_load(text) if text.strip() else None
         except yaml.YAMLError:

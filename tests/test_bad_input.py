@@ -1939,6 +1939,24 @@ ISSUE73_CASES = [
      ["report", "fig6", "results/cpu/train/head_off/seed0/curve.csv", "--levels", LEVEL, "--out-prefix", "{t}/f6"],
      f"egosearch report: error: --levels: {LEVEL} is frontier's level on head_on's curve scenarios, and the curves are "
      "head_off's; give the level of a variant they draw (.../eval_curve/frontier/head_off.csv)"),
+    # the command line's learner fields (issue 72's --set)
+    ("set_without_a_value", "cryptic",  # "--set: batch_size=None is not an int"
+     ["train", "--variant", "head_on", "--set", "batch_size=", "--out-dir", "{t}/r73"],
+     "egosearch train: error: --set 'batch_size=': no value after '='; give FIELD=VALUE, e.g. batch_size=<a value>"),
+    ("config_show_a_set_out_of_range", "cryptic",  # the range line without naming --set
+     ["config", "show", "sac_drq", "--variant", "head_on", "--set", "curriculum_start_radius=20"],
+     "egosearch config: error: --set curriculum_start_radius=20: LearnerConfig.curriculum_start_radius=20 is out of "
+     "range; allowed: (0, curriculum_end_radius=12.0] m"),
+    ("set_given_twice", "clear",
+     ["train", "--variant", "head_on", "--set", "batch_size=64", "--set", "batch_size=32", "--out-dir", "{t}/r73"],
+     "egosearch train: error: --set: batch_size is given twice (batch_size=64 and batch_size=32); give it once"),
+    ("set_the_seed", "clear", ["train", "--variant", "head_on", "--set", "seed=3", "--out-dir", "{t}/r73"],
+     "egosearch train: error: --set: seed is set per run (`egosearch train --seed`, the profile's seeds in the "
+     "workflow config), not by a variant or --set: leave it out"),
+    ("set_another_learner", "clear",
+     ["train", "--variant", "head_on", "--set", "algorithm=ppo", "--out-dir", "{t}/r73"],
+     "egosearch train: error: --set: algorithm is the variant's learner (its file's config: algorithm); a set changes "
+     "the fields of that learner: make a variant to train another one"),
 ]
 
 
@@ -1987,7 +2005,7 @@ ISSUE73_CONFIGS = [
      "config profiles/smoke/budget/variants: 'head_on' is the study's own setting (reference_variant), read against "
      "itself; leave it out of variants (its runs are the profile's seeds already)"),
 ]
-COUNTS_BEFORE_73 = {"clear": 1, "cryptic": 8, "traceback": 2, "silent": 27, "damage": 0}
+COUNTS_BEFORE_73 = {"clear": 4, "cryptic": 10, "traceback": 2, "silent": 27, "damage": 0}
 """What the rows above did before the fix (with the Slurm and read-only rows below); after it each is one clear
 line before any work."""
 

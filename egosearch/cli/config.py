@@ -35,7 +35,13 @@ def run(args) -> None:
             raise ValueError(f"--variant {args.variant} trains algorithm {trained} at the {args.profile} profile "
                              f"(the profile's learner), not {args.algorithm}: show that one (egosearch config show "
                              f"{trained} --profile {args.profile} --variant {args.variant})")
-    rows = config_sources(args.algorithm, args.profile, overrides, name, set_overrides)
+    try:
+        rows = config_sources(args.algorithm, args.profile, overrides, name, set_overrides)
+    except ValueError as err:
+        if not set_overrides:
+            raise
+        # the value out of range may be the command line's: say so, as egosearch train does
+        raise ValueError(f"--set {format_set(set_overrides)}: {err}") from None
     files = sorted({row["declared_in"].rsplit(".", 1)[0] for row in rows})
     print(f"{args.algorithm} at profile {args.profile}{f' with variant {name}' if name else ''}"
           f"{f' and --set {format_set(set_overrides)}' if set_overrides else ''}: {len(rows)} fields, "
