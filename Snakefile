@@ -11,7 +11,7 @@ import sys
 from snakemake.settings.types import Quietness
 from snakemake.utils import min_version, validate
 
-from egosearch.workflow.check import checked_variants
+from egosearch.workflow.check import checked_variants, let_jobs_run_long
 
 min_version("9.0")
 
@@ -20,10 +20,8 @@ configfile: "egosearch/workflow/config.yaml"
 # line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
 CHECKED_VARIANTS = checked_variants(config, command_line=workflow.config_settings.overwrite_config)
 validate(config, "egosearch/workflow/config.schema.json")
-if config.get("allow_long"):
-    # the jobs' `egosearch train` and `demos` allow what the checks above allowed; their command lines stay as
-    # they were, so that no stored job reruns for a changed command (egosearch.rl.run_settings.ALLOW_LONG_ENV)
-    os.environ["EGOSEARCH_ALLOW_LONG"] = "1"
+# with allow_long, the jobs' `egosearch train` and `demos` allow what the checks above allowed
+let_jobs_run_long(config)
 
 include: "egosearch/workflow/rules/common.smk"
 include: "egosearch/workflow/rules/scenarios.smk"

@@ -10,6 +10,7 @@ a string that reads as one is taken as that number, so ``--config 'heights=[1.05
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 from pathlib import Path
@@ -19,6 +20,7 @@ from egosearch.report.workflow_jobs import claims_pairs  # noqa: F401  (the rule
 from egosearch.searchers import searcher_registry as searchers
 from egosearch.variants import (  # noqa: F401  (variant_head: the rules import it from here)
     ABLATIONS_DIR,
+    ALLOW_LONG_ENV,
     ALLOW_LONG_WORKFLOW,
     Variant,
     VariantError,
@@ -112,6 +114,14 @@ def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
     if config.get("fresh_scenario_seed") == config["scenario_seed"]:
         raise ConfigError(f"config fresh_scenario_seed: {config['fresh_scenario_seed']} is the stored sets' "
                           "scenario_seed; the fresh-set check needs sets never stored")
+
+
+def let_jobs_run_long(config: dict) -> None:
+    """With the workflow config's ``allow_long``, the jobs' ``egosearch train`` and ``demos`` allow what the
+    Snakefile's checks allowed, through the environment (``ALLOW_LONG_ENV``, which they read) rather than a flag:
+    their command lines stay as they were, so that no stored job reruns for a changed command."""
+    if config.get("allow_long"):
+        os.environ[ALLOW_LONG_ENV] = "1"
 
 
 def check_training_seeds(config: dict) -> None:

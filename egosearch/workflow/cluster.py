@@ -274,7 +274,8 @@ def print_sbatch_plan_at_exit(workflow, file=None) -> None:
 
     def print_plan():
         dag = getattr(workflow, "dag", None)
-        lines = sbatch_plan(dag.needrun_jobs(), workflow.resource_settings.overwrite_threads,
+        # every job the run needs, those the dry run has since listed (marked finished) included
+        lines = sbatch_plan(dag.needrun_jobs(exclude_finished=False), workflow.resource_settings.overwrite_threads,
                             getattr(workflow, "_localrules", ())) if dag is not None else []
         if lines:
             print("What each job asks sbatch for (the slurm plugin adds its job name, log and account):", *lines,
