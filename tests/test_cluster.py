@@ -223,14 +223,14 @@ CHECK = "(check log file(s) for error details)"
 SLURM_LOG = "/w/.snakemake/slurm_logs/rule_{}/{}.log"
 LOG = f"""[Sat Nov 28 09:47:43 2026]
 rule train:
-    output: {TRAIN}/actor.pt, {TRAIN}/curve.csv
+    output: {TRAIN}/actor.pt (update), {TRAIN}/curve.csv (update)
     log: results/smoke/logs/train/head_on/seed0.log
     jobid: 3
     reason: Missing output files: {TRAIN}/actor.pt
     resources: tmpdir=<TBD>, mem_mb=1500, mem=1.5 GB, mem_mib=1431, runtime=10, gpu=0
 [Sat Nov 28 09:47:43 2026]
 rule bound:
-    output: results/smoke/eval/random/seed0/kitchen_living/everywhere/h1.65.csv
+    output: results/smoke/eval/random/seed0/kitchen_living/everywhere/h1.65.csv (update)
     jobid: 2
     resources: tmpdir=<TBD>, mem_mb=50, mem=50 MB, mem_mib=48, runtime=30
 Job 3 has been submitted with SLURM jobid 5 (log: /w/.snakemake/slurm_logs/rule_train/smoke_head_on_0/5.log).
@@ -239,14 +239,14 @@ Job 2 has been submitted with SLURM jobid 6 (log: /w/.snakemake/slurm_logs/rule_
 Error in rule train:
     message: SLURM-job '5' failed, SLURM status is: 'TIMEOUT'. {WHY}
     jobid: 3
-    output: {TRAIN}/actor.pt, {TRAIN}/curve.csv
+    output: {TRAIN}/actor.pt (update), {TRAIN}/curve.csv (update)
     log: results/smoke/logs/train/head_on/seed0.log, {SLURM_LOG.format("train/smoke_head_on_0", 5)} {CHECK}
     external_jobid: 5
 [Sat Nov 28 09:47:58 2026]
 Error in rule bound:
     message: SLURM-job '6' failed, SLURM status is: 'FAILED'. {WHY}
     jobid: 2
-    output: results/smoke/eval/random/seed0/kitchen_living/everywhere/h1.65.csv
+    output: results/smoke/eval/random/seed0/kitchen_living/everywhere/h1.65.csv (update)
     log: results/smoke/logs/bound/random.log, {SLURM_LOG.format("bound/x", 6)} {CHECK}
     external_jobid: 6
 """

@@ -289,6 +289,8 @@ def print_sbatch_plan_at_exit(workflow, file=None) -> None:
 _TIME_SIGNS = ("DUE TO TIME LIMIT",)
 _MEMORY_SIGNS = ("exceeded memory limit", "Exceeded job memory limit", "oom-kill", "oom_kill", "OUT_OF_MEMORY")
 _STATUS = re.compile(r"SLURM-job '(\d+)' failed.*?SLURM status is: '([A-Z_]+)'")
+_FLAGS = re.compile(r"\s+\((?:update|temp|protected|ancient|directory)(?:, \w+)*\)$")
+"""The flags Snakemake's log writes after an output's path (``path (update)``): not part of the path."""
 
 
 def _blocks(text: str) -> list[list[str]]:
@@ -352,7 +354,7 @@ def killed_jobs(log_text: str, read=lambda path: Path(path).read_text(errors="re
             continue
         asked = started.get(fields.get("jobid", ""), {}).get("resources", "")
         killed.append({"rule": head[len("Error in rule "):].rstrip(":"), "slurm_job": slurm_id, "limit": limit,
-                       "outputs": [p.strip() for p in fields.get("output", "").split(",") if p.strip()],
+                       "outputs": [_FLAGS.sub("", p.strip()) for p in fields.get("output", "").split(",") if p.strip()],
                        "runtime": _resource(asked, "runtime"), "mem_mb": _resource(asked, "mem_mb")})
     return killed
 
