@@ -245,17 +245,24 @@ def evaluation_job(variant: str, seed: int, cell: str, order: int):
                   wildcards={"profile": "cpu", "variant": variant, "seed": str(seed)})
 
 
-def test_the_cost_line_counts_every_job_of_the_plan(tmp_path, monkeypatch, capsys):
-    """Issue 57: the line counts the plan's jobs by rule, as Snakemake's job stats do, the reference's
-    trainings and evaluations among them, each training at its own variant's steps, and lays them out."""
+
+def _calibrated_at_100_steps_a_second(tmp_path, monkeypatch) -> None:
+    """Work in ``tmp_path`` with this machine's calibration cached there at 100 body steps a second."""
     import egosearch.cost.estimate as estimate
     from egosearch.cost import calibration
-    from egosearch.workflow.dag import DagJob
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     (tmp_path / "rate.json").write_text(json.dumps({"machine": estimate.machine_key(calibration.this_machine()),
                                                     "rate": 100.0, "steps": "body steps"}))
+
+def test_the_cost_line_counts_every_job_of_the_plan(tmp_path, monkeypatch, capsys):
+    """Issue 57: the line counts the plan's jobs by rule, as Snakemake's job stats do, the reference's
+    trainings and evaluations among them, each training at its own variant's steps, and lays them out."""
+    import egosearch.cost.estimate as estimate
+    from egosearch.workflow.dag import DagJob
+
+    _calibrated_at_100_steps_a_second(tmp_path, monkeypatch)
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
     (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
@@ -313,15 +320,11 @@ def test_a_smoke_cost_line_prices_the_capped_config_in_minutes(tmp_path, monkeyp
     stores none), in minutes: the training at its env steps plus a job's start, an evaluation at the recorded time
     scaled to smoke's scenarios a cell."""
     import egosearch.cost.estimate as estimate
-    from egosearch.cost import calibration
     from egosearch.variants import resolve_variant
 
     config = resolve_variant("head_on_25px", "smoke").config
     assert config.total_env_steps == 300 and not config.demo_episodes
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
-    (tmp_path / "rate.json").write_text(json.dumps({"machine": estimate.machine_key(calibration.this_machine()),
-                                                    "rate": 100.0, "steps": "body steps"}))
+    _calibrated_at_100_steps_a_second(tmp_path, monkeypatch)
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
     (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
