@@ -1,5 +1,5 @@
 # egosearch: the paper's experiments as one DAG.
-#   snakemake all                               # everything at the default `cpu` profile (hours: `egosearch estimate all` says how many here)
+#   snakemake all                               # everything at the default `cpu` preset (hours: `egosearch estimate all` says how many here)
 #   snakemake table1                            # Table 1 only (trains what it needs)
 #   snakemake compare --config variant=my_variant
 #   snakemake -n results/cpu/train/my_variant/seed0/actor.pt --config set="batch_size=64"   # learner fields, as `egosearch train --set`
@@ -11,11 +11,13 @@ import sys
 from snakemake.settings.types import Quietness
 from snakemake.utils import min_version, validate
 
-from egosearch.workflow.check import checked_variants, let_jobs_run_long
+from egosearch.workflow.check import checked_variants, let_jobs_run_long, renamed_preset_key
 
 min_version("9.0")
 
 configfile: "egosearch/workflow/config.yaml"
+# `--config profile=NAME`: the old name of `preset`, read with a note until egosearch 0.2
+renamed_preset_key(config, note=workflow.is_main_process)
 # A bad key or value, or a typo in a variant's name or file (its learner fields included), is one
 # line here and exit 1, before the DAG is built; command-line numbers are read as numbers first.
 CHECKED_VARIANTS = checked_variants(config, command_line=workflow.config_settings.overwrite_config)

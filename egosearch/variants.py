@@ -1,5 +1,5 @@
 """Variants as data: one YAML file per variant in ``ablations/``, and the one place where a variant
-at a learner profile becomes what a training runs (:func:`resolve_variant`: the learner config and
+at a learner preset becomes what a training runs (:func:`resolve_variant`: the learner config and
 the env id it observes). The CLI, the benchmarks and the DAG's checks all resolve through it.
 
 Adding a variant is adding a file; nothing else changes. A file is validated against
@@ -57,7 +57,7 @@ class Variant:
     train_env: dict
     """Keyword arguments of the training env (layout, placement, objects, training-only aids)."""
     config: dict = field(default_factory=dict)
-    """Learner config overrides on top of the profile."""
+    """Learner config overrides on top of the preset."""
     description: str = ""
     path: str = ""
     """The file it was read from (for messages)."""
@@ -136,12 +136,12 @@ def load_variant(name_or_path: str | Path, directory: Path = ABLATIONS_DIR) -> V
 
 @dataclass(frozen=True)
 class ResolvedVariant:
-    """A variant at a learner profile: the config and env id a training of it runs with."""
+    """A variant at a learner preset: the config and env id a training of it runs with."""
     variant: Variant
-    profile: str
-    """The learner profile (smoke, cpu or paper) the config starts from."""
+    preset: str
+    """The learner preset (smoke, cpu or paper) the config starts from."""
     config: LearnerConfig
-    """The profile's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top; at
+    """The preset's config with the variant's overrides, the ``--set`` overrides, then the caller's, on top; at
     ``smoke``, the variant's ``cpu`` learner with every size its file pins capped
     (:func:`egosearch.rl.config.load_variant_config`)."""
     env_id: str
@@ -161,9 +161,9 @@ class ResolvedVariant:
         return self.variant.train_env
 
 
-def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict | None = None,
+def resolve_variant(variant: str | Path | Variant, preset: str, overrides: dict | None = None,
                     set_overrides: dict | None = None) -> ResolvedVariant:
-    """``variant`` (a name, a path or a loaded :class:`Variant`) at the learner ``profile``, with
+    """``variant`` (a name, a path or a loaded :class:`Variant`) at the learner ``preset``, with
     ``set_overrides`` (the command line's ``--set``, parsed by :func:`parse_set`) on top of the variant's own
     config fields and ``overrides`` (seed, threads, ...) on top of those. A ``--set`` value out of range (or
     that breaks a rule between fields) is a one-line ``VariantError`` naming ``--set``. At ``smoke`` the variant's
@@ -175,17 +175,17 @@ def resolve_variant(variant: str | Path | Variant, profile: str, overrides: dict
     set_overrides = dict(set_overrides or {})
     if set_overrides:
         try:
-            load_variant_config(profile, variant.config, overrides)
+            load_variant_config(preset, variant.config, overrides)
         except ValueError:
             pass  # the variant's own problem: reported below as it is without --set
         else:
             try:
-                load_variant_config(profile, variant.config, {**set_overrides, **(overrides or {})})
+                load_variant_config(preset, variant.config, {**set_overrides, **(overrides or {})})
             except ValueError as err:
                 raise VariantError(f"--set {format_set(set_overrides)}: {err}") from None
-    config = load_variant_config(profile, variant.config, {**set_overrides, **(overrides or {})})
+    config = load_variant_config(preset, variant.config, {**set_overrides, **(overrides or {})})
     env_id = observed_env_id(variant.env_id, config.target_memory, config.modular_searcher)
-    return ResolvedVariant(variant, profile, config, env_id, set_overrides)
+    return ResolvedVariant(variant, preset, config, env_id, set_overrides)
 
 
 def parse_set(items: list[str] | tuple[str, ...] | str | None, where: str = "--set") -> dict:
@@ -251,18 +251,18 @@ def check_run_length(config: LearnerConfig, flag: str = ALLOW_LONG_CLI) -> None:
                              f"documented bound; {flag} allows more")
 
 
-def check_learner_config(variant: Variant, learner_profile: str, allow_long: bool = False,
+def check_learner_config(variant: Variant, learner_preset: str, allow_long: bool = False,
                          flag: str = ALLOW_LONG_CLI, set_overrides: dict | None = None) -> None:
-    """The variant's overrides (and the command line's ``set_overrides``) on top of ``learner_profile`` give a
+    """The variant's overrides (and the command line's ``set_overrides``) on top of ``learner_preset`` give a
     valid learner config (ranges and cross-field rules such as ``crop_size <= image_size``) within the
     documented bounds of a run's length unless ``allow_long`` (:func:`check_run_length`, naming ``flag``), else
     one-line ``VariantError``."""
     try:
-        resolved = resolve_variant(variant, learner_profile, None, set_overrides)
+        resolved = resolve_variant(variant, learner_preset, None, set_overrides)
         if not long_runs_allowed(allow_long):
             check_run_length(resolved.config, flag)
     except ValueError as err:
-        raise VariantError(f"{variant.path or variant.name}: config (on the {learner_profile} learner profile): "
+        raise VariantError(f"{variant.path or variant.name}: config (on the {learner_preset} learner preset): "
                            f"{err}") from None
 
 
@@ -281,7 +281,7 @@ def learner_overrides(config: dict, where: str) -> dict:
     for key, value in config.items():
         if key == "seed":
             # every run sets it (egosearch train --seed, the DAG's seeds), so a variant's would never be read
-            raise VariantError(f"{where}: seed is set per run (`egosearch train --seed`, the profile's seeds in "
+            raise VariantError(f"{where}: seed is set per run (`egosearch train --seed`, the preset's seeds in "
                                "the workflow config), not by a variant or --set: leave it out")
         if key not in kinds:
             close = difflib.get_close_matches(str(key), kinds, n=1)
@@ -371,7 +371,7 @@ def new_variant(name: str, template: str = "head_on", directory: Path = ABLATION
     path.write_text(
         f"# A variant of {template}: edit what differs. env_id: EgoSearch-v0 (head on) or EgoSearchNoHead-v0;\n"
         "# train_env: the training home and placement scheme; config: run settings (egosearch/rl/run_settings.py)\n"
-        "# and the learner's own fields (egosearch/rl/*_settings.py) overridden on top of the profile.\n"
+        "# and the learner's own fields (egosearch/rl/*_settings.py) overridden on top of the preset.\n"
         + yaml.safe_dump(data, sort_keys=False, default_flow_style=False))
     try:
         load_variant(path)

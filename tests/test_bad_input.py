@@ -38,24 +38,24 @@ BAD_VARIANT_FILES = [
     ("lr_word", HEAD + "config: {critic_lr: fast}\n",
      "ablations/lr_word.yaml: config: critic_lr='fast' is not a float"),
     ("lr_negative", HEAD + "config: {critic_lr: -1.0}\n",
-     "ablations/lr_negative.yaml: config (on the cpu learner profile): LearnerConfig.critic_lr=-1.0 is out of "
+     "ablations/lr_negative.yaml: config (on the cpu learner preset): LearnerConfig.critic_lr=-1.0 is out of "
      "range; allowed: > 0"),
     ("too_short", HEAD + "config: {train_height_min: 0.1}\n",
-     "ablations/too_short.yaml: config (on the cpu learner profile): LearnerConfig.train_height_min=0.1 is out "
+     "ablations/too_short.yaml: config (on the cpu learner preset): LearnerConfig.train_height_min=0.1 is out "
      "of range; allowed: [0.3, 1.8] m (training heights are drawn from [this, 1.8] m)"),
     ("steps_float", HEAD + "config: {total_env_steps: 2.5e4}\n",
      "ablations/steps_float.yaml: config: total_env_steps='2.5e4' is not an int"),
     ("steps_below_warmup", HEAD + "config: {total_env_steps: 500}\n",
-     "ablations/steps_below_warmup.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=500 is "
+     "ablations/steps_below_warmup.yaml: config (on the cpu learner preset): LearnerConfig.total_env_steps=500 is "
      "out of range; allowed: >= 4000, the env step of the first update (after init_steps=4000 random steps, an "
      "update every 4 steps): fewer train no update"),
     ("cloning_without_teacher", HEAD + "config: {demo_episodes: 0}\n",
-     "ablations/cloning_without_teacher.yaml: config (on the cpu learner profile): LearnerConfig.bc_updates=12000 "
+     "ablations/cloning_without_teacher.yaml: config (on the cpu learner preset): LearnerConfig.bc_updates=12000 "
      "is out of range; allowed: 0 unless demo_episodes >= 1 (it reads the demonstrations); without demonstrations "
      "set bc_updates: 0, critic_warmup_updates: 0, demo_batch_fraction: 0, bc_weight: 0, bc_decay_steps: 0, "
      "demo_teacher: frontier"),
     ("half_batches_all_demos", HEAD + "config: {demo_episodes: 100, demo_batch_fraction: 1.0}\n",
-     "ablations/half_batches_all_demos.yaml: config (on the cpu learner profile): "
+     "ablations/half_batches_all_demos.yaml: config (on the cpu learner preset): "
      "LearnerConfig.demo_batch_fraction=1.0 is out of range; allowed: [0, 1) (the rest of each batch is online)"),
     ("flag_word", HEAD + "config: {encoder_tanh: maybe}\n",
      "ablations/flag_word.yaml: config: encoder_tanh='maybe' is not a bool"),
@@ -98,7 +98,7 @@ BAD_CONFIGS = [
     (["variant=nope"], "config variant: variant='nope' is unknown; allowed: {allowed} (files in ablations)"),
     (["heights=[7.0]"], "config heights/0: 7.0 is greater than the maximum of 2.0"),
     (["heights=[tall]"], "config heights/0: 'tall' is not of type 'number'"),
-    (["profile=fast"], "config profile: 'fast' is not one of ['smoke', 'cpu', 'paper']"),
+    (["preset=fast"], "config preset: 'fast' is not one of ['smoke', 'cpu', 'paper']"),
     (["placements=[under_the_sofa]"], "config placements/0: 'under_the_sofa' is not one of ['no_low_cabinets', "
                                       "'everywhere']"),
     (["scenario_seed=-1"], "config scenario_seed: -1 is less than the minimum of 0"),
@@ -118,7 +118,7 @@ def config(**changes):
 
 @pytest.fixture(scope="module")
 def suite(tmp_path_factory):
-    """The workflow files, its profiles and ablations/ with every bad variant file added (no results)."""
+    """The workflow files, its presets and ablations/ with every bad variant file added (no results)."""
     dest = tmp_path_factory.mktemp("suite")
     shutil.copy2(REPO / "Snakefile", dest / "Snakefile")
     shutil.copytree(REPO / "egosearch" / "workflow", dest / "egosearch" / "workflow")
@@ -210,7 +210,7 @@ def test_compare_without_a_variant_is_one_line(suite):
 def test_heights_given_on_the_command_line_are_numbers(suite):
     """`--config 'heights=[1.05]'` reaches Snakemake as ['1.05']: it is read as the number."""
     out = subprocess.run([sys.executable, "-m", "snakemake", "-n", "table1", "--config", "heights=[1.05]",
-                          "profile=smoke"], cwd=suite, capture_output=True, text=True, timeout=600)
+                          "preset=smoke"], cwd=suite, capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
     text = out.stdout + out.stderr
     assert "scenarios/kitchen_living/everywhere/h1.05.csv" in text
@@ -222,10 +222,10 @@ def test_coerce_numbers_follows_the_schema():
 
     schema = json.loads((REPO / "egosearch/workflow/config.schema.json").read_text())
     cfg = config(heights=["1.05", "0.450"], scenario_seed="7", variants=["head_on", "12"],
-                 profiles={**config()["profiles"], "smoke": {**config()["profiles"]["smoke"], "seeds": ["0", "3"]}})
+                 presets={**config()["presets"], "smoke": {**config()["presets"]["smoke"], "seeds": ["0", "3"]}})
     out = coerce_numbers(cfg, schema)
     assert out["heights"] == [1.05, 0.45] and out["scenario_seed"] == 7
-    assert out["profiles"]["smoke"]["seeds"] == [0, 3]
+    assert out["presets"]["smoke"]["seeds"] == [0, 3]
     assert out["variants"] == ["head_on", "12"]  # strings where the schema wants strings
     bad = config(scenario_seed="7.5")
     with pytest.raises(ConfigError, match="config scenario_seed: '7.5' is not of type 'integer'"):
@@ -297,11 +297,11 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
     cases = [
         (["evaluate", "--scenarios", "s.csv", "--weights", str(readme), "--out", "o.csv"],
          f"egosearch evaluate: error: {readme} is not an egosearch actor file; an actor file is the actor.pt that "
-         "`egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt) (torch cannot read it: "
+         "`egosearch train` writes (results/<preset>/train/<variant>/seed<N>/actor.pt) (torch cannot read it: "
          "UnpicklingError)"),
         (["evaluate", "--scenarios", "s.csv", "--weights", str(not_torch), "--out", "o.csv"],
          f"egosearch evaluate: error: {not_torch} is not an egosearch actor file; an actor file is the actor.pt "
-         "that `egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt)"),
+         "that `egosearch train` writes (results/<preset>/train/<variant>/seed<N>/actor.pt)"),
         (["evaluate", "--scenarios", "s.csv", "--weights", "missing.pt", "--out", "o.csv"],
          "egosearch evaluate: error: missing.pt: no such actor file"),
         (["evaluate", "--scenarios", "s.csv", "--policy", "banana", "--out", "o.csv"],
@@ -318,8 +318,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["train", "--variant", "hed_on", "--out-dir", str(tmp_path / "run")],
          f"egosearch train: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
          "ablations)"),
-        (["train", "--variant", "head_on", "--profile", "fast", "--out-dir", str(tmp_path / "run")],
-         "egosearch train: error: unknown profile 'fast'; allowed: smoke, cpu, paper"),
+        (["train", "--variant", "head_on", "--preset", "fast", "--out-dir", str(tmp_path / "run")],
+         "egosearch train: error: unknown preset 'fast'; allowed: smoke, cpu, paper"),
         (["train", "--variant", "head_on", "--max-wall-s", "0", "--out-dir", str(tmp_path / "run")],
          "egosearch train: error: --max-wall-s must be a positive number of seconds, got 0.0"),
         (["demos", "--variant", "hed_on", "--episodes", "5", "--out", str(tmp_path / "d.replay.npz")],
@@ -331,7 +331,7 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
          f"egosearch demos: error: --out={tmp_path / 'd.npz'}: a demonstrations file (git-ignored: hundreds of MB) "
          "must end in .replay.npz"),
         (["bench", "gpu", "--seconds", "60"],
-         "egosearch bench: error: bench gpu needs --out-dir (the paper-profile training's folder)"),
+         "egosearch bench: error: bench gpu needs --out-dir (the paper-preset training's folder)"),
         (["bench", "gpu", "--seconds", "-1", "--out-dir", str(tmp_path / "run")],
          "egosearch bench: error: --seconds must be a positive number, got -1.0"),
         (["bench", "gpu", "--out-dir", str(tmp_path / "run"), "--baseline-seconds", "-5"],
@@ -345,8 +345,8 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys, monkeypatch):
         (["variant", "check", "hed_on"],
          f"egosearch variant: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} "
          "(files in ablations)"),
-        (["report", "regenerate", "--profile", "fast"],
-         "egosearch report: error: --profile='fast'; allowed: smoke, cpu, paper"),
+        (["report", "regenerate", "--preset", "fast"],
+         "egosearch report: error: --preset='fast'; allowed: smoke, cpu, paper"),
         (["report", "fig6", str(tmp_path / "curve.csv"), "--out-prefix", str(tmp_path / "f6")],
          f"egosearch report: error: the input files: {tmp_path / 'curve.csv'} not found"),
     ]
@@ -595,16 +595,16 @@ ISSUE_CASES = [
      ["report", "compare", "--reference", "{t}/prof/results/cpu/eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
       "--candidate", "{t}/prof/results/cpu/eval/cand/seed0/kitchen_living/everywhere/h1.05.csv"],
      "egosearch report: error: --candidate: {t}/prof/results/cpu/eval/cand/seed0/kitchen_living/everywhere/h1.05.csv "
-     "was evaluated from an actor trained at the smoke learner profile "
+     "was evaluated from an actor trained at the smoke learner preset "
      "({t}/prof/results/cpu/train/cand/seed0/config.json), the reference's at cpu: compare variants trained at one "
-     "profile"),
+     "preset"),
     ("evaluate_threads_negative", "traceback",
      ["evaluate", "--scenarios", S3, "--policy", "oracle", "--threads", "-3", "--out", "{t}/o.csv"],
      "egosearch evaluate: error: --threads=-3: a number of threads (0: all cores) must be >= 0"),
     ("train_into_another_variants_run", "traceback", ["train", "--variant", "head_off", "--out-dir", "{t}/run"],
      CHECKPOINT.format(t="{t}", variant="'head_off'", env="'EgoSearchNoHeadMemory-v0'")),
-    ("train_into_a_run_of_another_profile", "traceback",
-     ["train", "--variant", "head_on", "--profile", "smoke", "--out-dir", "{t}/run"],
+    ("train_into_a_run_of_another_preset", "traceback",
+     ["train", "--variant", "head_on", "--preset", "smoke", "--out-dir", "{t}/run"],
      # at smoke head_on has its cpu learner and observation (issue 73): what differs is every size of the run
      "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: "
      "actor_hidden_dim=256 (now 64), batch_size=64 (now 32), bc_decay_steps=100000 (now 150), bc_updates=12000 "
@@ -767,8 +767,8 @@ NEW_CASES = [
      "egosearch bench: error: --frames=0: the number of sensor frames to time must be >= 1"),
     ("bench_env_steps_negative", "cryptic", ["bench", "env", "--frames", "10", "--steps", "-5"],
      "egosearch bench: error: --steps=-5: the number of env steps to time must be >= 1"),
-    ("variant_check_unknown_profile", "cryptic", ["variant", "check", "head_on", "--profile", "fast"],
-     "egosearch variant: error: --profile='fast'; allowed: smoke, cpu, paper"),
+    ("variant_check_unknown_preset", "cryptic", ["variant", "check", "head_on", "--preset", "fast"],
+     "egosearch variant: error: --preset='fast'; allowed: smoke, cpu, paper"),
     ("variant_check_binary_yaml", "cryptic", ["variant", "check", "{t}/bin.yaml"],
      "egosearch variant: error: {t}/bin.yaml: not a text file; a variant is a YAML file with name, env_id, "
      "train_env"),
@@ -814,7 +814,7 @@ NEW_CASES = [
 # tried in the estimate, the searchers' env options, the variant files' new fields and the commands above.
 BEFORE_KINDS_48 = ("clear", "cryptic", "traceback", "silent", "damage")
 RECORD = ("a provenance record is the JSON file `egosearch report provenance` writes "
-          "(results/<profile>/provenance.json)")
+          "(results/<preset>/provenance.json)")
 BENCH = "a learner benchmark record is the JSON file `egosearch bench learner --out` writes"
 SNAKEMAKE_LOG = "a Snakemake log is .snakemake/log/<date>.snakemake.log"
 NOT_A_VARIANT = "a variant is a name (a file in ablations) or the path of an existing .yaml file"
@@ -842,11 +842,11 @@ ISSUE48_CASES = [
      "table1 or screen (`snakemake --list-target-rules` lists them)"),
     ("estimate_check_smoke_log_against_the_cpu_record", "silent", ["estimate", "check", "--log", "{t}/smoke.log"],
      "egosearch estimate: error: results/smoke/provenance.json not found: the jobs of {t}/smoke.log ran at the smoke "
-     "profile, and the check judges them against that profile's recorded job times: give --record, a record of the "
-     "smoke profile"),
-    ("estimate_check_profile_ignored", "silent", ["estimate", "check", "--log", "{t}/cpu.log", "--profile", "paper"],
-     "egosearch estimate: error: --profile=paper: the jobs of {t}/cpu.log ran at the cpu profile (their paths say "
-     "so): leave --profile out, or give the log of a paper run"),
+     "preset, and the check judges them against that preset's recorded job times: give --record, a record of the "
+     "smoke preset"),
+    ("estimate_check_preset_ignored", "silent", ["estimate", "check", "--log", "{t}/cpu.log", "--preset", "paper"],
+     "egosearch estimate: error: --preset=paper: the jobs of {t}/cpu.log ran at the cpu preset (their paths say "
+     "so): leave --preset out, or give the log of a paper run"),
     ("evaluate_head_off_floor_in_a_head_on_env", "silent",
      ["evaluate", "--scenarios", S3, "--policy", "modular_random_head_off", "--env-id", "EgoSearch-v0", "--out",
       "{t}/o.csv"],
@@ -887,10 +887,10 @@ NEW48_CASES = [
      f"egosearch estimate: error: --log: {{t}}/eval is a folder; {SNAKEMAKE_LOG}"),
     ("estimate_check_log_missing", "cryptic", ["estimate", "check", "--log", "{t}/missing.log"],
      f"egosearch estimate: error: --log: {{t}}/missing.log not found; {SNAKEMAKE_LOG}"),
-    ("estimate_check_record_of_another_profile", "silent",
+    ("estimate_check_record_of_another_preset", "silent",
      ["estimate", "check", "--log", "{t}/cpu.log", "--record", "{t}/smoke_record.json"],
-     "egosearch estimate: error: --record: {t}/smoke_record.json holds the smoke profile's job times, but the jobs of "
-     "{t}/cpu.log ran at the cpu profile: give a record of the cpu profile"),
+     "egosearch estimate: error: --record: {t}/smoke_record.json holds the smoke preset's job times, but the jobs of "
+     "{t}/cpu.log ran at the cpu preset: give a record of the cpu preset"),
     ("estimate_check_record_jobs_not_a_list", "traceback",
      ["estimate", "check", "--log", "{t}/cpu.log", "--record", "{t}/nojobs.json"],
      "egosearch estimate: error: --record: {t}/nojobs.json holds no list of jobs with their rule and job ('jobs'); "
@@ -901,9 +901,9 @@ NEW48_CASES = [
      f"be objects); {BENCH}"),
     ("estimate_all_rate_infinite", "silent", ["estimate", "all", "--rate", "inf"],
      "egosearch estimate: error: --rate=inf: env steps per CPU-second must be a positive, finite number"),
-    ("estimate_all_profile_without_a_run", "silent", ["estimate", "all", "--profile", "paper", "--rate", "50"],
-     "egosearch estimate: error: results/paper/provenance.json records no job's time: the paper profile has no "
-     "stored run to scale (--profile cpu has one)"),
+    ("estimate_all_preset_without_a_run", "silent", ["estimate", "all", "--preset", "paper", "--rate", "50"],
+     "egosearch estimate: error: results/paper/provenance.json records no job's time: the paper preset has no "
+     "stored run to scale (--preset cpu has one)"),
     ("estimate_check_rate_zero", "silent", ["estimate", "check", "--log", "{t}/cpu.log", "--rate", "0"],
      "egosearch estimate: error: --rate is read by `estimate all` only, not by `estimate check`"),
     ("bench_learner_baseline_seconds_zero", "silent", ["bench", "learner", "--baseline-seconds", "0"],
@@ -937,7 +937,7 @@ NEW48_CASES = [
      "34): run it in EgoSearchModular-v0"),
     ("demos_of_a_modular_variant", "cryptic",
      ["demos", "--variant", "head_on_modular", "--episodes", "1", "--out", "{t}/d.replay.npz"],
-     "egosearch demos: error: --variant=head_on_modular at the cpu profile is a modular searcher (its env step is a "
+     "egosearch demos: error: --variant=head_on_modular at the cpu preset is a modular searcher (its env step is a "
      "decision, not a body step): demonstrations are the frontier searcher's body steps, which it cannot learn "
      "from; give a variant that acts at every body step (e.g. head_on_from_scratch)"),
     ("scenarios_layout_and_homes", "silent",
@@ -945,7 +945,7 @@ NEW48_CASES = [
      "egosearch scenarios: error: --layout=studio and --homes=0:2 both name the homes: give one"),
     ("variant_config_sets_the_seed", "silent", ["variant", "check", "{t}/seed_in.yaml"],
      "egosearch variant: error: {t}/seed_in.yaml: config: seed is set per run (`egosearch train --seed`, the "
-     "profile's seeds in the workflow config), not by a variant or --set: leave it out"),
+     "preset's seeds in the workflow config), not by a variant or --set: leave it out"),
     ("variant_objects_empty", "silent", ["variant", "check", "{t}/objects_empty.yaml"],
      "egosearch variant: error: {t}/objects_empty.yaml: train_env/objects: [] should be non-empty"),
     ("variant_check_a_folder", "cryptic", ["variant", "check", "{t}/eval"],
@@ -1098,7 +1098,7 @@ def bad(tmp_path_factory):
         np.savez(t / dest, step=np.zeros(1))
     write("badtraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", b"scenario_id,step\n0,0\n")
     write("zerotraces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", b"")
-    # a finished run of head_on at the cpu profile, seed 0 (the one `train` may not be pointed at with another run)
+    # a finished run of head_on at the cpu preset, seed 0 (the one `train` may not be pointed at with another run)
     resolved = resolve_variant("head_on", "cpu", {"seed": 0})
     done = {**json.loads((results / "train/head_on/seed0/done.json").read_text()), "variant": "head_on",
             "env_id": resolved.env_id, "env_kwargs": env_kwargs_key(resolved.train_env),
@@ -1109,13 +1109,13 @@ def bad(tmp_path_factory):
     write("list.json", b"[1, 2]")
     write("nojobs.json", b'{"jobs": 5}')
     write("badbench.json", b'{"result": [1]}')
-    write("smoke_record.json", json.dumps({"profile": "smoke", "jobs": [{"rule": "train", "job": "my_lr/seed0",
+    write("smoke_record.json", json.dumps({"preset": "smoke", "jobs": [{"rule": "train", "job": "my_lr/seed0",
                                                                            "wall_s": 60.0}]}).encode())
-    for profile, variant in (("cpu", "head_on"), ("smoke", "my_lr")):
-        write(f"{profile}.log", "\n".join([
+    for preset, variant in (("cpu", "head_on"), ("smoke", "my_lr")):
+        write(f"{preset}.log", "\n".join([
             "Provided cores: 2", "[Fri Nov 27 08:00:00 2026]", "localrule train:", "    jobid: 3",
-            f"    benchmark: results/{profile}/benchmarks/train/{variant}/seed0.tsv",
-            f"    wildcards: profile={profile}, variant={variant}, seed=0", "[Fri Nov 27 08:01:00 2026]",
+            f"    benchmark: results/{preset}/benchmarks/train/{variant}/seed0.tsv",
+            f"    wildcards: preset={preset}, variant={variant}, seed=0", "[Fri Nov 27 08:01:00 2026]",
             "Finished jobid: 3 (Rule: train)", ""]).encode())
     copy(results / "eval/head_on/seed0/kitchen_living/everywhere/h1.05.csv",
          "copy/cand/seed0/kitchen_living/everywhere/h1.05.csv")
@@ -1138,23 +1138,23 @@ def bad(tmp_path_factory):
         writer = csv.DictWriter(f, list(episodes[0]))
         writer.writeheader()
         writer.writerows(episodes)
-    # a results folder as the DAG lays it out, whose candidate trained at the smoke profile
+    # a results folder as the DAG lays it out, whose candidate trained at the smoke preset
     for variant, config in (("head_on", load_config("cpu").to_dict()),
                             ("cand", load_variant_config("smoke").to_dict())):
         copy(ref, f"prof/results/cpu/eval/{variant}/seed0/kitchen_living/everywhere/h1.05.csv")
         write(f"prof/results/cpu/train/{variant}/seed0/config.json",
               json.dumps({"variant": variant, "config": config}).encode())
-    # issue 57: a stopped run of head_on at the cpu profile (its checkpoint's header) whose demonstrations are not
+    # issue 57: a stopped run of head_on at the cpu preset (its checkpoint's header) whose demonstrations are not
     # its own, or not whole
     from egosearch.rl.demos import wanted_summary
     from egosearch.rl.run_files import CHECKPOINT_FORMAT
 
     wanted = wanted_summary(resolved.env_id, resolved.config, resolved.train_env, "head_on")
     other = resolve_variant("head_off", "cpu", {"seed": 0})
-    # another profile's: the paper profile's SAC+CURL (at smoke, head_on has its cpu learner since issue 73)
+    # another preset's: the paper preset's SAC+CURL (at smoke, head_on has its cpu learner since issue 73)
     paper = resolve_variant("head_on", "paper", {"seed": 0})
     runs = {"dr_variant": (wanted | wanted_summary(other.env_id, other.config, other.train_env, "head_off"), 50, 2),
-            "dr_profile": ({k: v for k, v in (wanted | wanted_summary(paper.env_id, paper.config, paper.train_env,
+            "dr_preset": ({k: v for k, v in (wanted | wanted_summary(paper.env_id, paper.config, paper.train_env,
                                                                     episodes=1500)).items() if k != "variant"}, 100, 2),
             "dr_npz": (wanted, 100, 3), "dr_cut": (wanted, 50, 2), "dr_nosummary": (wanted, 50, 2)}
     for run, (summary, side, transitions) in runs.items():
@@ -1260,7 +1260,7 @@ def test_each_bad_input_is_one_clear_line_before_any_work(case, bad, capsys, mon
 
 
 def test_the_overwrite_guard_without_git_reads_the_provenance(tmp_path, monkeypatch):
-    """An unpacked archive has no git to ask: the sha256 list of results/<profile>/provenance.json
+    """An unpacked archive has no git to ask: the sha256 list of results/<preset>/provenance.json
     says what is stored, and paper_figs/ beside such a record is stored too."""
     import json
 
@@ -1327,23 +1327,23 @@ def test_a_compare_that_passes_writes_its_files_under_their_names(bad, capsys):
     assert sorted(p.name for p in out.parent.iterdir()) == ["c.csv", "c_by_length.csv", "c_stuck.csv"]
 
 
-def test_a_smoke_actor_gets_a_note_naming_its_profile(capsys):
+def test_a_smoke_actor_gets_a_note_naming_its_preset(capsys):
     """Evaluated beside the cpu results, a smoke actor's rows would pass for a poor variant's."""
     import json
     from types import SimpleNamespace
 
-    from egosearch.cli.acting import note_profile
-    from egosearch.cli.checks import learner_profile_of
+    from egosearch.cli.acting import note_preset
+    from egosearch.cli.checks import learner_preset_of
     from egosearch.rl.config import load_variant_config
 
-    note_profile("smoke.pt", SimpleNamespace(config=load_variant_config("smoke").to_dict(), variant="head_on"))
-    assert capsys.readouterr().err == ("note: smoke.pt was trained at the smoke learner profile (its config is the "
-                                       "smoke profile's), not at cpu: do not read its results beside the cpu "
-                                       "profile's\n")
-    # every stored run reads as the profile of the folder it is stored in
+    note_preset("smoke.pt", SimpleNamespace(config=load_variant_config("smoke").to_dict(), variant="head_on"))
+    assert capsys.readouterr().err == ("note: smoke.pt was trained at the smoke learner preset (its config is the "
+                                       "smoke preset's), not at cpu: do not read its results beside the cpu "
+                                       "preset's\n")
+    # every stored run reads as the preset of the folder it is stored in
     for config in sorted(REPO.glob("results/*/train/*/seed*/config.json")):
         record = json.loads(config.read_text())
-        assert learner_profile_of(record["config"], record.get("variant"))[0] == config.parts[-5], config
+        assert learner_preset_of(record["config"], record.get("variant"))[0] == config.parts[-5], config
 
 
 def test_help_names_every_layout_the_commands_take(capsys):
@@ -1368,11 +1368,11 @@ ISSUE57_CASES = [
     ("table1_bounds_a_searchers_name", "cryptic",
      ["report", "table1", ev("head_on"), "--bounds", "frontier", "--out-prefix", "{t}/t"],
      "egosearch report: error: --bounds: frontier not found; --bounds takes evaluation CSV paths, not a searcher's "
-     "name: frontier's are results/<profile>/eval/frontier/seed<N>/<home>/<placement>/h<height>.csv"),
+     "name: frontier's are results/<preset>/eval/frontier/seed<N>/<home>/<placement>/h<height>.csv"),
     ("table1_bounds_a_missing_csv", "cryptic",
      ["report", "table1", ev("head_on"), "--bounds", "{t}/missing.csv", "--out-prefix", "{t}/t"],
      "egosearch report: error: --bounds: {t}/missing.csv not found; --bounds takes the evaluation CSV paths of the "
-     f"searchers ({BOUNDS}): results/<profile>/eval/<searcher>/seed<N>/<home>/<placement>/h<height>.csv"),
+     f"searchers ({BOUNDS}): results/<preset>/eval/<searcher>/seed<N>/<home>/<placement>/h<height>.csv"),
 ]
 TPG = "allowed: 'auto' or an integer from 1 to 64"
 ISSUE57_CONFIGS = [
@@ -1386,8 +1386,8 @@ ISSUE57_CONFIGS = [
      f"config trainings_per_gpu: 0 is not allowed; {TPG}"),
 ]
 ISSUE57_VARIANT_FILES = [
-    ("top_level_profile", "cryptic", HEAD + "profile: turbo\n",
-     "ablations/top_level_profile.yaml: (top level): 'profile' is not a key here; allowed: name, description, "
+    ("top_level_preset", "cryptic", HEAD + "preset: turbo\n",
+     "ablations/top_level_preset.yaml: (top level): 'preset' is not a key here; allowed: name, description, "
      "env_id, train_env, config"),
     ("train_env_key_typo", "cryptic", HEAD.replace("everywhere}", "everywhere, objets: [mug]}"),
      "ablations/train_env_key_typo.yaml: train_env: 'objets' (did you mean 'objects'?) is not a key here; allowed: "
@@ -1395,8 +1395,8 @@ ISSUE57_VARIANT_FILES = [
 ]
 # (id, before, the snakemake arguments after -n, the one line)
 ISSUE57_SNAKEMAKE = [
-    ("paper_gpu_slots_zero", "silent", ["all", "--config", "profile=paper", "--resources", "gpu_slots=0"],
-     "egosearch: error: --resources gpu_slots=0: every paper-profile training asks for one gpu_slots (its share of "
+    ("paper_gpu_slots_zero", "silent", ["all", "--config", "preset=paper", "--resources", "gpu_slots=0"],
+     "egosearch: error: --resources gpu_slots=0: every paper-preset training asks for one gpu_slots (its share of "
      "the GPU), so none could start; give gpu_slots=1 or more (the trainings side by side on one GPU), or leave it "
      "out (config trainings_per_gpu sets it: 6 here)"),
 ]
@@ -1450,9 +1450,9 @@ ISSUE57_DEMOS = [
                                                                "{t}/dr_variant"],
      RESUME % "dr_variant" + "{t}/dr_variant/ckpt/demos.replay.npz holds other demonstrations than this run's: "
      "variant='head_off', env_id='EgoSearchNoHeadMemory-v0'; expected variant='head_on', env_id='EgoSearchMemory-v0'"),
-    ("train_resume_with_another_profiles_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
-                                                               "{t}/dr_profile"],
-     RESUME % "dr_profile" + "{t}/dr_profile/ckpt/demos.replay.npz holds other demonstrations than this run's: "
+    ("train_resume_with_another_presets_demos", "traceback", ["train", "--variant", "head_on", "--out-dir",
+                                                               "{t}/dr_preset"],
+     RESUME % "dr_preset" + "{t}/dr_preset/ckpt/demos.replay.npz holds other demonstrations than this run's: "
      "env_id='EgoSearch-v0', env_kwargs={'layout': 'paper_homes', 'placement': 'everywhere'}, teacher='frontier', "
      f"image_size=100; expected env_id='EgoSearchMemory-v0', env_kwargs={HEAD_ON_KWARGS}, teacher='frontier_tuned', "
      "image_size=50"),
@@ -1532,31 +1532,31 @@ ISSUE57_NEW_CASES = [
                 rf"which is a stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
     ("failures_stuck_read_twice", "silent", [*FAILURES, "{t}/f", "--stuck-read", "head_on", "head_on"],
      "egosearch report: error: --stuck-read: head_on is given twice; each method's section is written once"),
-    ("failures_of_two_profiles", "silent",
+    ("failures_of_two_presets", "silent",
      ["report", "failures", "{t}/f57/results/cpu/traces/head_on/seed0/kitchen_living/everywhere/h1.05.npz",
       "{t}/f57/results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz", "--out-prefix", "{t}/f"],
-     "egosearch report: error: the input files mix profiles: {t}/f57/results/cpu/traces/head_on/seed0/kitchen_living/"
+     "egosearch report: error: the input files mix presets: {t}/f57/results/cpu/traces/head_on/seed0/kitchen_living/"
      "everywhere/h1.05.npz is cpu's, {t}/f57/results/smoke/traces/head_on/seed0/kitchen_living/everywhere/h1.65.npz "
-     "is smoke's; a failure table reads one profile's traces"),
+     "is smoke's; a failure table reads one preset's traces"),
     ("failures_out_prefix_empty", "silent", [*FAILURES, ""],  # wrote .csv, _stuck.csv and .md where it ran
      "egosearch report: error: --out-prefix='' is empty; allowed: a path to which failures adds .csv, _stuck.csv and "
      ".md (e.g. paper_figs/cpu/failures)"),
     ("failures_stuck_read_a_searcher_not_given", "clear", [*FAILURES, "{t}/f", "--stuck-read", "frontier"],
      "egosearch report: error: --stuck-read: frontier has no trace among the input files (head_on)"),
-    ("table2_unknown_profile", "clear", ["report", "table2", "--profile", "fast", "--out-prefix", "{t}/t2"],
-     "egosearch report: error: unknown profile 'fast'; allowed: smoke, cpu, paper"),
-    ("table2_out_prefix_ending_in_md", "silent", ["report", "table2", "--profile", "cpu", "--out-prefix", "{t}/t2.md"],
+    ("table2_unknown_preset", "clear", ["report", "table2", "--preset", "fast", "--out-prefix", "{t}/t2"],
+     "egosearch report: error: unknown preset 'fast'; allowed: smoke, cpu, paper"),
+    ("table2_out_prefix_ending_in_md", "silent", ["report", "table2", "--preset", "cpu", "--out-prefix", "{t}/t2.md"],
      "egosearch report: error: --out-prefix={t}/t2.md ends in .md, and table2 adds .md and .tex to it ({t}/t2.md.md); "
      "allowed: the prefix without .md, {t}/t2"),
     ("table2_out_prefix_stored", "clear",
-     ["report", "table2", "--profile", "paper", "--out-prefix", "paper_figs/table2"],
+     ["report", "table2", "--preset", "paper", "--out-prefix", "paper_figs/table2"],
      re.compile(r"egosearch report: error: --out-prefix=paper_figs/table2 writes paper_figs/table2\.md, which is a "
                 rf"stored result {STORED}; pass --force to overwrite it, or write elsewhere")),
-    ("table2_out_prefix_empty", "silent", ["report", "table2", "--profile", "cpu", "--out-prefix", ""],
+    ("table2_out_prefix_empty", "silent", ["report", "table2", "--preset", "cpu", "--out-prefix", ""],
      "egosearch report: error: --out-prefix='' is empty; allowed: a path to which table2 adds .md and .tex (e.g. "
      "paper_figs/cpu/table2)"),
-    ("variant_check_a_profile_twice", "silent", ["variant", "check", "head_on", "--profile", "cpu", "cpu"],
-     "egosearch variant: error: --profile: cpu is given twice; each profile is checked once"),
+    ("variant_check_a_preset_twice", "silent", ["variant", "check", "head_on", "--preset", "cpu", "cpu"],
+     "egosearch variant: error: --preset: cpu is given twice; each preset is checked once"),
     ("variant_check_a_name_with_its_suffix", "clear", ["variant", "check", "head_on.yaml"],
      f"egosearch variant: error: head_on.yaml: no such file; {NOT_A_VARIANT}"),
     ("variant_check_capitalised", "clear", ["variant", "check", "Head_On"],
@@ -1751,10 +1751,10 @@ def test_a_smoke_runs_outputs_are_git_ignored():
 # the default, and gpu: a login node) or "sinfo fails" (the same, its controller not answering); and whether it
 # is a dry run (-n) or a real one, stopped before its first job. A job Slurm kills at its time or memory limit
 # is one line too, when the run stops (tests/test_cluster.py, tests/test_slurm.py on a real Slurm).
-SLURM_PAPER = ["--config", "profile=paper"]
+SLURM_PAPER = ["--config", "preset=paper"]
 ISSUE58_SNAKEMAKE = [
     ("slurm_without_sbatch", "cryptic", "no slurm", False,
-     ["table2", "--executor", "slurm", "--jobs", "2", "--config", "profile=smoke"],
+     ["table2", "--executor", "slurm", "--jobs", "2", "--config", "preset=smoke"],
      "egosearch: error: --executor slurm: sbatch is not on PATH here, so no job could be submitted or followed; run "
      "snakemake on a machine that submits to Slurm (a login node, where sbatch, squeue, sinfo are), or leave "
      "--executor slurm (and --workflow-profile profiles/slurm) out to run on this machine"),
@@ -1764,19 +1764,19 @@ ISSUE58_SNAKEMAKE = [
      "on; under a cluster executor each training is a job of its own with a whole GPU (gpu=1): leave it auto or 1 "
      "there, or run snakemake with --cores inside one GPU allocation"),
     ("slurm_partition_unknown", "cryptic", "sinfo lists", True,
-     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke", "--default-resources",
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "preset=smoke", "--default-resources",
       "slurm_partition=gpuz"],
      "egosearch: error: --default-resources slurm_partition=gpuz: no such partition on this cluster (sinfo lists: "
      "debug, gpu); name one of them, or leave slurm_partition out (each job then goes to the cluster's default "
      "partition, debug)"),
     ("slurm_rule_partition_unknown", "cryptic", "sinfo lists", False,
-     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke", "--set-resources",
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "preset=smoke", "--set-resources",
       "table2:slurm_partition=gpus"],
      "egosearch: error: --set-resources table2:slurm_partition=gpus: no such partition on this cluster (sinfo "
      "lists: debug, gpu); name one of them, or leave slurm_partition out (each job then goes to the cluster's "
      "default partition, debug)"),
     ("slurm_controller_unreachable", "cryptic", "sinfo fails", False,
-     ["table2", "--workflow-profile", "profiles/slurm", "--config", "profile=smoke"],
+     ["table2", "--workflow-profile", "profiles/slurm", "--config", "preset=smoke"],
      "egosearch: error: --executor slurm: sinfo failed: sinfo: error: Unable to contact slurm controller (connect "
      "failure); run snakemake where Slurm's controller answers (a login node; SLURM_CONF names the cluster's "
      "slurm.conf)"),
@@ -1848,20 +1848,20 @@ def test_issue_58s_cluster_rows_are_one_line_before_any_job(case, suite, slurm_p
 STEPS_BOUND = "<= 20,000,000 env steps (about 27x Table 2's 750,000), the documented bound"
 CURVE_BOUND = ("<= 10,000 episodes a curve point (the most scenarios of one set, `egosearch scenarios --n`), the "
                "documented bound")
-DEMOS_BOUND = "<= 100,000 demonstration episodes (about 67x the cpu profile's 1,500), the documented bound"
+DEMOS_BOUND = "<= 100,000 demonstration episodes (about 67x the cpu preset's 1,500), the documented bound"
 MEMORY_OFF = ("config: target_memory: false contradicts env_id: EgoSearchMemory-v0, which observes the last-seen "
               "target memory; allowed: target_memory: true or leave it out, or env_id EgoSearch-v0")
 # (file stem, before, text, the one line of the workflow's check with variant=stem): in the `suite` and `bad`
 # fixtures' files
 ISSUE73_VARIANT_FILES = [
     ("long_steps", "silent", HEAD + "config: {total_env_steps: 1000000000000}\n",  # "about 10205001.1 h", then ran
-     "ablations/long_steps.yaml: config (on the cpu learner profile): LearnerConfig.total_env_steps=1000000000000 is "
+     "ablations/long_steps.yaml: config (on the cpu learner preset): LearnerConfig.total_env_steps=1000000000000 is "
      f"out of range; allowed: {STEPS_BOUND}; --config allow_long=true allows more"),
     ("long_curve", "silent", HEAD + "config: {eval_episodes: 20000}\n",
-     "ablations/long_curve.yaml: config (on the cpu learner profile): LearnerConfig.eval_episodes=20000 is out of "
+     "ablations/long_curve.yaml: config (on the cpu learner preset): LearnerConfig.eval_episodes=20000 is out of "
      f"range; allowed: {CURVE_BOUND}; --config allow_long=true allows more"),
     ("long_demos", "silent", HEAD + "config: {demo_episodes: 1000000}\n",
-     "ablations/long_demos.yaml: config (on the cpu learner profile): LearnerConfig.demo_episodes=1000000 is out of "
+     "ablations/long_demos.yaml: config (on the cpu learner preset): LearnerConfig.demo_episodes=1000000 is out of "
      f"range; allowed: {DEMOS_BOUND}; --config allow_long=true allows more"),
     # variant check said valid, config show said False, and the training observed the memory
     ("memory_off", "silent", HEAD.replace("EgoSearch-v0", "EgoSearchMemory-v0") + "config: {target_memory: false}\n",
@@ -1870,7 +1870,7 @@ ISSUE73_VARIANT_FILES = [
      + "config: {modular_searcher: false, target_memory: false}\n",
      "ablations/modular_off.yaml: config: modular_searcher: false contradicts env_id: EgoSearchModular-v0, which is "
      "a modular searcher's decision env; allowed: modular_searcher: true or leave it out, or env_id EgoSearch-v0"),
-    # a line about target_memory, which the file never set (the cpu profile's), or at smoke the map dropped
+    # a line about target_memory, which the file never set (the cpu preset's), or at smoke the map dropped
     ("map_modular", "cryptic", HEAD.replace("EgoSearch-v0", "EgoSearchMap-v0") + "config: {modular_searcher: true}\n",
      "ablations/map_modular.yaml: config: modular_searcher: true contradicts env_id: EgoSearchMap-v0, which is a "
      "body env (the policy acts at every body step); allowed: leave modular_searcher out, or env_id EgoSearch-v0"),
@@ -1879,18 +1879,18 @@ F6 = ["report", "fig6", "results/cpu/train/head_on/seed0/curve.csv"]
 LEVEL = "results/cpu/eval_curve/frontier/head_on.csv"
 ISSUE73_CASES = [
     ("train_past_the_steps_bound", "silent", ["train", "--variant", "{t}/long_steps.yaml", "--out-dir", "{t}/r73"],
-     "egosearch train: error: {t}/long_steps.yaml: config (on the cpu learner profile): "
+     "egosearch train: error: {t}/long_steps.yaml: config (on the cpu learner preset): "
      f"LearnerConfig.total_env_steps=1000000000000 is out of range; allowed: {STEPS_BOUND}; --allow-long allows more"),
     ("demos_past_the_episodes_bound", "silent",
      ["demos", "--variant", "head_on", "--episodes", "1000000", "--out", "{t}/d73.replay.npz"],
      f"egosearch demos: error: --episodes=1000000 is out of range; allowed: {DEMOS_BOUND}; --allow-long allows more"),
     ("demos_of_a_variant_past_the_episodes_bound", "silent",
      ["demos", "--variant", "{t}/long_demos.yaml", "--out", "{t}/d73.replay.npz"],
-     "egosearch demos: error: {t}/long_demos.yaml: config (on the cpu learner profile): "
+     "egosearch demos: error: {t}/long_demos.yaml: config (on the cpu learner preset): "
      f"LearnerConfig.demo_episodes=1000000 is out of range; allowed: {DEMOS_BOUND}; --allow-long allows more"),
     ("evaluate_a_curve_past_the_episodes_bound", "silent",
      ["evaluate", "--curve-of", "{t}/long_curve.yaml", "--policy", "random", "--out", "{t}/o.csv"],
-     "egosearch evaluate: error: {t}/long_curve.yaml: config (on the cpu learner profile): "
+     "egosearch evaluate: error: {t}/long_curve.yaml: config (on the cpu learner preset): "
      f"LearnerConfig.eval_episodes=20000 is out of range; allowed: {CURVE_BOUND}; --allow-long allows more"),
     ("variant_check_a_memory_id_with_the_memory_off", "silent", ["variant", "check", "{t}/memory_off.yaml"],
      f"egosearch variant: error: {{t}}/memory_off.yaml: {MEMORY_OFF}"),
@@ -1920,9 +1920,9 @@ ISSUE73_CASES = [
      "egosearch evaluate: error: {t}/semicolon.csv is separated by ';', not ','; a scenario CSV is comma-separated, "
      "as `egosearch scenarios` writes it"),
     ("config_show_a_variant_of_another_learner", "silent",  # a SAC+CURL table for a SAC-DrQ training
-     ["config", "show", "sac_curl", "--profile", "cpu", "--variant", "head_on"],
-     "egosearch config: error: --variant head_on trains algorithm sac_drq at the cpu profile (the profile's "
-     "learner), not sac_curl: show that one (egosearch config show sac_drq --profile cpu --variant head_on)"),
+     ["config", "show", "sac_curl", "--preset", "cpu", "--variant", "head_on"],
+     "egosearch config: error: --variant head_on trains algorithm sac_drq at the cpu preset (the preset's "
+     "learner), not sac_curl: show that one (egosearch config show sac_drq --preset cpu --variant head_on)"),
     ("train_a_variant_typo", "clear", ["train", "--variant", "hed_on", "--out-dir", "{t}/r73"],
      f"egosearch train: error: variant='hed_on' is unknown (did you mean 'head_on'?); allowed: {ALLOWED} (files in "
      "ablations)"),
@@ -1951,7 +1951,7 @@ ISSUE73_CASES = [
      ["train", "--variant", "head_on", "--set", "batch_size=64", "--set", "batch_size=32", "--out-dir", "{t}/r73"],
      "egosearch train: error: --set: batch_size is given twice (batch_size=64 and batch_size=32); give it once"),
     ("set_the_seed", "clear", ["train", "--variant", "head_on", "--set", "seed=3", "--out-dir", "{t}/r73"],
-     "egosearch train: error: --set: seed is set per run (`egosearch train --seed`, the profile's seeds in the "
+     "egosearch train: error: --set: seed is set per run (`egosearch train --seed`, the preset's seeds in the "
      "workflow config), not by a variant or --set: leave it out"),
     ("set_another_learner", "clear",
      ["train", "--variant", "head_on", "--set", "algorithm=ppo", "--out-dir", "{t}/r73"],
@@ -1960,13 +1960,13 @@ ISSUE73_CASES = [
 ]
 
 
-def _profile(name: str, **changes) -> dict:
-    """The workflow config's ``profiles`` with ``changes`` in profile ``name`` (``budget`` merged)."""
-    profiles = config()["profiles"]
-    profile = dict(profiles[name])
+def _preset(name: str, **changes) -> dict:
+    """The workflow config's ``presets`` with ``changes`` in preset ``name`` (``budget`` merged)."""
+    presets = config()["presets"]
+    preset = dict(presets[name])
     for key, value in changes.items():
-        profile[key] = {**profile.get(key, {}), **value} if key == "budget" else value
-    return {"profiles": {**profiles, name: profile}}
+        preset[key] = {**preset.get(key, {}), **value} if key == "budget" else value
+    return {"presets": {**presets, name: preset}}
 
 
 BIG = 2**32
@@ -1974,7 +1974,7 @@ SEED_BOUND = "is out of range; allowed: a training seed <= 2**32 - 1 = 429496729
 # (id, before, --config changes, target, the one line): `checked_variants`, as ISSUE48_CONFIGS
 ISSUE73_CONFIGS = [
     ("claims_first_pair_classical", "traceback",  # VariantError in common.smk, whatever the target
-     {"profile": "smoke", "claims_pairs": [["frontier", "frontier_head_off"]]}, "versus_teacher",
+     {"preset": "smoke", "claims_pairs": [["frontier", "frontier_head_off"]]}, "versus_teacher",
      "config claims_pairs: the first pair ['frontier', 'frontier_head_off'] is Figure 6's and versus_teacher's, which "
      "read its trainings: name variants there (e.g. [head_on, head_off]) and the classical searchers in a later pair"),
     ("claims_pair_backwards", "silent", {"claims_pairs": [["head_off", "head_on"]]}, "versus_teacher",
@@ -1990,20 +1990,20 @@ ISSUE73_CONFIGS = [
     ("screen_seeds_past_numpys_seed", "cryptic",  # the DAG ran; the fifth training failed in its job
      {"variant": "head_off", "screen_seed": BIG - 1}, "screen",
      f"config screen_seed: {BIG - 1} with screen_seeds=5 trains seeds up to {BIG + 3}, which {SEED_BOUND}"),
-    ("profile_seed_past_numpys_seed", "cryptic", _profile("smoke", seeds=[BIG]), "all",
-     f"config profiles/smoke/seeds: {BIG} {SEED_BOUND}"),
-    ("spread_seed_past_numpys_seed", "cryptic", _profile("cpu", spread_seeds=[0, BIG]), "seed_spread",
-     f"config profiles/cpu/spread_seeds: {BIG} {SEED_BOUND}"),
-    ("budget_seed_past_numpys_seed", "cryptic", _profile("cpu", budget={"seeds": [BIG]}), "budget",
-     f"config profiles/cpu/budget/seeds: {BIG} {SEED_BOUND}"),
+    ("preset_seed_past_numpys_seed", "cryptic", _preset("smoke", seeds=[BIG]), "all",
+     f"config presets/smoke/seeds: {BIG} {SEED_BOUND}"),
+    ("spread_seed_past_numpys_seed", "cryptic", _preset("cpu", spread_seeds=[0, BIG]), "seed_spread",
+     f"config presets/cpu/spread_seeds: {BIG} {SEED_BOUND}"),
+    ("budget_seed_past_numpys_seed", "cryptic", _preset("cpu", budget={"seeds": [BIG]}), "budget",
+     f"config presets/cpu/budget/seeds: {BIG} {SEED_BOUND}"),
     ("budget_reference_among_its_settings", "silent",  # its seed-0 run stood in for the setting's, unsaid
-     _profile("cpu", budget={"variants": ["head_on_from_scratch", "head_on_25px"]}), "budget",
-     "config profiles/cpu/budget/variants: 'head_on_from_scratch' is the study's own setting (budget/reference), "
-     "read against itself; leave it out of variants (its runs are the profile's seeds already)"),
+     _preset("cpu", budget={"variants": ["head_on_from_scratch", "head_on_25px"]}), "budget",
+     "config presets/cpu/budget/variants: 'head_on_from_scratch' is the study's own setting (budget/reference), "
+     "read against itself; leave it out of variants (its runs are the preset's seeds already)"),
     ("budget_reference_variant_among_the_settings", "silent",
-     {"profile": "smoke", **_profile("smoke", budget={"variants": ["head_on"]})}, "budget",
-     "config profiles/smoke/budget/variants: 'head_on' is the study's own setting (reference_variant), read against "
-     "itself; leave it out of variants (its runs are the profile's seeds already)"),
+     {"preset": "smoke", **_preset("smoke", budget={"variants": ["head_on"]})}, "budget",
+     "config presets/smoke/budget/variants: 'head_on' is the study's own setting (reference_variant), read against "
+     "itself; leave it out of variants (its runs are the preset's seeds already)"),
 ]
 COUNTS_BEFORE_73 = {"clear": 4, "cryptic": 10, "traceback": 2, "silent": 27, "damage": 0}
 """What the rows above did before the fix (with the Slurm and read-only rows below); after it each is one clear
@@ -2013,7 +2013,7 @@ line before any work."""
 def test_issue_73s_counts_before():
     rows = ([c[:2] for c in ISSUE73_CASES] + [c[:2] for c in ISSUE73_CONFIGS] + [c[:2] for c in ISSUE73_VARIANT_FILES]
             + [c[:2] for c in ISSUE73_SNAKEMAKE] + [("results_read_only", "traceback"),
-                                                   ("claims_pairs_a_profile_overrides", "silent")])
+                                                   ("claims_pairs_a_preset_overrides", "silent")])
     before = dict.fromkeys(BEFORE_KINDS_48, 0)
     for _, kind in rows:
         before[kind] += 1
@@ -2043,18 +2043,18 @@ def test_issue_73s_variant_files_are_one_line_in_the_workflow(case, suite, monke
     test_issue_57s_variant_files_list_the_allowed_keys(case, suite, monkeypatch, capsys)
 
 
-def test_claims_pairs_a_profile_overrides_are_one_line(suite, monkeypatch, capsys):
-    """`--config claims_pairs=...` at the cpu profile, which names its own: they were ignored without a word."""
+def test_claims_pairs_a_preset_overrides_are_one_line(suite, monkeypatch, capsys):
+    """`--config claims_pairs=...` at the cpu preset, which names its own: they were ignored without a word."""
     monkeypatch.chdir(suite)
     pairs = [["head_on", "head_off"]]
     with pytest.raises(SystemExit) as stop:
         checked_variants(config(claims_pairs=pairs), argv=["behaviour"], directory=suite / "ablations",
                          command_line={"claims_pairs": pairs})
     assert stop.value.code == 1 and capsys.readouterr().err == (
-        "egosearch: error: config claims_pairs: the cpu profile names its own (profiles/cpu/claims_pairs in "
+        "egosearch: error: config claims_pairs: the cpu preset names its own (presets/cpu/claims_pairs in "
         "egosearch/workflow/config.yaml), which the run reads instead of the top level's; edit that one, or run "
-        "another profile\n")
-    checked_variants(config(claims_pairs=pairs, profile="smoke"), argv=["behaviour"], directory=suite / "ablations",
+        "another preset\n")
+    checked_variants(config(claims_pairs=pairs, preset="smoke"), argv=["behaviour"], directory=suite / "ablations",
                      command_line={"claims_pairs": pairs})
 
 
@@ -2067,14 +2067,14 @@ def test_a_long_run_is_taken_when_allowed(suite, bad, monkeypatch, capsys):
                                             directory=suite / "ablations")
     monkeypatch.chdir(REPO)
     long_steps = str(bad / "long_steps.yaml")
-    assert main(["variant", "check", long_steps, "--profile", "cpu", "--allow-long"]) == 0
+    assert main(["variant", "check", long_steps, "--preset", "cpu", "--allow-long"]) == 0
     monkeypatch.setenv("EGOSEARCH_ALLOW_LONG", "1")
-    assert main(["variant", "check", long_steps, "--profile", "cpu"]) == 0
-    assert capsys.readouterr().out.count("valid at the cpu learner profile") == 2
+    assert main(["variant", "check", long_steps, "--preset", "cpu"]) == 0
+    assert capsys.readouterr().out.count("valid at the cpu learner preset") == 2
 
 
 def test_a_stored_variant_is_within_the_bounds(monkeypatch):
-    """Every variant the suite ships trains within the documented bounds at every profile it runs at."""
+    """Every variant the suite ships trains within the documented bounds at every preset it runs at."""
     from egosearch.variants import check_learner_config
 
     monkeypatch.delenv("EGOSEARCH_ALLOW_LONG", raising=False)
@@ -2109,16 +2109,16 @@ def test_config_show_cuts_no_field_at_an_abbreviation():
 # copied into the suite and edited, as tests/test_cluster.py runs it
 ISSUE73_SNAKEMAKE = [
     ("slurm_mem_mb_a_word", "cryptic",  # "Exception ignored in atexit callback ... ResourceConversionError", exit 0
-     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "profile=smoke"],
+     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "preset=smoke"],
      ("mem_mb: 1000", "mem_mb: lots"),
      "egosearch: error: --default-resources mem_mb=lots: not a number; allowed: a number of megabytes > 0 (e.g. "
      "mem_mb=1000)"),
     ("slurm_runtime_zero", "silent",  # the plan's sbatch had no -t
-     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "profile=smoke"], ("runtime: 30", "runtime: 0"),
+     ["table2", "--workflow-profile", "profiles/slurm73", "--config", "preset=smoke"], ("runtime: 30", "runtime: 0"),
      "egosearch: error: --default-resources runtime=0: a job would ask for no time limit (sbatch without -t); "
      "allowed: a number of minutes > 0"),
     ("slurm_profile_under_the_default_one", "silent",  # profiles/default's jobs: 2 capped the 100
-     ["table2", "--profile", "profiles/slurm73", "--config", "profile=smoke"], None,
+     ["table2", "--profile", "profiles/slurm73", "--config", "preset=smoke"], None,
      "egosearch: error: --profile profiles/slurm73: Snakemake reads the workflow profile profiles/default on top of "
      "it, and its jobs: 2 overrides the jobs: 100 of profiles/slurm73; use --workflow-profile profiles/slurm73 "
      "instead (it replaces profiles/default; docs/running.md)"),
@@ -2189,7 +2189,7 @@ def test_a_read_only_results_folder_is_one_line_before_the_first_job(suite, tmp_
         pytest.skip(f"cannot mount a read-only folder here: {mounted.stderr.strip()}")
     try:
         target = "results/smoke/scenarios/kitchen_living/everywhere/h1.05.csv"
-        out = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", target, "--config", "profile=smoke"],
+        out = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", target, "--config", "preset=smoke"],
                              cwd=suite, capture_output=True, text=True, timeout=600)
     finally:
         subprocess.run(["umount", str(results)], check=True)

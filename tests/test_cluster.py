@@ -103,22 +103,22 @@ def _check_plan_against_the_jobs(text: str) -> dict[str, list[dict]]:
 
 def test_a_paper_training_under_slurm_asks_for_one_gpu_and_the_dry_run_says_so():
     """`--executor slurm` on the command line: Snakemake parses the Snakefile before it hands the run its
-    executor (workflow.local_exec read True there), so each paper-profile training asked for a share of this
+    executor (workflow.local_exec read True there), so each paper-preset training asked for a share of this
     machine's GPU (gpu_slots=1), not a GPU of its own; now it asks sbatch for --gpus=1."""
     text = _dry_run("-p", "-F", "results/paper/train/head_on/seed0/actor.pt",
                     "results/paper/scenarios/kitchen_living/everywhere/h1.05.csv",
-                    "--executor", "slurm", "--jobs", "6", "--config", "profile=paper")
+                    "--executor", "slurm", "--jobs", "6", "--config", "preset=paper")
     [train] = [job for job in _job_blocks(text) if job["rule"] == "train"]
     assert "gpu=1" in train["resources"].split(", ") and "gpu_slots" not in train["resources"]
     # one thread, as its job asks for (--set-threads train=N gives more)
-    assert "egosearch train --force --variant head_on --profile paper --seed 0 --threads 1 " in text
+    assert "egosearch train --force --variant head_on --preset paper --seed 0 --threads 1 " in text
     plan = _plan(text)
     assert plan["train"] == (1, "-t 720 --mem 8000 --cpus-per-task=1 --gpus=1")
-    assert f"A paper-profile training asks for `{plan['train'][1]}`" in _running_md()
+    assert f"A paper-preset training asks for `{plan['train'][1]}`" in _running_md()
     assert plan["scenarios"] == (1, "-t 10 --mem 1000 --ntasks=1 --cpus-per-task=1")
     _check_plan_against_the_jobs(text)
     # on this machine the same training asks for one of the run's GPU shares, and no plan is printed
-    local = _dry_run("-F", "results/paper/train/head_on/seed0/actor.pt", "--cores", "6", "--config", "profile=paper")
+    local = _dry_run("-F", "results/paper/train/head_on/seed0/actor.pt", "--cores", "6", "--config", "preset=paper")
     [train] = [job for job in _job_blocks(local) if job["rule"] == "train"]
     assert "gpu_slots=1" in train["resources"].split(", ") and PLAN_HEAD not in local
 
@@ -137,7 +137,7 @@ def _record_key(benchmark: str) -> str:
 
 @pytest.mark.skipif(not RECORD.is_file(), reason="needs the stored cpu run's provenance")
 def test_the_slurm_profile_asks_sbatch_for_what_each_job_uses():
-    """profiles/slurm's dry run of everything the cpu profile stores: each rule's sbatch options follow its jobs'
+    """profiles/slurm's dry run of everything the cpu preset stores: each rule's sbatch options follow its jobs'
     resources (the profile's default-resources where a rule declares none), and they cover what the stored run's
     jobs used: their time 1.5 times over (hosts differ), their memory and the job's own snakemake."""
     text = _dry_run("-F", "all", "fresh", "behaviour", "generalise", "budget", "--workflow-profile", "profiles/slurm")
@@ -146,7 +146,7 @@ def test_the_slurm_profile_asks_sbatch_for_what_each_job_uses():
     assert profile["executor"] == "slurm" and profile["slurm-status-command"] == "squeue"
     assert _plan(text)["table1"][1] == (f"-t {profile['default-resources']['runtime']} "
                                         f"--mem {profile['default-resources']['mem_mb']} --ntasks=1 --cpus-per-task=1")
-    assert f"a cpu-profile one for `{_plan(text)['train'][1]}`" in _running_md()  # the page says what is asked
+    assert f"a cpu-preset one for `{_plan(text)['train'][1]}`" in _running_md()  # the page says what is asked
     asked = {}
     for rule, jobs in jobs_by_rule.items():
         for job in jobs:

@@ -35,7 +35,7 @@ def show(capsys, *args: str) -> list[str]:
 
 def test_config_show_prints_the_variants_env_and_the_curriculum_radii(capsys):
     variant = load_variant("head_on")
-    out = show(capsys, "sac_drq", "--profile", "cpu", "--variant", "head_on")
+    out = show(capsys, "sac_drq", "--preset", "cpu", "--variant", "head_on")
     env_line = next(line for line in out if line.startswith("env_id "))
     observed = resolve_variant("head_on", "cpu").env_id
     assert variant.env_id in env_line and observed in env_line and "variant head_on" in env_line
@@ -109,7 +109,7 @@ def test_each_config_field_has_one_default():
                 found.append(f"{rel}: {match.group(0)}")
     assert not found, found
     workflow = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    assert not set(workflow) & names and not any(set(p) & names for p in workflow["profiles"].values())
+    assert not set(workflow) & names and not any(set(p) & names for p in workflow["presets"].values())
 
 
 def test_set_is_checked_as_a_variant_files_value():
@@ -136,20 +136,20 @@ def test_set_is_checked_as_a_variant_files_value():
 def test_config_show_names_each_values_source(capsys):
     out = show(capsys, "sac_drq", "--variant", "head_on_contact_signal", "--set", "batch_size=64",
                "--set", "contact_signal=false")
-    assert out[0].startswith("sac_drq at profile cpu with variant head_on_contact_signal and --set "
+    assert out[0].startswith("sac_drq at preset cpu with variant head_on_contact_signal and --set "
                              "batch_size=64,contact_signal=False: ")
     rows = {line.split()[0]: line.split()[1:3] for line in out[4:]}
     assert rows["batch_size"] == ["64", "--set"] and rows["contact_signal"] == ["False", "--set"]
-    assert rows["total_env_steps"] == ["200000", "profile"] and rows["gamma"] == ["0.99", "default"]
+    assert rows["total_env_steps"] == ["200000", "preset"] and rows["gamma"] == ["0.99", "default"]
 
 
 def test_a_bad_set_on_the_command_line_is_one_line(tmp_path, capsys):
-    assert main(["train", "--variant", "head_on", "--profile", "smoke", "--set", "batch_siz=64",
+    assert main(["train", "--variant", "head_on", "--preset", "smoke", "--set", "batch_siz=64",
                  "--out-dir", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err.strip()
     assert err == ("egosearch train: error: --set: 'batch_siz' is not a LearnerConfig field (did you mean "
                    "batch_size?)")
-    assert main(["train", "--variant", "head_on", "--profile", "smoke", "--set", "batch_size=0",
+    assert main(["train", "--variant", "head_on", "--preset", "smoke", "--set", "batch_size=0",
                  "--out-dir", str(tmp_path / "run")]) == 2
     assert capsys.readouterr().err.strip().startswith("egosearch train: error: --set batch_size=0: LearnerConfig.")
     assert not (tmp_path / "run").exists()
@@ -198,13 +198,13 @@ def test_snakemake_hands_the_set_to_the_trainings_and_refuses_stored_ones():
     smoke = "results/smoke/train/head_on/seed0/actor.pt"
     if (REPO / smoke).exists():
         pytest.skip("a smoke training is stored in this checkout")
-    planned = dry(smoke, "--config", "profile=smoke", "set=batch_size=16,actor_lr=1e-4")
+    planned = dry(smoke, "--config", "preset=smoke", "set=batch_size=16,actor_lr=1e-4")
     assert planned.returncode == 0, planned.stderr
     assert "--set batch_size=16 --set actor_lr=0.0001 > results/smoke/logs/train/head_on/seed0.log" in planned.stdout
-    typo = dry(smoke, "--config", "profile=smoke", "set=batch_siz=16")
+    typo = dry(smoke, "--config", "preset=smoke", "set=batch_siz=16")
     assert typo.returncode == 1 and typo.stderr.strip().splitlines()[-1] == (
         "egosearch: error: config set: 'batch_siz' is not a LearnerConfig field (did you mean batch_size?)")
-    out_of_range = dry(smoke, "--config", "profile=smoke", "set=batch_size=-1")
+    out_of_range = dry(smoke, "--config", "preset=smoke", "set=batch_size=-1")
     assert out_of_range.returncode == 1 and out_of_range.stderr.strip().splitlines()[-1].startswith(
         "egosearch: error: config set=batch_size=-1: variant head_on: LearnerConfig.batch_size=-1 is out of range")
     stored = "results/cpu/train/head_on/seed0/actor.pt"

@@ -101,10 +101,10 @@ def _weights(agent) -> dict[str, torch.Tensor]:
 
 @pytest.mark.gpu
 @needs_cuda
-@pytest.mark.parametrize("profile", ["paper", "cpu"])
-def test_one_update_on_cuda_matches_the_cpu_update(profile):
+@pytest.mark.parametrize("preset", ["paper", "cpu"])
+def test_one_update_on_cuda_matches_the_cpu_update(preset):
     """``paper``: SAC+CURL at Table 2's sizes; ``cpu``: SAC-DrQ with the privileged critic."""
-    cfg = load_config(profile, {"device": "cpu"})
+    cfg = load_config(preset, {"device": "cpu"})
     state_dim = PRIVILEGED_STATE_DIM if cfg.critic_privileged_state else 0
     torch.manual_seed(0)
     cpu_agent = make_agent(cfg, 5, 30, 4, torch.device("cpu"), state_dim)
@@ -115,7 +115,7 @@ def test_one_update_on_cuda_matches_the_cpu_update(profile):
             cpu_agent.update(replay.sample(cfg.batch_size))
     state = copy.deepcopy(cpu_agent.state_dict())
     batch = replay.sample(cfg.batch_size)
-    cuda_agent = make_agent(load_config(profile, {"device": "cuda"}), 5, 30, 4, torch.device("cuda"), state_dim)
+    cuda_agent = make_agent(load_config(preset, {"device": "cuda"}), 5, 30, 4, torch.device("cuda"), state_dim)
     cuda_agent.load_state_dict(state)
     before = _weights(cpu_agent)
     with exact_fp32():
@@ -140,7 +140,7 @@ def test_one_update_on_cuda_matches_the_cpu_update(profile):
         worst_tensor = max(worst_tensor, err / scale if scale > 0 else 0.0)
         assert err <= 1e-3 * scale + 1e-7 * math.sqrt(start.numel()), (name, err, scale)
     assert moved >= len(before) // 2  # the update changed the networks: the comparison compares something
-    _report(f"update_{profile}", {"algorithm": cfg.algorithm, "batch": cfg.batch_size, "tensors": len(before),
+    _report(f"update_{preset}", {"algorithm": cfg.algorithm, "batch": cfg.batch_size, "tensors": len(before),
                                   "tensors_moved": moved, "max_relative_metric_difference": worst_metric,
                                   "max_relative_update_difference": worst_tensor})
 
@@ -193,7 +193,7 @@ def test_a_graphed_update_matches_the_eager_update_and_survives_a_reload():
 
     cfg = load_config("paper", {"device": "cuda"})
     torch.manual_seed(0)
-    eager = SacCurlAgent(replace(cfg, cuda_graph=False), 5, device="cuda")  # the paper profile graphs by default
+    eager = SacCurlAgent(replace(cfg, cuda_graph=False), 5, device="cuda")  # the paper preset graphs by default
     for opt in eager.optimisers.values():
         for group in opt.param_groups:
             group["capturable"] = True
@@ -325,8 +325,8 @@ def test_cuda_training_resumes_and_its_actor_loads_without_cuda(tmp_path):
 
 @pytest.mark.gpu
 @needs_cuda
-def test_the_default_profile_imitates_then_fine_tunes_on_cuda_and_its_actor_walks_on_the_cpu(tmp_path):
-    """The ``cpu`` profile (the default) learns from the frontier searcher's demonstrations, then fine-tunes
+def test_the_default_preset_imitates_then_fine_tunes_on_cuda_and_its_actor_walks_on_the_cpu(tmp_path):
+    """The ``cpu`` preset (the default) learns from the frontier searcher's demonstrations, then fine-tunes
     at every body step: on a machine with CUDA its training runs there (the teacher's episodes, the clone,
     the critic's warm-up, SAC with demonstrations in every batch, the privileged critic), and the actor and
     the start it leaves walk the body env on the CPU as evaluation runs them."""

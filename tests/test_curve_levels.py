@@ -41,7 +41,7 @@ def test_evaluate_curve_of_reads_the_variants_curve_scenarios_and_refuses_a_seed
     expected = curve_scenarios(curve_homes(resolved.train_env), resolved.train_env["placement"],
                                resolved.config.eval_episodes)
     out = tmp_path / "random.csv"
-    assert main(["evaluate", "--policy", "random", "--curve-of", "head_on", "--profile", "smoke", "--out",
+    assert main(["evaluate", "--policy", "random", "--curve-of", "head_on", "--preset", "smoke", "--out",
                  str(out)]) == 0
     rows = pd.read_csv(out)
     assert sorted(zip(rows["home"], rows["height"], rows["scenario_id"])) == sorted(

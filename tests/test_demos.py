@@ -16,7 +16,7 @@ from egosearch.variants import load_variant
 
 ENV = {"layout": "kitchen_living", "placement": "everywhere"}
 FROM_SCRATCH = load_variant("head_on_from_scratch").config
-"""The learner that demonstrations serve: the cpu profile before it became a modular searcher (the pins of its
+"""The learner that demonstrations serve: the cpu preset before it became a modular searcher (the pins of its
 stored variant)."""
 
 
@@ -115,15 +115,15 @@ def test_a_teacher_is_named_only_with_demonstrations():
         load_config("cpu", {**FROM_SCRATCH, "demo_episodes": 5, "demo_teacher": "oracle"})
 
 
-def test_demonstrations_are_collected_at_every_profile(tmp_path, capsys):
-    """Issue 57: at the paper profile (and at smoke, a variant that pins it) the learner SAC+CURL stores the env's
+def test_demonstrations_are_collected_at_every_preset(tmp_path, capsys):
+    """Issue 57: at the paper preset (and at smoke, a variant that pins it) the learner SAC+CURL stores the env's
     frames unpooled, and has no obs_downsample: `egosearch demos` and the `demos` rule stopped there on an
-    AttributeError. (At smoke head_off has its cpu learner since issue 73, SAC-DrQ: the paper profile keeps it.)"""
+    AttributeError. (At smoke head_off has its cpu learner since issue 73, SAC-DrQ: the paper preset keeps it.)"""
     from egosearch.cli import main
     from egosearch.variants import resolve_variant
 
     out = tmp_path / "d.replay.npz"
-    assert main(["demos", "--variant", "head_off", "--profile", "paper", "--episodes", "1", "--out", str(out)]) == 0
+    assert main(["demos", "--variant", "head_off", "--preset", "paper", "--episodes", "1", "--out", str(out)]) == 0
     cfg = resolve_variant("head_off", "paper").config
     assert not hasattr(cfg, "obs_downsample")
     summary = json.loads(summary_path(out).read_text())

@@ -38,15 +38,15 @@ def test_blocks_in_docs_pages_read_the_project_root(tmp_path, monkeypatch, capsy
     assert update_pages(tmp_path, "p", check=True) == [tmp_path / "README.md", page]
     assert "stale" in page.read_text()                      # check mode writes nothing
     monkeypatch.chdir(tmp_path)
-    assert main(["report", "readme", "--profile", "p", "--check"]) == 2
+    assert main(["report", "readme", "--preset", "p", "--check"]) == 2
     assert "README.md, docs/deep/page.md out of date" in capsys.readouterr().err
-    assert main(["report", "readme", "--profile", "p"]) == 0
+    assert main(["report", "readme", "--preset", "p"]) == 0
     for path in (tmp_path / "README.md", page):
         assert "| 0.42 |" in path.read_text() and "stale" not in path.read_text() and "wrong" not in path.read_text()
     assert "text kept" in page.read_text()
-    assert main(["report", "readme", "--profile", "p", "--check"]) == 0
+    assert main(["report", "readme", "--preset", "p", "--check"]) == 0
     # one page alone, as before the docs existed
-    assert main(["report", "readme", "--profile", "p", "--check", "--readme", str(page)]) == 0
+    assert main(["report", "readme", "--preset", "p", "--check", "--readme", str(page)]) == 0
 
 
 def test_every_block_lives_in_some_page():
@@ -225,7 +225,7 @@ def test_every_machine_measured_is_a_row_of_the_speed_block_and_a_line_of_proven
         block_speed(tmp_path, "p")
     # the provenance block names it beside the stored run's own estimate
     (tmp_path / "results" / "p" / "provenance.json").write_text(json.dumps({
-        "profile": "p", "commit": "0123456789", "date_utc": "2026-01-02T03:04:05", "machine": {"cpu": "X CPU"},
+        "preset": "p", "commit": "0123456789", "date_utc": "2026-01-02T03:04:05", "machine": {"cpu": "X CPU"},
         "jobs": [], "wall_s_all_jobs_summed": 0.0}))
     (bench / "estimate_all.json").write_text(json.dumps({
         "cores": 2, "steps": "decisions", "hours_as_recorded": 3.6, "hours_cpu_over_cores": 2.7}))
@@ -253,7 +253,7 @@ def test_a_records_machine_placeholder_is_this_machines_folder(tmp_path, monkeyp
     out = tmp_path / "{machine}" / "estimate_all.json"
     assert main(["estimate", "all", "--rate", "10", "--out", str(out)]) == 0
     record = json.loads((tmp_path / "amd-epyc-16-cores" / "estimate_all.json").read_text())
-    assert record["command"] == f"egosearch estimate all --cores 2 --profile cpu --rate 10 --out " \
+    assert record["command"] == f"egosearch estimate all --cores 2 --preset cpu --rate 10 --out " \
         f"{tmp_path / 'amd-epyc-16-cores' / 'estimate_all.json'}" and record["machine"]["cores"] == 16
     assert record["date_utc"] and record["commit"] and record["bench_rate"] == 10
 

@@ -16,11 +16,11 @@ RECORD = REPO / "results" / "cpu" / "provenance.json"
 @pytest.mark.skipif(not RECORD.exists(), reason="no stored cpu run")
 def test_the_estimate_simulates_the_schedule_and_scales_trainings_to_the_machine(monkeypatch):
     monkeypatch.chdir(REPO)
-    from egosearch.cost.rates import steps_of_profile, stored_training_rates
+    from egosearch.cost.rates import steps_of_preset, stored_training_rates
 
     record = json.loads(RECORD.read_text())
-    # rates in the profile's own unit (decisions for a modular searcher), about the recorded ones
-    base = min(stored_training_rates(record, RECORD.parent, steps_of_profile("cpu")).values())
+    # rates in the preset's own unit (decisions for a modular searcher), about the recorded ones
+    base = min(stored_training_rates(record, RECORD.parent, steps_of_preset("cpu")).values())
     slow = estimate_all(record, RECORD.parent, 2, "cpu", rate=base)
     fast = estimate_all(record, RECORD.parent, 2, "cpu", rate=2 * base)
     # waiting and imperfect packing: the schedule is never shorter than CPU time / cores
@@ -57,7 +57,7 @@ def test_a_training_says_at_its_start_how_long_it_takes_here(tmp_path, monkeypat
     (tmp_path / "rate.json").write_text(json.dumps({"machine": "another machine", "rate": 100.0,
                                                     "steps": "decisions"}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
-    # a calibration made while the profile was a modular searcher timed its decisions, not body steps
+    # a calibration made while the preset was a modular searcher timed its decisions, not body steps
     (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "decisions"}))
     assert "no calibration" in estimate.training_time_line(180_000, "cpu")
     assert estimate.training_time_line(180_000, "smoke") is None
@@ -148,7 +148,7 @@ def test_a_training_that_learns_from_the_teacher_adds_its_imitation_phase(tmp_pa
     (results / "bench" / "learner.json").write_text(json.dumps(bench))
     cfg = load_config("cpu", {"modular_searcher": False, "demo_episodes": 100, "bc_updates": 500,
                               "dagger_rounds": 1, "dagger_episodes": 20})
-    # the calibration times the profile's body steps, as this training's: its RL phase at the calibrated rate
+    # the calibration times the preset's body steps, as this training's: its RL phase at the calibrated rate
     line = estimate.training_time_line(200_000, "cpu", cfg)
     assert "calibrated at 50 body steps per CPU-second" in line and "teacher's 100 episodes" in line
     run = results / "train" / "cloned" / "seed0"
@@ -169,14 +169,14 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
     from egosearch.cost import calibration
     from egosearch.workflow.dag import DagJob
 
-    def short_training(profile, env_steps):
+    def short_training(preset, env_steps):
         print("eval @ 0: success nan  return nan  spl nan")  # what a real calibration prints
         return {"env_steps_per_core_s": 40.0}
 
     monkeypatch.chdir(REPO)
     monkeypatch.setattr(calibration, "CALIBRATION_CACHE", tmp_path / "rate.json")
     monkeypatch.setattr(egosearch.rl.bench_learner, "training_throughput", short_training)
-    monkeypatch.setattr(egosearch.rl.bench_learner, "cpu_profile_run_steps", lambda: 10)
+    monkeypatch.setattr(egosearch.rl.bench_learner, "cpu_preset_run_steps", lambda: 10)
     monkeypatch.setattr(estimate, "dag_jobs", lambda target, cores, config: [
         DagJob(id="train/head_on/seed0", rule="train", job="head_on/seed0", record_rule="train", threads=1, deps=(),
                order=1)])
@@ -187,7 +187,7 @@ def test_estimate_all_prints_its_answer_naming_the_cpu_and_a_busy_machine(tmp_pa
     assert main(["estimate", "all"]) == 0
     out, err = capsys.readouterr()
     lines = out.splitlines()
-    assert "nan" not in out and lines[0].startswith("snakemake --cores 2 all from a fresh clone, cpu profile")
+    assert "nan" not in out and lines[0].startswith("snakemake --cores 2 all from a fresh clone, cpu preset")
     here = estimate.machine_key(calibration.this_machine())
     assert lines[1].startswith(f"  on this machine ({here}): about ") and "40 body steps per CPU-second" in lines[1]
     assert ("  the machine was busy while it calibrated: other processes used 1.5 cores meanwhile, so the rate here "
@@ -209,7 +209,7 @@ def test_a_comparisons_cost_adds_the_teachers_episodes_of_a_variant_that_learns_
     assert config.demo_episodes and config.env_step_unit == "body steps"
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
-    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+    (results / "provenance.json").write_text(json.dumps({"preset": "cpu", "jobs": [
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0}]}))
     (results / "bench" / "learner.json").write_text(json.dumps({"result": {
         "env_steps_per_core_s_cpu_profile": 100.0, "cpu_profile_steps": "body steps"}}))  # 0.01 CPU-s a step
@@ -233,7 +233,7 @@ def training_job(variant: str, seed: int = 0, deps=()):
     from egosearch.workflow.dag import DagJob
 
     return DagJob(id=f"train/{variant}/seed{seed}", rule="train", job=f"{variant}/seed{seed}", record_rule="train",
-                  threads=1, deps=tuple(deps), order=seed, wildcards={"profile": "cpu", "variant": variant,
+                  threads=1, deps=tuple(deps), order=seed, wildcards={"preset": "cpu", "variant": variant,
                                                                       "seed": str(seed)})
 
 
@@ -242,7 +242,7 @@ def evaluation_job(variant: str, seed: int, cell: str, order: int):
 
     return DagJob(id=f"eval/{variant}/seed{seed}/{cell}", rule="evaluate", job=f"{variant}/seed{seed}/{cell}",
                   record_rule="eval", threads=1, deps=(f"train/{variant}/seed{seed}",), order=order,
-                  wildcards={"profile": "cpu", "variant": variant, "seed": str(seed)})
+                  wildcards={"preset": "cpu", "variant": variant, "seed": str(seed)})
 
 
 
@@ -265,7 +265,7 @@ def test_the_cost_line_counts_every_job_of_the_plan(tmp_path, monkeypatch, capsy
     _calibrated_at_100_steps_a_second(tmp_path, monkeypatch)
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
-    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+    (results / "provenance.json").write_text(json.dumps({"preset": "cpu", "jobs": [
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0},
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.65", "wall_s": 60.0}]}))
     monkeypatch.setattr(estimate, "teacher_cost_s", lambda config, results, bench, rate: 360.0)
@@ -300,7 +300,7 @@ def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatc
             "the machine is idle)")
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
-    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+    (results / "provenance.json").write_text(json.dumps({"preset": "cpu", "jobs": [
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 40.0}]}))
     for other, said in ((1.3, True), (0.1, False), (None, False)):
         (tmp_path / "rate.json").write_text(json.dumps({"machine": here, "rate": 100.0, "steps": "body steps",
@@ -316,7 +316,7 @@ def test_a_cost_line_that_reuses_a_busy_calibration_says_so(tmp_path, monkeypatc
 
 def test_a_smoke_cost_line_prices_the_capped_config_in_minutes(tmp_path, monkeypatch, capsys):
     """Issue 73 item 3: head_on_25px pins 300,000 env steps, and a smoke dry run planned them (41 min); at smoke it
-    trains the capped config's steps, and the line prices that config, from the cpu profile's stored run (smoke
+    trains the capped config's steps, and the line prices that config, from the cpu preset's stored run (smoke
     stores none), in minutes: the training at its env steps plus a job's start, an evaluation at the recorded time
     scaled to smoke's scenarios a cell."""
     import egosearch.cost.estimate as estimate
@@ -327,7 +327,7 @@ def test_a_smoke_cost_line_prices_the_capped_config_in_minutes(tmp_path, monkeyp
     _calibrated_at_100_steps_a_second(tmp_path, monkeypatch)
     results = tmp_path / "results" / "cpu"
     (results / "bench").mkdir(parents=True)
-    (results / "provenance.json").write_text(json.dumps({"profile": "cpu", "jobs": [
+    (results / "provenance.json").write_text(json.dumps({"preset": "cpu", "jobs": [
         {"rule": "eval", "job": "x/seed0/kitchen_living/everywhere/h1.05", "wall_s": 53.0}]}))
     plan = [training_job("head_on_25px"), evaluation_job("head_on_25px", 0, "c1", 1)]
     estimate.print_plan_cost("screen of head_on_25px against head_on", plan, "smoke", 1, "head_on",
@@ -337,9 +337,9 @@ def test_a_smoke_cost_line_prices_the_capped_config_in_minutes(tmp_path, monkeyp
     evaluation_s = estimate.JOB_START_S + (53.0 - estimate.JOB_START_S) * 4 / 200
     assert (f"1 training(s) of {config.total_env_steps} env steps, about {training_s / 60:.1f} min each on this "
             "machine (its last calibration), 1 evaluations of about 4 s: "
-            f"about {(training_s + evaluation_s) / 60:.1f} min on 1 core(s) (the smoke profile stores no run: priced "
-            "from the cpu profile's") in line, line
-    # without the cpu profile's run either, no estimate, as before
+            f"about {(training_s + evaluation_s) / 60:.1f} min on 1 core(s) (the smoke preset stores no run: priced "
+            "from the cpu preset's") in line, line
+    # without the cpu preset's run either, no estimate, as before
     (results / "provenance.json").unlink()
     estimate.print_plan_cost("screen of head_on_25px against head_on", plan, "smoke", 1, "head_on")
-    assert "no estimate of the run's time: the smoke profile has no stored run" in capsys.readouterr().err
+    assert "no estimate of the run's time: the smoke preset has no stored run" in capsys.readouterr().err

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 import torch
 
-SMOKE = "profile=smoke"
+SMOKE = "preset=smoke"
 TARGET = "results/smoke/eval/head_on/seed0/kitchen_living/everywhere/h1.65.csv"
 RUN = "results/smoke/train/head_on/seed0"
 TIMING = ["steps_per_s", "updates_per_s", "wall_s"]   # wall-clock columns: never the same twice

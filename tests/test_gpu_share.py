@@ -1,4 +1,4 @@
-"""Several paper-profile trainings on one GPU (issue 47): the DAG's share and threads at each profile, the
+"""Several paper-preset trainings on one GPU (issue 47): the DAG's share and threads at each preset, the
 CUDA MPS detector, the line a run says once, and the side-by-side measurement's record and projection."""
 
 import io
@@ -35,7 +35,7 @@ REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 
-# ---- the share and the threads at each profile ------------------------------------------------
+# ---- the share and the threads at each preset ------------------------------------------------
 
 def test_the_share_is_six_on_one_machine_and_a_whole_gpu_under_a_cluster_unless_the_config_says():
     assert resolve_trainings_per_gpu("auto", local=True) == 6 == gpu_share.DEFAULT_TRAININGS_PER_GPU
@@ -50,14 +50,14 @@ def test_the_share_is_six_on_one_machine_and_a_whole_gpu_under_a_cluster_unless_
             resolve_trainings_per_gpu(bad, local=True)
 
 
-def test_a_training_takes_a_fair_share_of_the_cores_at_the_paper_profile_only():
+def test_a_training_takes_a_fair_share_of_the_cores_at_the_paper_preset_only():
     assert train_threads("paper", 16, 6) == 2  # the measured setting: six trainings, 2 threads each
     assert train_threads("paper", 16, 2) == 8
     assert train_threads("paper", 16, 1) == 16  # one at a time: every core
     assert train_threads("paper", 4, 6) == 1  # never 0
     assert train_threads("paper", None, 6) == 1  # a cluster executor's run names no cores
-    for profile in ("cpu", "smoke"):
-        assert train_threads(profile, 16, 6) == 1
+    for preset in ("cpu", "smoke"):
+        assert train_threads(preset, 16, 6) == 1
 
 
 def test_the_config_key_is_validated_before_any_job():
@@ -93,19 +93,19 @@ def _train_jobs(text):
 
 def test_a_paper_dry_run_with_two_shares_splits_the_cores_and_says_once_that_mps_is_not_running(tmp_path):
     targets = ["results/paper/train/head_on/seed0/actor.pt", "results/paper/train/head_off/seed1/actor.pt"]
-    shared = _dry_run(*targets, "--cores", "8", "--config", "profile=paper", "trainings_per_gpu=2",
+    shared = _dry_run(*targets, "--cores", "8", "--config", "preset=paper", "trainings_per_gpu=2",
                       pipe_dir=tmp_path)
     jobs = _train_jobs(shared)
     assert len(jobs) == 2
     for _, threads, resources in jobs:
         assert threads == 4  # 8 cores / 2 shares
         assert "gpu_slots=1" in resources and "gpu=1" not in resources
-    lines = [line for line in shared.splitlines() if "paper-profile trainings run side by side on one GPU" in line]
+    lines = [line for line in shared.splitlines() if "paper-preset trainings run side by side on one GPU" in line]
     assert len(lines) == 1, lines  # once, before the DAG's jobs
     assert "Up to 2 " in lines[0] and "without CUDA MPS" in lines[0] and str(tmp_path) in lines[0]
     assert "208 env steps/s in all against 541 under MPS" in lines[0] and "nvidia-cuda-mps-control -d" in lines[0]
     # one at a time: every core, the same jobs and paths, nothing said about sharing
-    alone = _dry_run(*targets, "--cores", "8", "--config", "profile=paper", "trainings_per_gpu=1", pipe_dir=tmp_path)
+    alone = _dry_run(*targets, "--cores", "8", "--config", "preset=paper", "trainings_per_gpu=1", pipe_dir=tmp_path)
     assert [(o, t) for o, t, _ in _train_jobs(alone)] == [(o, 8) for o, _, _ in jobs]
     assert "side by side on one GPU" not in alone
 
@@ -175,7 +175,7 @@ NO_MPS = MpsStatus(False, "/tmp/nvidia-mps", "no nvidia-cuda-mps-control process
 def test_the_line_says_what_sharing_without_mps_costs_and_nothing_for_one_at_a_time():
     assert sharing_line(1, NO_MPS) is None
     line = sharing_line(6, NO_MPS)
-    assert line.startswith("Up to 6 paper-profile trainings run side by side on one GPU (trainings_per_gpu) without "
+    assert line.startswith("Up to 6 paper-preset trainings run side by side on one GPU (trainings_per_gpu) without "
                            "CUDA MPS (no nvidia-cuda-mps-control process")
     assert (f"{MEASURED['trainings']} side by side trained 208 env steps/s in all against 541 under MPS (NVIDIA H200; "
             "issue 47's measurement") in line
@@ -205,7 +205,7 @@ def test_a_run_says_it_once(monkeypatch, tmp_path):
     env = {"CUDA_MPS_PIPE_DIRECTORY": str(tmp_path / "pipe")}
     proc = _proc(tmp_path, {})
     out = io.StringIO()
-    assert not warn_gpu_sharing("cpu", 6, tmp_path, env, proc, out)  # no GPU sharing at the cpu profile
+    assert not warn_gpu_sharing("cpu", 6, tmp_path, env, proc, out)  # no GPU sharing at the cpu preset
     assert not warn_gpu_sharing("paper", 1, tmp_path, env, proc, out)  # one at a time
     assert warn_gpu_sharing("paper", 6, tmp_path, env, proc, out)
     assert not warn_gpu_sharing("paper", 6, tmp_path, env, proc, out)
@@ -221,7 +221,7 @@ def test_the_cost_line_says_it_once_however_often_it_is_printed(monkeypatch, cap
     for _ in range(2):
         print_costs(["table2"], config, "paper", [0], "head_on", None, trainings_per_gpu=3)
     err = capsys.readouterr().err
-    assert err.count("Up to 3 paper-profile trainings run side by side") == 1
+    assert err.count("Up to 3 paper-preset trainings run side by side") == 1
 
 
 # ---- the record and its projection -----------------------------------------------------------------
@@ -333,7 +333,7 @@ def test_the_measurement_runs_one_alone_then_n_side_by_side_under_mps(tmp_path):
     alone, without, side = runner.batches
     assert alone[0].threads == 8 and [t.threads for t in side] == [4, 4] and [t.seed for t in side] == [0, 1]
     argv = " ".join(side[1].argv)
-    assert "train --variant head_on --profile paper --seed 1 --threads 4" in argv and "--max-wall-s 30" in argv
+    assert "train --variant head_on --preset paper --seed 1 --threads 4" in argv and "--max-wall-s 30" in argv
     assert side[1].out_dir == str(tmp_path / "runs" / "side_by_side" / "1") and side[1].env["OMP_NUM_THREADS"] == "4"
     assert "--max-wall-s 20" in " ".join(without[0].argv)
     assert r["mps"] is True and "started `nvidia-cuda-mps-control -d`" in r["mps_note"]
@@ -382,7 +382,7 @@ def test_the_command_refuses_in_one_line(tmp_path, capsys):
         (["bench", "gpu", "--side-by-side", "1", "--out-dir", str(tmp_path / "x"), *out],
          "egosearch bench: error: --side-by-side=1: the trainings side by side on one GPU must be >= 2"),
         (["bench", "gpu", "--side-by-side", "2", "--cuda-graph", "--out-dir", str(tmp_path / "x"), *out],
-         "egosearch bench: error: --cuda-graph is not read with --side-by-side: its trainings run the paper profile "
+         "egosearch bench: error: --cuda-graph is not read with --side-by-side: its trainings run the paper preset "
          "as the DAG does (cuda_graph on)"),
         (["bench", "learner", "--side-by-side", "2", *out],
          "egosearch bench: error: --side-by-side is read by `bench gpu` only, not by `bench learner`"),
@@ -427,7 +427,7 @@ def test_the_command_writes_the_flat_record_where_the_docs_read_it(tmp_path, mon
 
 
 def test_all_env_steps_are_the_paper_alls_trainings(monkeypatch):
-    """The projection's numerator: every variant of `all` x the paper profile's seeds, 750k env steps each."""
+    """The projection's numerator: every variant of `all` x the paper preset's seeds, 750k env steps each."""
     import argparse
 
     import egosearch.cli.side_by_side as side_by_side
@@ -474,7 +474,7 @@ def test_the_projection_reads_the_side_by_side_record_where_it_exists(tmp_path):
     assert math.isclose(q["trainings_h"] * 3600, 3600.0) and math.isclose(q["other_h"] * 3600, 135.0)
     assert math.isclose(q["total_h"] * 3600, 3735.0) and q["n"] == 2 and q["mps"] is True
     text = block_gpu_projection(tmp_path, "cpu")
-    assert text.startswith("On one H (8 CPU cores), `snakemake --cores 8 --config profile=paper all` is projected at "
+    assert text.startswith("On one H (8 CPU cores), `snakemake --cores 8 --config preset=paper all` is projected at "
                            "**about 1.0 h**: 6 trainings, 900,000 env steps in all, 2 side by side under CUDA MPS at "
                            "the measured 250 env steps/s in all (1.0 h; one training alone: 120.0 env steps/s, 2.1 h "
                            "one at a time)")

@@ -23,7 +23,7 @@ SMALL = {"device": "cpu", "num_threads": 1, "algorithm": "sac_drq", "obs_downsam
          "encoder_stride2_layers": 2, "aug_pad": 1, "target_memory": True, "critic_privileged_state": True,
          "train_height_min": 0.45, "n_step": 3, "batch_size": 32, "actor_update_freq": 1,
          "critic_target_update_freq": 1}
-"""The cpu profile's learner and observation at smoke sizes."""
+"""The cpu preset's learner and observation at smoke sizes."""
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,6 @@
 """A config per learner (issue 46, item 1): the run settings every learner shares, each learner's own
 settings registered with it, composed into one config class per learner; a field a learner does not
-have is one line, wherever it is set; the profiles are data a learner takes the fields it has of."""
+have is one line, wherever it is set; the presets are data a learner takes the fields it has of."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from egosearch.rl.config import (
     shared_fields,
 )
 from egosearch.rl.learner_registry import LEARNERS
-from egosearch.rl.profiles import CPU, PROFILES
+from egosearch.rl.presets import CPU, PRESETS
 from egosearch.rl.run_settings import RunSettings
 from egosearch.variants import VariantError, load_variant
 
@@ -75,8 +75,8 @@ def test_a_field_no_learner_has_names_the_nearest():
         load_config("cpu", {"obs_downsampel": 2})
 
 
-def test_a_profile_sets_the_fields_a_learner_has_and_leaves_the_others():
-    # PPO's own rules only: the cpu profile's demonstration fields never reach a learner that does not read them
+def test_a_preset_sets_the_fields_a_learner_has_and_leaves_the_others():
+    # PPO's own rules only: the cpu preset's demonstration fields never reach a learner that does not read them
     cfg = load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "n_step": 1, "update_every": 16,
                               "replay_capacity": 1000})
     assert cfg.obs_downsample == CPU["obs_downsample"] and not hasattr(cfg, "aug_pad")
@@ -84,9 +84,9 @@ def test_a_profile_sets_the_fields_a_learner_has_and_leaves_the_others():
     assert cfg.critic_privileged_state == CPU["critic_privileged_state"]  # PPO's value network reads it
     with pytest.raises(ValueError, match=r"ppo .* no field 'demo_episodes' \(a setting of sac_drq, sac_drq_rec"):
         load_config("cpu", {"algorithm": "ppo", "init_steps": 0, "update_every": 16, "demo_episodes": 10})
-    assert not hasattr(cfg, "alpha_lr")  # the cpu profile's temperature rate: PPO has no temperature
-    for profile in PROFILES:
-        assert set(load_config(profile).to_dict()) <= set(field_defaults())
+    assert not hasattr(cfg, "alpha_lr")  # the cpu preset's temperature rate: PPO has no temperature
+    for preset in PRESETS:
+        assert set(load_config(preset).to_dict()) <= set(field_defaults())
 
 
 def test_a_variant_naming_its_learner_is_checked_against_it_when_read(tmp_path):
@@ -104,7 +104,7 @@ def test_a_learner_registered_without_settings_has_the_run_settings_alone():
     try:
         cfg = load_config("smoke", {"algorithm": "toy_settingless"})
         assert set(cfg.to_dict()) == SHARED
-        # at the cpu profile too, with nothing pinned: the profile's demonstrations and privileged critic are
+        # at the cpu preset too, with nothing pinned: the preset's demonstrations and privileged critic are
         # for the learners that read them
         assert not hasattr(load_config("cpu", {"algorithm": "toy_settingless"}), "critic_privileged_state")
         with pytest.raises(ValueError, match="has no field 'actor_lr'"):
@@ -115,7 +115,7 @@ def test_a_learner_registered_without_settings_has_the_run_settings_alone():
 
 def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_file(capsys):
     """What a reader opens one learner's config with: each field once, its value and where it comes from (the
-    field's default, the profile, the variant), the class and file that declare it."""
+    field's default, the preset, the variant), the class and file that declare it."""
     import importlib
     import inspect
 
@@ -125,7 +125,7 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
     rows = {r["field"]: r for r in config_sources("sac_drq", "cpu")}
     assert set(rows) == set(LearnerConfig(algorithm="sac_drq").to_dict())
     assert (rows["total_env_steps"]["value"], rows["total_env_steps"]["source"], rows["total_env_steps"]["paper"]) == (
-        "200000", "profile cpu", "750000")
+        "200000", "preset cpu", "750000")
     assert (rows["gamma"]["value"], rows["gamma"]["source"]) == ("0.99", "default")
     assert rows["algorithm"]["declared_in"] == "egosearch.rl.run_settings.RunSettings"
     for row in rows.values():  # the named class's own source declares the field
@@ -133,7 +133,7 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
         assert f"    {row['field']}:" in inspect.getsource(getattr(importlib.import_module(module), klass)), row
     ppo = {r["field"]: r for r in config_sources("ppo", "cpu", {"init_steps": 0, "update_every": 16, "n_step": 1})}
     # PPO opts into one training aid, not the other
-    assert "demo_episodes" not in ppo and ppo["critic_privileged_state"]["source"] == "profile cpu"
+    assert "demo_episodes" not in ppo and ppo["critic_privileged_state"]["source"] == "preset cpu"
     paper = {r["field"]: r for r in config_sources("sac_drq", "paper")}
     assert (paper["total_env_steps"]["value"], paper["total_env_steps"]["source"]) == ("750000", "default")
     varied = {r["field"]: r
@@ -144,7 +144,7 @@ def test_config_show_gives_every_field_once_with_its_value_source_and_declaring_
     main(["config", "show", "sac_drq", "--variant", "head_on_contact_signal"])
     out = capsys.readouterr().out.splitlines()
     n = len(dataclasses.fields(config_class("sac_drq")))
-    assert out[0].startswith(f"sac_drq at profile cpu with variant head_on_contact_signal: {n} fields, declared in ")
+    assert out[0].startswith(f"sac_drq at preset cpu with variant head_on_contact_signal: {n} fields, declared in ")
     # the header, the variant's env_id and train_env, the column heads, then one line a field
     assert len(out) == 4 + n and sum(line.startswith("contact_signal ") for line in out) == 1
     assert main(["config", "show", "sac_curl", "--variant", "head_on_ppo"]) == 2
@@ -199,4 +199,4 @@ def test_the_config_page_gives_each_learner_the_shared_fields_and_exactly_its_ow
         section = page.split(f"(`algorithm: {name}`)")[1].split("\n## ")[0]
         assert [line.split("`")[1] for line in section.splitlines() if line.startswith("| `")] == list(
             own_settings(name))
-    assert "| `bc_weight_floor` | `0.0` |  |" in page  # the paper's value; the cpu profile leaves it at 0
+    assert "| `bc_weight_floor` | `0.0` |  |" in page  # the paper's value; the cpu preset leaves it at 0

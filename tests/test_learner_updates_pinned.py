@@ -57,7 +57,7 @@ PINNED: dict[str, tuple[str, dict]] = {
     "ppo": ("smoke", {"algorithm": "ppo", "obs_downsample": 4, "encoder_stride2_layers": 2, "init_steps": 0,
                       "num_envs": 2, "update_every": 16, "replay_capacity": 64, "ppo_epochs": 2, "ppo_minibatches": 2}),
 }
-"""Name -> (profile, overrides on top of :data:`TINY_RUN`): every learner, and its own options."""
+"""Name -> (preset, overrides on top of :data:`TINY_RUN`): every learner, and its own options."""
 
 EXPECTED = {
     "sac_curl": "adf3d08ee0a056e212ad41b1a33081d2f39aa4e850a559c8103db4ec503b55e3",
@@ -75,8 +75,8 @@ LOSS_COLUMNS = ("updates", "train_return", "critic_loss", "actor_loss", "alpha_l
 
 
 def pinned_config(name: str):
-    profile, overrides = PINNED[name]
-    return load_config(profile, {**TINY_RUN, **overrides})
+    preset, overrides = PINNED[name]
+    return load_config(preset, {**TINY_RUN, **overrides})
 
 
 def training_hash(out: Path) -> str:

@@ -8,8 +8,8 @@ enough on one host and not on another: on a 2-core Intel Xeon the policy had onl
 (0.19 and 0.13 against the random searcher's 0.10, seeds 0 and 1), while at 20k seeds 0, 1 and 2 each
 found 0.79 on it, about 2.5 minutes a run on an otherwise idle core.
 
-It sees the profile's earlier observation, 25 px depth without the target memory: the same learner,
-but the profile's 50 px + memory observation costs about four times as much per update and learns
+It sees the preset's earlier observation, 25 px depth without the target memory: the same learner,
+but the preset's 50 px + memory observation costs about four times as much per update and learns
 more slowly at first (measured, when this test ran 12k env steps: 0.30 against the random searcher's 0.20
 on the first 20 of the scenarios below, 8 minutes beside two trainings), more than a test can spend.
 """
@@ -30,7 +30,7 @@ STEPS = 20_000
 
 @pytest.mark.slow
 def test_cpu_learner_beats_the_random_searcher_in_kitchen_living(tmp_path):
-    # the learner that acts at every body step (the cpu profile's before its modular searcher: its stored
+    # the learner that acts at every body step (the cpu preset's before its modular searcher: its stored
     # variant's pins); curriculum_steps 10x the run: the start radius grows only from 1.0 to 2.1 m
     cfg = load_config("cpu", {**load_variant("head_on_from_scratch").config, "total_env_steps": STEPS,
                               "curriculum_steps": 10 * STEPS, "init_steps": 2000, "eval_every": STEPS,

@@ -16,7 +16,7 @@ REPO = Path(__file__).resolve().parent.parent
 STORED_RUN = [REPO / "results" / "cpu" / "provenance.json", REPO / "results" / "cpu" / "eval" / "head_on"]
 needs_stored_run = pytest.mark.skipif(
     not all(p.exists() for p in STORED_RUN),
-    reason="the stored run of the current cpu profile is not committed yet (see the README's Results status)")
+    reason="the stored run of the current cpu preset is not committed yet (see the README's Results status)")
 
 
 def copy_stored_cpu_results(dest: Path) -> None:
@@ -42,7 +42,7 @@ def _stored_results(root: Path) -> None:
                   "n_seeds": [3, 3, 1], "success_rate": [0.1, 0.3, 0.05], "low": [0.0, 0.2, float("nan")],
                   "high": [0.2, 0.4, float("nan")]}).to_csv(figs / "fig6.csv", index=False)
     (results / "provenance.json").write_text(json.dumps({
-        "profile": "p", "commit": "0123456789abcdef", "date_utc": "2026-01-02T03:04:05+00:00",
+        "preset": "p", "commit": "0123456789abcdef", "date_utc": "2026-01-02T03:04:05+00:00",
         "machine": {"cpu": "X", "cores": 2, "torch": "2"}, "wall_s_per_rule_summed": {"train": 10800.0, "eval": 60.0},
         "wall_s_all_jobs_summed": 10860.0, "note": "resumed once",
         # head_on's training shared a core: it ran 3600 s of its 7200 (its CPU time)
@@ -101,9 +101,9 @@ def test_check_mode_reports_stale_blocks_without_writing(tmp_path):
     assert readme.read_text() == README
     assert update_readme(readme, "p") is False              # rewritten now
     assert update_readme(readme, "p", check=True) is True
-    assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 0
+    assert main(["report", "readme", "--readme", str(readme), "--preset", "p", "--check"]) == 0
     (tmp_path / "paper_figs" / "p" / "table1.md").write_text("| a |\n|---|\n| 0.43 |\n")
-    assert main(["report", "readme", "--readme", str(readme), "--profile", "p", "--check"]) == 2
+    assert main(["report", "readme", "--readme", str(readme), "--preset", "p", "--check"]) == 2
 
 
 def test_compare_blocks_list_every_stored_comparison_on_its_familys_page(tmp_path):
@@ -221,20 +221,20 @@ def test_the_repository_readme_and_docs_match_the_stored_cpu_results():
     assert REPO / "README.md" in pages(REPO) and REPO / "docs" / "results.md" in pages(REPO)
     stale = update_pages(REPO, "cpu", check=True)
     assert stale == [], (f"generated blocks of {', '.join(str(p.relative_to(REPO)) for p in stale)} differ from "
-                         "results/cpu + paper_figs/cpu: run `egosearch report readme --profile cpu`")
+                         "results/cpu + paper_figs/cpu: run `egosearch report readme --preset cpu`")
 
 
-def test_the_readings_contrasts_read_the_profiles_seeds_only(tmp_path):
-    """head_on also stores the reference's spread seeds beyond the profile's (`snakemake seed_spread`): the
-    reading's height and cabinet contrasts are Table 1's, read on the profile's seeds alone."""
+def test_the_readings_contrasts_read_the_presets_seeds_only(tmp_path):
+    """head_on also stores the reference's spread seeds beyond the preset's (`snakemake seed_spread`): the
+    reading's height and cabinet contrasts are Table 1's, read on the preset's seeds alone."""
     import yaml
 
     from egosearch.report.readme import table1_contrast
 
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    seeds, spread = config["profiles"]["cpu"]["seeds"], config["profiles"]["cpu"]["spread_seeds"]
+    seeds, spread = config["presets"]["cpu"]["seeds"], config["presets"]["cpu"]["spread_seeds"]
     extra = [s for s in spread if s not in seeds]
-    assert seeds == [0, 1, 2] and extra, "the cpu profile's spread seeds go beyond its seeds"
+    assert seeds == [0, 1, 2] and extra, "the cpu preset's spread seeds go beyond its seeds"
     home, n = config["homes"][0], 20
     results = tmp_path / "results" / "cpu"
     for height in (0.45, 1.05):
@@ -254,7 +254,7 @@ def test_the_readings_contrasts_read_the_profiles_seeds_only(tmp_path):
     res = table1_contrast(tmp_path, "cpu")((1.05, "everywhere"), (0.45, "everywhere"))
     assert res["n_seeds"] == len(seeds) and res["n_shared"] == n
     assert res["difference"] == 0.0 and res["ci_low"] == res["ci_high"] == 0.0
-    # a profile with fewer seeds reads fewer of them (the smoke profile: seed 0)
+    # a preset with fewer seeds reads fewer of them (the smoke preset: seed 0)
     (tmp_path / "results" / "cpu").rename(tmp_path / "results" / "smoke")
     assert table1_contrast(tmp_path, "smoke")((1.05, "everywhere"), (0.45, "everywhere"))["n_seeds"] == 1
 
@@ -272,7 +272,7 @@ def test_regenerate_reproduces_the_stored_cpu_tables_and_figure_data(tmp_path, m
         group.parent.mkdir(parents=True)
         group.write_text(cell.read_text())
     monkeypatch.chdir(tmp_path)
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 0
     stored, again = REPO / "paper_figs" / "cpu", tmp_path / "paper_figs" / "cpu"
     names = ["table1.csv", "table1.md", "table2.md", "fig6.csv", "fig7.csv", "fig7_oracle.csv"]
     assert [n for n in names if not (stored / n).exists()] == []
@@ -292,7 +292,7 @@ def test_regenerate_writes_the_bytes_the_dag_stored(tmp_path, monkeypatch):
     copy_stored_cpu_results(results)
     shutil.rmtree(results / "pathlength")  # what regenerate writes must be written, not left from the copy
     monkeypatch.chdir(tmp_path)
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 0
     written = sorted(p for folder in (tmp_path / "paper_figs" / "cpu", results / "pathlength")
                      for p in folder.rglob("*") if p.is_file())
     assert len(written) >= 20 and any(p.suffix == ".pdf" for p in written)
@@ -313,7 +313,7 @@ def test_regenerate_leaves_the_file_times_of_unchanged_outputs(tmp_path, monkeyp
     for i, path in enumerate(outputs):  # distinct old times, so that a rewrite cannot pass for unchanged
         os.utime(path, ns=(1_000_000_000 * (1000 + i),) * 2)
     before = {p: p.stat().st_mtime_ns for p in outputs}
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 0
     assert [str(p) for p in outputs if p.stat().st_mtime_ns != before[p]] == []
 
 
@@ -323,12 +323,12 @@ def test_regenerate_twice_gives_byte_identical_files(tmp_path, monkeypatch):
     copy_stored_cpu_results(tmp_path / "results" / "cpu")
     monkeypatch.chdir(tmp_path)
     figs = tmp_path / "paper_figs" / "cpu"
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 0
     first = {p.name: p.read_bytes() for p in sorted(figs.iterdir())}
     assert {"fig6.pdf", "fig7.pdf", "fig6.png", "table1.tex"} <= set(first)
     for p in figs.iterdir():    # a stale file left in place must not pass for a rewritten one
         p.unlink()
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 0
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 0
     second = {p.name: p.read_bytes() for p in sorted(figs.iterdir())}
     assert sorted(second) == sorted(first)
     assert [name for name in first if first[name] != second[name]] == []
@@ -342,13 +342,13 @@ def test_regenerate_refuses_a_stored_csv_edited_after_its_provenance(tmp_path, m
     copy_stored_cpu_results(results)
     monkeypatch.chdir(tmp_path)
     write_provenance("cpu", results, results / "provenance.json")
-    assert main(["report", "verify", "--profile", "cpu"]) == 0
+    assert main(["report", "verify", "--preset", "cpu"]) == 0
     stored = sorted((results / "eval" / "head_on").rglob("h1.05.csv"))[0]
     text = stored.read_text()
     stored.write_text(text[: len(text) // 3])
     capsys.readouterr()
-    assert main(["report", "regenerate", "--profile", "cpu"]) == 2
+    assert main(["report", "regenerate", "--preset", "cpu"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"{stored.relative_to(tmp_path)} was truncated" in err
     assert not (tmp_path / "paper_figs").exists()          # refused before writing anything
-    assert main(["report", "verify", "--profile", "cpu"]) == 2
+    assert main(["report", "verify", "--preset", "cpu"]) == 2

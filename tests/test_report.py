@@ -729,9 +729,9 @@ def test_figure6_band_resamples_the_curve_episodes_when_every_seed_kept_them(tmp
 
 
 def test_gpu_projection_by_hand(tmp_path):
-    """The paper profile's `all` from a GPU check: trainings one at a time at the measured rate with
+    """The paper preset's `all` from a GPU check: trainings one at a time at the measured rate with
     their curve evaluations, plus the cpu run's other jobs of `all` over the machine's cores, the
-    full-body ones scaled by the paper profile's count of runs (3 motion generators x 3 seeds = 9)."""
+    full-body ones scaled by the paper preset's count of runs (3 motion generators x 3 seeds = 9)."""
     import json
 
     from egosearch.report.gpu import GPU_CHECK, block_gpu_projection, projection
@@ -760,7 +760,7 @@ def test_gpu_projection_by_hand(tmp_path):
     # a graphed training with its eager baseline on the same machine: the projection says which rate it used
     record["result"]["training"] = {**run, "overrides": {"cuda_graph": True}}
     (tmp_path / GPU_CHECK / "gpu_check.json").write_text(json.dumps(record))
-    assert "(0.0 h each; the update recorded as CUDA graphs, as the profile does)" in block_gpu_projection(
+    assert "(0.0 h each; the update recorded as CUDA graphs, as the preset does)" in block_gpu_projection(
         tmp_path, "cpu")
     from egosearch.report.gpu import _baseline_sentence
 
@@ -768,9 +768,9 @@ def test_gpu_projection_by_hand(tmp_path):
     assert _baseline_sentence(base, record["result"]["training"]) == (
         " The same training with the update launched eagerly (`cuda_graph: false`), run next for 60 s on the same "
         "machine (`baseline/`): 4.0 env steps/s while updating (median of 3 rows), so 2.5x.")
-    record["result"]["training"] = {**run, "cuda_graph": True}  # what a record says since the profile graphs
+    record["result"]["training"] = {**run, "cuda_graph": True}  # what a record says since the preset graphs
     (tmp_path / GPU_CHECK / "gpu_check.json").write_text(json.dumps(record))
-    assert "as the profile does" in block_gpu_projection(tmp_path, "cpu")
+    assert "as the preset does" in block_gpu_projection(tmp_path, "cpu")
     (tmp_path / GPU_CHECK / "gpu_check.json").unlink()
     assert projection(tmp_path) is None and "Not measured yet" in block_gpu_projection(tmp_path, "cpu")
 
@@ -780,10 +780,10 @@ def test_the_cuda_tests_of_a_later_tree_and_a_gpu_hosts_benchmark_are_read_from_
     benchmark records of machines with a GPU."""
     import json
 
-    from egosearch.report.gpu import CPU_PROFILE_GPU_CHECK, _cpu_profile_lines
+    from egosearch.report.gpu import CPU_PRESET_GPU_CHECK, _cpu_profile_lines
 
     assert _cpu_profile_lines(tmp_path) == []                       # nothing stored: nothing said
-    check = tmp_path / CPU_PROFILE_GPU_CHECK
+    check = tmp_path / CPU_PRESET_GPU_CHECK
     check.mkdir(parents=True)
     (check / "cuda_tests.log").write_text("......                [100%]\n6 passed, 1 deselected in 53.59s\n")
     (check / "cuda_report.json").write_text(json.dumps({"modular_cpu_profile": {"env_steps": 64, "updates": 49}}))

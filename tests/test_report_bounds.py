@@ -215,7 +215,7 @@ def test_the_provenance_log_line_is_the_same_whether_the_record_was_rewritten_or
 
     results, files = _stored_run(tmp_path)
     record = results / "provenance.json"
-    argv = ["report", "provenance", "--profile", "p", "--results", str(results), "--out", str(record)]
+    argv = ["report", "provenance", "--preset", "p", "--results", str(results), "--out", str(record)]
     files[0].write_text(files[0].read_text() + "0,0,100,1.0,1.0,0.0,0,0.0\n")
     capsys.readouterr()
     assert main(argv) == 0  # rewritten: a stored file changed

@@ -1,4 +1,4 @@
-"""The cpu profile's learner (SAC with a DrQ-v2-style update) and the lockstep-env replay."""
+"""The cpu preset's learner (SAC with a DrQ-v2-style update) and the lockstep-env replay."""
 
 from __future__ import annotations
 
@@ -237,8 +237,8 @@ def test_training_throughput_counts_env_steps_per_core_second():
 
 
 def test_training_throughput_leaves_the_imitation_phase_out():
-    """A profile that learns from the classical searcher first is timed in its RL phase alone (what the stored
-    rates count), with a token imitation phase whatever the profile's (its 1,500 demonstrations would take
+    """A preset that learns from the classical searcher first is timed in its RL phase alone (what the stored
+    rates count), with a token imitation phase whatever the preset's (its 1,500 demonstrations would take
     many minutes of a one-minute benchmark)."""
     from egosearch.rl.bench_learner import training_throughput
 

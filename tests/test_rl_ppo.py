@@ -171,8 +171,8 @@ def test_the_variant_is_valid_at_every_profile_and_ppo_at_the_cpu_profile():
     from egosearch.variants import check_learner_config, load_variant
 
     variant = load_variant("head_on_ppo")
-    for profile in ("smoke", "cpu", "paper"):
-        check_learner_config(variant, profile)
+    for preset in ("smoke", "cpu", "paper"):
+        check_learner_config(variant, preset)
     cfg = load_config("cpu", variant.config)
     assert (cfg.algorithm, cfg.n_step, cfg.init_steps, cfg.critic_privileged_state) == ("ppo", 1, 0, True)
     assert cfg.update_every // cfg.num_envs == 128

@@ -69,7 +69,7 @@ def filled_replay(episode_lengths: list[int], num_envs: int = 1, n_step: int = 3
 
 # ---- config -----------------------------------------------------------------------------------
 
-def test_config_fields_and_profiles():
+def test_config_fields_and_presets():
     assert load_config("cpu").algorithm == "sac_drq"  # the lead decides by measurement
     paper = load_config("paper")
     assert table2_rows(load_config("paper", {"algorithm": "sac_curl"})) == table2_rows(paper)
@@ -200,7 +200,7 @@ def test_burn_in_steps_get_no_gradient():
     assert any(p.grad is not None and p.grad.any() for p in agent.encoder.parameters())
     agent.encoder.zero_grad(set_to_none=True)
     agent.update(batch)
-    metrics = agent.update(batch)  # the actor's step is every 2nd update at the smoke profile
+    metrics = agent.update(batch)  # the actor's step is every 2nd update at the smoke preset
     assert all(np.isfinite(metrics[k]) for k in ("critic_loss", "actor_loss", "alpha", "entropy", "q_mean"))
 
 

@@ -145,7 +145,7 @@ def test_register_refuses_a_taken_name_and_a_format_loaded_differently(toy_learn
     assert actor_loader("no-such-actor-v1") is None
 
 
-# overrides that make the smoke profile valid for each built-in learner
+# overrides that make the smoke preset valid for each built-in learner
 @pytest.mark.parametrize("name", list(LEARNERS))
 def test_every_registered_learner_is_an_agent_and_writes_a_registered_actor_format(name):
     cfg = load_config("smoke", {"algorithm": name, "device": "cpu", **LEARNERS[name].smoke_overrides})

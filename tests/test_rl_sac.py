@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from egosearch.rl.common import METRIC_KEYS, AgentStateError, center_crop, crop_at, crop_gather, crop_loop
-from egosearch.rl.config import PROFILES, TABLE2_PAPER, LearnerConfig, load_config, table2_rows
+from egosearch.rl.config import PRESETS, TABLE2_PAPER, LearnerConfig, load_config, table2_rows
 from egosearch.rl.sac_curl import SacCurlAgent, conv_out_side, load_actor_net
 
 # A small but structurally complete config (100 -> 84 crops, K = 5, 4 conv layers).
@@ -277,18 +277,18 @@ def test_config_validation_errors_are_one_line_and_name_the_field(overrides, fie
     assert "\n" not in msg and field in msg
 
 
-def test_unknown_profile_or_field():
-    with pytest.raises(ValueError, match="unknown profile 'fast'; allowed: smoke, cpu, paper"):
+def test_unknown_preset_or_field():
+    with pytest.raises(ValueError, match="unknown preset 'fast'; allowed: smoke, cpu, paper"):
         load_config("fast", {})
     with pytest.raises(ValueError, match="unknown LearnerConfig field"):
         load_config("paper", {"learning_rate": 1e-3})
 
 
-def test_profiles_are_valid_and_paper_is_table2():
-    for name in PROFILES:
+def test_presets_are_valid_and_paper_is_table2():
+    for name in PRESETS:
         load_config(name, {})
     paper = load_config("paper", {})
-    # Table 2's values are the defaults; the profile adds how a GPU runs them (cuda_graph, housekeeping)
+    # Table 2's values are the defaults; the preset adds how a GPU runs them (cuda_graph, housekeeping)
     assert {f for f, v in paper.to_dict().items() if v != LearnerConfig().to_dict()[f]} == {"cuda_graph"}
 
 
@@ -319,9 +319,9 @@ def _walk(node):
             yield from _walk(value)
 
 
-def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
+def test_every_preset_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
     """One image size (egosearch.sim.body.IMAGE_SIZE): the env's frames, the sensor's default, and every
-    profile's image_size; a config that differs is refused in one line when it is loaded or trained."""
+    preset's image_size; a config that differs is refused in one line when it is loaded or trained."""
     from egosearch.rl.train import train
     from egosearch.sim.body import IMAGE_SIZE
     from egosearch.sim.env import SearchEnv
@@ -333,7 +333,7 @@ def test_every_profile_and_the_sensor_use_the_frames_the_env_renders(tmp_path):
     finally:
         env.close()
     assert (DEFAULT_WIDTH, DEFAULT_HEIGHT) == (IMAGE_SIZE, IMAGE_SIZE)
-    assert {load_config(name, {}).image_size for name in PROFILES} == {LearnerConfig().image_size} == {IMAGE_SIZE}
+    assert {load_config(name, {}).image_size for name in PRESETS} == {LearnerConfig().image_size} == {IMAGE_SIZE}
     with pytest.raises(ValueError, match=r"image_size=90 is out of range; allowed: 100 \(the env renders") as err:
         load_config("smoke", {"image_size": 90})
     assert "\n" not in str(err.value)
@@ -398,21 +398,21 @@ def test_bench_timer_runs():
 
     r = time_updates("smoke", threads=1, warmup=1, updates=2)
     assert 0 < r["best_s"] <= r["median_s"] < 10
-    # the cpu profile's learner has a privileged critic: its update needs the replay's states
+    # the cpu preset's learner has a privileged critic: its update needs the replay's states
     r = time_updates("cpu", threads=1, warmup=1, updates=2)
     assert 0 < r["best_s"] <= r["median_s"] < 10
 
 
-def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_graphs(monkeypatch):
+def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_preset_graphs(monkeypatch):
     """The eager Table 2 rows are the baseline the graphed row is read against: they must turn the
-    paper profile's cuda_graph off themselves, or on a GPU both sides would be graphed."""
+    paper preset's cuda_graph off themselves, or on a GPU both sides would be graphed."""
     import egosearch.rl.bench_learner as bench
 
     asked = []
 
-    def fake_time_updates(profile="paper", overrides=None, agent_options=None, threads=None, warmup=3, updates=10,
+    def fake_time_updates(preset="paper", overrides=None, agent_options=None, threads=None, warmup=3, updates=10,
                           **_):
-        asked.append((profile, dict(overrides or {}), (agent_options or {}).get("impl", "fast")))
+        asked.append((preset, dict(overrides or {}), (agent_options or {}).get("impl", "fast")))
         return {"median_s": 0.1, "best_s": 0.1}
 
     monkeypatch.setattr(bench, "time_updates", fake_time_updates)
@@ -420,12 +420,12 @@ def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_profile_g
     monkeypatch.setattr(bench, "_avx2_limited_cpu_profile", lambda quick, run: {"updates_per_s_cpu_profile": 3.0})
     result = bench.bench_learner(quick=True, cpu_profile_run=False)
     assert result["updates_per_s_cpu_profile_avx2"] == 3.0
-    fast_table2 = [o for profile, o, impl in asked if profile == "paper" and impl == "fast"]
+    fast_table2 = [o for preset, o, impl in asked if preset == "paper" and impl == "fast"]
     assert len(fast_table2) == 3 and all(o.get("cuda_graph") is False for o in fast_table2)
     assert "updates_per_s_table2" in result
 
 
-def test_cuda_graph_is_on_in_the_paper_profile_alone_and_ignored_on_the_cpu():
+def test_cuda_graph_is_on_in_the_paper_preset_alone_and_ignored_on_the_cpu():
     assert load_config("paper", {}).cuda_graph and not load_config("cpu", {}).cuda_graph
     assert not load_config("smoke", {}).cuda_graph
     load_config("paper", {"algorithm": "sac_drq", "compile": True})  # the learners it does not apply to ignore it

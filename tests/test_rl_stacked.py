@@ -60,7 +60,7 @@ def batch(seed: int, side: int, b: int = 16, drq: bool = False) -> dict[str, tor
            "next_mask": torch.randn(b, 30, generator=g), "next_proprio": torch.randn(b, 4, generator=g),
            "action": torch.rand(b, 5, generator=g) * 2 - 1, "reward": torch.randn(b, 1, generator=g),
            "not_done": (torch.rand(b, 1, generator=g) > 0.2).float()}
-    if drq:  # the cpu profile's batches: n-step discounts, the privileged state, half from demonstrations
+    if drq:  # the cpu preset's batches: n-step discounts, the privileged state, half from demonstrations
         out.update(discount=torch.full((b, 1), 0.99 ** 3), state=torch.randn(b, STATE_DIM, generator=g),
                    next_state=torch.randn(b, STATE_DIM, generator=g),
                    demo=torch.cat([torch.zeros(b // 2, 1), torch.ones(b - b // 2, 1)]))
@@ -264,7 +264,7 @@ def test_stacked_seeds_refuse_every_field_their_update_does_not_implement(algori
     kind = STACKED[learner(algorithm).agent_factory()]
     names = {f.name for f in update_fields(cfg)}
     assert kind.implemented <= names, sorted(kind.implemented - names)
-    check_stackable(cfg)  # the profile itself stacks
+    check_stackable(cfg)  # the preset itself stacks
     for f in update_fields(cfg):
         if f.name in kind.implemented:
             continue

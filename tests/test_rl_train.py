@@ -244,7 +244,7 @@ def test_bad_actor_file_is_a_clear_error(tmp_path):
 LEARNERS = {
     # ~25 s on one core: 500 updates of the smoke-sized learner (100 -> 84 crops, K = 5, CURL)
     "sac_curl": {"total_env_steps": 700},
-    # the cpu profile's learner at smoke sizes: 4 lockstep envs, 3-step returns, 500 updates of 64
+    # the cpu preset's learner at smoke sizes: 4 lockstep envs, 3-step returns, 500 updates of 64
     "sac_drq": {"algorithm": "sac_drq", "obs_downsample": 2, "encoder_num_layers": 2, "encoder_stride2_layers": 2,
                 "aug_pad": 2, "num_envs": 4, "n_step": 3, "batch_size": 64, "update_every": 2,
                 "actor_update_freq": 1, "critic_target_update_freq": 1, "total_env_steps": 1200},

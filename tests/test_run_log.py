@@ -25,8 +25,8 @@ def test_a_log_gives_each_jobs_start_and_end_and_the_runs_elapsed_time(tmp_path)
     text = "\n".join(
         ["  Command: snakemake --cores 2 all", "Provided cores: 2", "Execute 2 jobs..."]
         + _start("Fri Nov 27 07:58:54 2026", "evaluate", 42,
-                 "profile=p, variant=v, seed=0, layout=kitchen_living, placement=everywhere, height=1.05", bench)
-        + _start("Fri Nov 27 07:58:54 2026", "table2", 7, "profile=p")
+                 "preset=p, variant=v, seed=0, layout=kitchen_living, placement=everywhere, height=1.05", bench)
+        + _start("Fri Nov 27 07:58:54 2026", "table2", 7, "preset=p")
         + _finish("Fri Nov 27 07:58:58 2026", "table2", 7)
         + _start("Fri Nov 27 07:58:59 2026", "provenance", 3, "")
         + _finish("Fri Nov 27 07:59:48 2026", "evaluate", 42)
@@ -48,13 +48,13 @@ def test_the_check_sets_a_run_beside_the_simulation_of_its_own_jobs(tmp_path, mo
     jobs ran 2 min each; its own times simulated give that back, and their sum / 2 is the old lower bound."""
     from egosearch.workflow.dag import dag_jobs
 
-    jobs = [j for j in dag_jobs("table1", 2, {"profile": "smoke"}) if j.record_rule == "bound"][:3]
+    jobs = [j for j in dag_jobs("table1", 2, {"preset": "smoke"}) if j.record_rule == "bound"][:3]
     assert len(jobs) == 3  # each reads a scenarios job's output, which the run did not make: left out
     lines = ["Provided cores: 2"]
     ends = ("08:01:00", "08:02:00", "08:03:00")
     starts = ("08:00:00", "08:00:00", "08:01:00")
     for n, (job, start) in enumerate(zip(jobs, starts)):
-        wildcards = ", ".join(f"{k}={v}" for k, v in {"profile": "smoke", **job.wildcards}.items())
+        wildcards = ", ".join(f"{k}={v}" for k, v in {"preset": "smoke", **job.wildcards}.items())
         lines += _start(f"Fri Nov 27 {start} 2026", "bound", n, wildcards,
                         f"results/smoke/benchmarks/{job.record_rule}/{job.job}.tsv")
     for n, end in sorted(enumerate(ends), key=lambda x: x[1]):
@@ -68,8 +68,8 @@ def test_the_check_sets_a_run_beside_the_simulation_of_its_own_jobs(tmp_path, mo
                         lambda target, cores, config: asked.append(config) or [])
     assert main(["estimate", "check", "--log", str(tmp_path / "run.log"), "--record", str(tmp_path / "record.json"),
                  "--target", "all", "--out", str(out)]) == 2
-    assert "none of the 3 jobs it ran is in the DAG of `all` at the smoke profile" in capsys.readouterr().err
-    assert asked == [{"profile": "smoke"}]                      # the run's own profile, read off its jobs
+    assert "none of the 3 jobs it ran is in the DAG of `all` at the smoke preset" in capsys.readouterr().err
+    assert asked == [{"preset": "smoke"}]                      # the run's own preset, read off its jobs
     monkeypatch.setattr("egosearch.cost.schedule_check.dag_jobs", lambda target, cores, config: jobs)
     assert main(["estimate", "check", "--log", str(tmp_path / "run.log"), "--record", str(tmp_path / "record.json"),
                  "--target", "table1", "--out", str(out)]) == 0

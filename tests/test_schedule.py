@@ -1,5 +1,5 @@
 """The simulated schedule of `snakemake --cores N`: hand-worked cases, the durations a provenance
-record gives, the scaling of trainings to another machine, and the real DAG at the smoke profile."""
+record gives, the scaling of trainings to another machine, and the real DAG at the smoke preset."""
 
 import pytest
 
@@ -244,7 +244,7 @@ def test_machine_key_names_what_was_not_recorded():
 def test_the_smoke_dag_trains_before_it_evaluates():
     from egosearch.workflow.dag import dag_jobs
 
-    jobs = dag_jobs("all", cores=2, config={"profile": "smoke"})
+    jobs = dag_jobs("all", cores=2, config={"preset": "smoke"})
     by_id = {j.id: j for j in jobs}
     trains = [j for j in jobs if j.rule == "train"]
     assert trains and all(j.record_rule == "train" for j in trains)

@@ -343,16 +343,16 @@ def test_stored_evaluation_successes_respect_the_current_ell():
     checked = 0
     violations = set()
     for path in sorted(ROOT.glob("results/*/eval/*/seed*/*/*/h*.csv")):
-        profile, layout, placement, height = path.parts[-7], path.parts[-3], path.parts[-2], path.name
+        preset, layout, placement, height = path.parts[-7], path.parts[-3], path.parts[-2], path.name
         ells = {sc.scenario_id: sc.shortest_path
-                for sc in read_scenarios(ROOT / "results" / profile / "scenarios" / layout / placement / height)}
+                for sc in read_scenarios(ROOT / "results" / preset / "scenarios" / layout / placement / height)}
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
                 if int(row["success"]):
                     checked += 1
                     ell, p = ells[int(row["scenario_id"])], float(row["path_length"])
                     if not lower_bound_holds(ell, p):
-                        violations.add((f"{profile}/scenarios/{layout}/{placement}/{height}", int(row["scenario_id"])))
+                        violations.add((f"{preset}/scenarios/{layout}/{placement}/{height}", int(row["scenario_id"])))
     assert not violations - set(KNOWN_ELL_VIOLATIONS), sorted(violations - set(KNOWN_ELL_VIOLATIONS))
     stored = {k for k in KNOWN_ELL_VIOLATIONS if (ROOT / "results" / k[0]).exists()}
     assert stored <= violations, f"mended (remove from KNOWN_ELL_VIOLATIONS): {sorted(stored - violations)}"

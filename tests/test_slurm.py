@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parent.parent
-SMOKE = ["--config", "profile=smoke"]
+SMOKE = ["--config", "preset=smoke"]
 CELL = "kitchen_living/everywhere/h1.65"
 SCENARIOS = f"results/smoke/scenarios/{CELL}.csv"
 BOUNDS = {bound: f"results/smoke/eval/{bound}/seed0/{CELL}.csv" for bound in ("random", "oracle")}

@@ -40,7 +40,7 @@ def test_the_stacked_training_is_measured_last_into_the_same_record(tmp_path):
     assert events == ["run 1", "start", "probe", "run 2", "stop", "stacked"]  # after the MPS daemon stopped
     stacked = runner.batches[-1][0]
     argv = " ".join(stacked.argv)
-    assert "train --variant head_on --profile paper --stack-seeds 0,1,2 --threads 8" in argv
+    assert "train --variant head_on --preset paper --stack-seeds 0,1,2 --threads 8" in argv
     assert "--max-wall-s 30" in argv and "--seed " not in argv
     assert stacked.out_dir == str(tmp_path / "runs" / "stacked" / "seed{seed}")
     assert r["stacked"]["per_seed_env_steps_per_s"] == [60.0, 65.0, 70.0]
@@ -66,12 +66,12 @@ def test_the_commands_refuse_in_one_line(tmp_path, capsys):
          "egosearch bench: error: --stacked=1"),
         (["bench", "learner", "--stacked", "2", *out],
          "egosearch bench: error: --stacked is read by `bench gpu` only, not by `bench learner`"),
-        (["train", "--variant", "head_on", "--profile", "smoke", "--stack-seeds", "0,1", "--out-dir",
+        (["train", "--variant", "head_on", "--preset", "smoke", "--stack-seeds", "0,1", "--out-dir",
           str(tmp_path / "t")], "error: --out-dir=" + repr(str(tmp_path / "t"))
          + ": with --stack-seeds it must hold {seed} (one folder per seed)"),
-        (["train", "--variant", "head_on", "--profile", "smoke", "--stack-seeds", "0,0", "--out-dir",
+        (["train", "--variant", "head_on", "--preset", "smoke", "--stack-seeds", "0,0", "--out-dir",
           str(tmp_path / "t{seed}")], "egosearch train: error: --stack-seeds='0,0': one or more seeds, none repeated"),
-        (["train", "--variant", "head_on", "--profile", "smoke", "--stack-seeds", "0,x", "--out-dir",
+        (["train", "--variant", "head_on", "--preset", "smoke", "--stack-seeds", "0,x", "--out-dir",
           str(tmp_path / "t{seed}")], "egosearch train: error: --stack-seeds='0,x': comma-separated seeds"),
     ]
     if not torch.cuda.is_available():

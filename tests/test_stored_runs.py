@@ -1,5 +1,5 @@
-"""Every stored training resolves to the config it ran with: its variant file, on the profile as it is
-today, gives the same learner config and env id as the run's ``done.json``. A profile that moves must pin
+"""Every stored training resolves to the config it ran with: its variant file, on the preset as it is
+today, gives the same learner config and env id as the run's ``done.json``. A preset that moves must pin
 the moved fields in the variant files of the runs stored before it, or this fails (and the DAG would
 refuse to resume, or silently compare a run against a config it never had)."""
 
@@ -29,7 +29,7 @@ def test_stored_training_resolves_to_its_config(done):
     check_same_run("stored run", done, saved, saved["variant"], resolved.env_id, resolved.train_env, resolved.config)
 
 
-def test_a_moved_profile_field_is_caught(tmp_path):
+def test_a_moved_preset_field_is_caught(tmp_path):
     done = next(p for p in STORED if p.parent.parent.name == "head_on_imitation_finetune")
     saved = json.loads(done.read_text())
     resolved = resolve_variant("head_on_imitation_finetune", "cpu", {"seed": saved["config"]["seed"],

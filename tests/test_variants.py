@@ -13,21 +13,21 @@ def test_every_ablation_file_loads_and_its_config_validates(name):
 
     variant = load_variant(name)
     assert variant.name == name
-    for profile in ("smoke", "cpu", "paper"):  # `egosearch variant check` checks all three
-        load_config(profile, variant.config)
+    for preset in ("smoke", "cpu", "paper"):  # `egosearch variant check` checks all three
+        load_config(preset, variant.config)
 
 
 @pytest.mark.parametrize("name", variant_names())
 def test_a_pin_holds_a_value_the_cpu_profile_no_longer_has(name):
-    """``# pinned`` marks a config line kept for the variant's stored runs after the cpu profile moved; a pin
-    on the profile's own value changes nothing, and a file of such pins no longer says what it changes."""
+    """``# pinned`` marks a config line kept for the variant's stored runs after the cpu preset moved; a pin
+    on the preset's own value changes nothing, and a file of such pins no longer says what it changes."""
     from egosearch.rl.config import load_config
 
     cpu = load_config("cpu", {})
     config = load_variant(name).config
     pinned = re.findall(r"^  (\w+):[^#\n]*#\s*pinned", (ABLATIONS_DIR / f"{name}.yaml").read_text(), re.MULTILINE)
     assert all(key in config for key in pinned), pinned
-    assert not [key for key in pinned if getattr(cpu, key) == config[key]], "the cpu profile's own value again"
+    assert not [key for key in pinned if getattr(cpu, key) == config[key]], "the cpu preset's own value again"
 
 
 def test_bad_variant_files(tmp_path):
@@ -51,16 +51,16 @@ REPO = __import__("pathlib").Path(__file__).resolve().parent.parent
 
 @pytest.mark.parametrize("run", sorted(str(p.parent.relative_to(REPO)) for p in
                                        (REPO / "results").glob("*/train/*/seed*/config.json")))
-def test_a_stored_training_is_what_its_variant_file_says_at_its_profile(run):
-    """So a profile that changes pins the old values in the files of the runs stored before it (as
+def test_a_stored_training_is_what_its_variant_file_says_at_its_preset(run):
+    """So a preset that changes pins the old values in the files of the runs stored before it (as
     head_on_25px does): otherwise `compare` would read a stored run as the variant's, trained otherwise."""
     import json
 
     from egosearch.rl.config import field_defaults, load_config
 
-    _, profile, _, name, _ = run.split("/")
+    _, preset, _, name, _ = run.split("/")
     stored = json.loads((REPO / run / "config.json").read_text())
-    want = load_config(profile, load_variant(name).config).to_dict()
+    want = load_config(preset, load_variant(name).config).to_dict()
     got = field_defaults() | stored["config"]
     # runs from before target_memory was a learner field name the memory in their env id
     got["target_memory"] = got["target_memory"] or any(m in stored["env_id"] for m in ("Memory", "Map"))

@@ -12,7 +12,7 @@ import yaml
 
 REPO = Path(__file__).resolve().parent.parent
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
-PROFILE_CORES = yaml.safe_load((REPO / "profiles/default/config.yaml").read_text())["jobs"]
+PRESET_CORES = yaml.safe_load((REPO / "profiles/default/config.yaml").read_text())["jobs"]
 """The cores a run on this machine that names none runs on (the workflow profile's jobs, which Snakemake reads
 as cores there), dry runs' cost lines included."""
 
@@ -37,7 +37,7 @@ def checkout(tmp_path):
 
 
 def test_dry_run_of_all_lists_every_stage():
-    out = run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"])
+    out = run(["-n", "all", "--quiet", "rules", "--config", "preset=smoke"])
     assert out.returncode == 0, out.stderr
     for rule in ("scenarios", "train", "evaluate", "fullbody", "fullbody_oracle", "table1", "table2", "fig6", "fig7",
                  "fig7_oracle", "pathlength", "provenance"):
@@ -57,19 +57,19 @@ def test_snakemake_all_as_the_user_types_it():
 
 def test_a_run_as_the_user_types_it_runs_on_this_machine(checkout):
     """`snakemake table2` with no --cores runs (it used to stop: "cores have to be specified for local
-    execution"), on the profile's 2 cores; --jobs is still read as the cores on one machine."""
-    out = run(["table2", "--config", "profile=smoke"], cwd=checkout)
+    execution"), on the preset's 2 cores; --jobs is still read as the cores on one machine."""
+    out = run(["table2", "--config", "preset=smoke"], cwd=checkout)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
-    assert f"Provided cores: {PROFILE_CORES}" in out.stdout + out.stderr
+    assert f"Provided cores: {PRESET_CORES}" in out.stdout + out.stderr
     assert (checkout / "paper_figs/smoke/table2.md").is_file()
     planned = run(["-n", "screen", "-j", "6", "--config", "variant=head_off"])
     assert planned.returncode == 0 and "on 6 core(s)" in planned.stderr, planned.stderr[-3000:]
 
 
 def test_a_cluster_executors_dry_run_names_no_cores_of_this_machine():
-    """The profile's jobs are cores on this machine only: under a cluster executor they are the jobs it
+    """The preset's jobs are cores on this machine only: under a cluster executor they are the jobs it
     submits at once, and the cost line says it has no cores here to lay the jobs out on."""
-    assert PROFILE_CORES == 2
+    assert PRESET_CORES == 2
     out = run(["-n", "screen", "--config", "variant=head_off", "--executor", "cluster-generic",
                "--cluster-generic-submit-cmd", "true", "--jobs", "50"])
     assert out.returncode == 0, out.stderr[-3000:]
@@ -79,28 +79,28 @@ def test_a_cluster_executors_dry_run_names_no_cores_of_this_machine():
 
 
 def test_dry_run_of_generalise_reads_four_groups_of_homes():
-    out = run(["-n", "generalise", "--config", "profile=smoke"])
+    out = run(["-n", "generalise", "--config", "preset=smoke"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
     for group in ("generated_heldout", "generated_train", "kitchen_living", "bedroom_bath"):
         assert f"eval/head_on_generated_homes/seed0/{group}/everywhere/h1.05.csv" in text, group
     assert "group_scenarios" in text and "home900000:900020" not in text  # the homes go to the command
-    assert "generalise" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout
+    assert "generalise" not in run(["-n", "all", "--quiet", "rules", "--config", "preset=smoke"]).stdout
 
 
-def test_the_budget_study_reads_its_settings_against_the_profiles_reference():
-    # Every setting with its seed 0, the profile's own (the reference variant) with all its seeds;
+def test_the_budget_study_reads_its_settings_against_the_presets_reference():
+    # Every setting with its seed 0, the preset's own (the reference variant) with all its seeds;
     # the settings trained in kitchen_living alone are one-seed points like the rest.
     out = run(["-n", "-p", "-R", "budget", "budget"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
-    # the cpu profile's study walks its from-scratch learner's settings (config budget: reference)
+    # the cpu preset's study walks its from-scratch learner's settings (config budget: reference)
     assert "--chosen head_on_from_scratch " in text
     for seed in (0, 1, 2):
         assert f"--run head_on_from_scratch=results/cpu/train/head_on_from_scratch/seed{seed}/curve.csv" in text
     assert "--run head_on_kitchen_living=results/cpu/train/head_on_kitchen_living/seed0/curve.csv" in text
     assert "head_on_kitchen_living/seed1/" not in text
-    smoke = run(["-n", "-p", "budget", "--config", "profile=smoke"])
+    smoke = run(["-n", "-p", "budget", "--config", "preset=smoke"])
     assert smoke.returncode == 0, smoke.stderr
     assert "--chosen head_on " in smoke.stdout + smoke.stderr
 
@@ -111,7 +111,7 @@ def test_a_smoke_screens_cost_line_is_minutes_at_the_capped_steps():
     from egosearch.variants import resolve_variant
 
     steps = resolve_variant("head_on_25px", "smoke").config.total_env_steps
-    out = run(["-n", "screen", "--config", "variant=head_on_25px", "profile=smoke", "screen_seeds=1"])
+    out = run(["-n", "screen", "--config", "variant=head_on_25px", "preset=smoke", "screen_seeds=1"])
     assert out.returncode == 0, out.stderr
     line = next(x for x in out.stderr.splitlines() if x.startswith("screen of head_on_25px against head_on: "))
     assert f"3 training(s) (2 of them head_on's, the reference's) of {steps} env steps, about " in line, line
@@ -120,7 +120,7 @@ def test_a_smoke_screens_cost_line_is_minutes_at_the_capped_steps():
 
 
 def test_dry_run_of_behaviour_traces_every_pair_outside_all():
-    out = run(["-n", "-p", "behaviour", "searches", "--config", "profile=smoke"])
+    out = run(["-n", "-p", "behaviour", "searches", "--config", "preset=smoke"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
     for variant in ("head_on", "head_off", "frontier", "frontier_head_off"):
@@ -134,7 +134,7 @@ def test_dry_run_of_behaviour_traces_every_pair_outside_all():
     assert "--pairs head_on:head_off frontier:frontier_head_off --out-prefix paper_figs/smoke/behaviour" in text
     assert "searches/frontier_" not in text
     assert "searches/gaze_kitchen_living_everywhere_h1.65.png" in text
-    assert "trace" not in run(["-n", "all", "--quiet", "rules", "--config", "profile=smoke"]).stdout.split()
+    assert "trace" not in run(["-n", "all", "--quiet", "rules", "--config", "preset=smoke"]).stdout.split()
 
 
 def test_lint_is_clean():
@@ -144,7 +144,7 @@ def test_lint_is_clean():
 
 
 @pytest.mark.parametrize("override, key", [
-    ("profile=fast", "profile"),
+    ("preset=fast", "preset"),
     ("heights=[7.0]", "heights"),
     ("placements=[under_the_sofa]", "placements"),
 ])
@@ -165,7 +165,7 @@ def test_smoke_table1_end_to_end(checkout):
     # the reference's success by path length reads the same evaluations: one more job. The timeout
     # only stops a hang: the run is 75 one-process jobs, and it took over 15 minutes beside three
     # training jobs.
-    out = run(["table1", "paper_figs/smoke/pathlength_head_on.md", "--config", "profile=smoke"],
+    out = run(["table1", "paper_figs/smoke/pathlength_head_on.md", "--config", "preset=smoke"],
               cwd=checkout, timeout=2400)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     by_length = pd.read_csv(checkout / "results/smoke/pathlength/head_on.csv")
@@ -198,7 +198,7 @@ def test_smoke_table1_end_to_end(checkout):
 
 
 def test_smoke_fig7_with_the_oracle_planner_end_to_end(checkout):
-    out = run(["--cores", "2", "fig7_oracle", "--config", "profile=smoke"], cwd=checkout, timeout=900)
+    out = run(["--cores", "2", "fig7_oracle", "--config", "preset=smoke"], cwd=checkout, timeout=900)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     assert not (checkout / "results/smoke/train").exists()   # the oracle planner needs no training
     fig = pd.read_csv(checkout / "paper_figs/smoke/fig7_oracle.csv")
@@ -214,17 +214,17 @@ def test_smoke_fig7_with_the_oracle_planner_end_to_end(checkout):
 def test_cluster_generic_executor_runs_the_same_dag(checkout):
     submit = checkout / "tests/data/local_submit.sh"
     out = run(["--executor", "cluster-generic", "--cluster-generic-submit-cmd", f"bash {submit}", "--jobs", "2",
-               "--latency-wait", "30", "table2", "table2_paper", "--config", "profile=smoke"], cwd=checkout)
+               "--latency-wait", "30", "table2", "table2_paper", "--config", "preset=smoke"], cwd=checkout)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
     table = (checkout / "paper_figs/table2.md").read_text()
     assert "| Batch-size | 32 |" in table and "| Replay buffer | 100000 |" in table
     assert "0.75M" in table
 
 
-def test_config_file_is_valid_yaml_with_all_profiles():
+def test_config_file_is_valid_yaml_with_all_presets():
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    assert set(config["profiles"]) == {"smoke", "cpu", "paper"}
-    assert config["profile"] == "cpu"
+    assert set(config["presets"]) == {"smoke", "cpu", "paper"}
+    assert config["preset"] == "cpu"
 
 
 def test_a_report_with_stored_outputs_and_missing_inputs_is_named():
@@ -264,17 +264,17 @@ def test_a_stored_comparison_gives_no_missing_input_line():
 
 def test_a_screen_trains_screen_seeds_against_the_references_spread_seeds():
     """`snakemake screen --config variant=NAME`: the lever screen as one command, on screen_seeds seeds from
-    screen_seed, read against every spread seed of the reference (the smoke profile's: 0 and 1)."""
-    out = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seed=1", "screen_seeds=2"])
+    screen_seed, read against every spread seed of the reference (the smoke preset's: 0 and 1)."""
+    out = run(["-n", "screen", "--config", "preset=smoke", "variant=head_off", "screen_seed=1", "screen_seeds=2"])
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
     assert "results/smoke/compare/screen_head_off_seeds1-2_vs_head_on.csv" in text
     assert "results/smoke/compare/screen_head_off_seeds1-2_vs_head_on_aggregate.csv" in text
     assert "eval/head_off/seed1/" in text and "eval/head_off/seed2/" in text and "eval/head_off/seed0/" not in text
     assert "eval/head_on/seed0/" in text and "eval/head_on/seed1/" in text and "eval/head_on/seed2/" not in text
-    one = run(["-n", "screen", "--config", "profile=smoke", "variant=head_off", "screen_seeds=1"])
+    one = run(["-n", "screen", "--config", "preset=smoke", "variant=head_off", "screen_seeds=1"])
     assert "results/smoke/compare/screen_head_off_seed0_vs_head_on.csv" in one.stdout + one.stderr
-    missing = run(["-n", "screen", "--config", "profile=smoke"])
+    missing = run(["-n", "screen", "--config", "preset=smoke"])
     assert missing.returncode != 0 and "screen needs a variant" in missing.stdout + missing.stderr
 
 
@@ -301,9 +301,9 @@ def cost_line(text: str, opening: str) -> tuple[str, dict[str, int]]:
 def test_the_cost_line_counts_every_job_of_the_plan():
     """Issue 57: the line a dry run prints above its plan counts the plan's jobs as Snakemake's own job stats
     count them, the reference's trainings and evaluations included (a comparison against a reference whose
-    seeds are not all stored trains them too), and a screen's; once, on the profile's cores."""
+    seeds are not all stored trains them too), and a screen's; once, on the preset's cores."""
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    seeds = config["profiles"]["cpu"]["seeds"]
+    seeds = config["presets"]["cpu"]["seeds"]
     candidates = [v for v in ("head_on_ppo", "head_on_recurrent", "head_on_geodesic")
                   if not all((REPO / f"results/cpu/train/{v}/seed{s}/done.json").exists() for s in seeds)]
     reference = candidates[0]
@@ -315,7 +315,7 @@ def test_the_cost_line_counts_every_job_of_the_plan():
     assert counted == job_stats(text) and counted["train"] == missing >= 1, line
     assert f"{missing} training(s) ({missing} of them {reference}'s, the reference's)" in line
     assert f"{counted['evaluate']} evaluations ({counted['evaluate']} of them {reference}'s)" in line
-    assert line.endswith(f" on {PROFILE_CORES} core(s)") and out.stderr.splitlines().count(line) == 1
+    assert line.endswith(f" on {PRESET_CORES} core(s)") and out.stderr.splitlines().count(line) == 1
 
     out = run(["-n", "screen", "--config", "variant=head_off"])
     assert out.returncode == 0, out.stderr[-3000:]
@@ -329,9 +329,9 @@ def test_the_cost_line_counts_every_job_of_the_plan():
 
 def test_a_dry_run_without_a_stored_run_says_why_there_is_no_estimate(checkout):
     for target, what in (("screen", "the screen's cost"), ("all", "the run's time")):
-        out = run(["-n", target, "--config", "profile=smoke", "variant=head_off"], cwd=checkout)
+        out = run(["-n", target, "--config", "preset=smoke", "variant=head_off"], cwd=checkout)
         assert out.returncode == 0, out.stderr
-        assert (f"(no estimate of {what}: the smoke profile has no stored run whose job times an estimate scales "
+        assert (f"(no estimate of {what}: the smoke preset has no stored run whose job times an estimate scales "
                 "(results/smoke/provenance.json is not there); a smoke run is plumbing only, minutes long)"
                 in out.stderr.splitlines()), out.stderr
         assert "Errno" not in out.stderr
@@ -339,46 +339,46 @@ def test_a_dry_run_without_a_stored_run_says_why_there_is_no_estimate(checkout):
 
 def test_the_cpu_profile_reads_the_claims_on_its_from_scratch_pair_too():
     """Its pair is a modular searcher: the claims are read both ways (the pair that learned every body step is
-    stored); the other profiles read the top level's pairs."""
+    stored); the other presets read the top level's pairs."""
     from egosearch.report.workflow_jobs import claims_pairs
 
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    assert claims_pairs({**config, "profile": "cpu"}) == [
+    assert claims_pairs({**config, "preset": "cpu"}) == [
         ["head_on", "head_off"], ["head_on_from_scratch", "head_off_from_scratch"],
         ["head_on_modular", "head_off_modular"], ["frontier", "frontier_head_off"]]
-    assert claims_pairs({**config, "profile": "smoke"}) == config["claims_pairs"] == [
+    assert claims_pairs({**config, "preset": "smoke"}) == config["claims_pairs"] == [
         ["head_on", "head_off"], ["frontier", "frontier_head_off"]]
 
 
-def recorded_job(rule: str, profile: str, **wildcards) -> dict:
+def recorded_job(rule: str, preset: str, **wildcards) -> dict:
     """The provenance row of one job of ``rule``, keyed as the record keys it (egosearch.report.provenance):
-    the rule's ``benchmark:`` path, as its .smk file writes it, under results/<profile>/benchmarks/, split
+    the rule's ``benchmark:`` path, as its .smk file writes it, under results/<preset>/benchmarks/, split
     into its first folder (the recorded rule) and the rest (the job)."""
     text = "\n".join(path.read_text() for path in sorted((REPO / "egosearch/workflow/rules").glob("*.smk")))
     [body] = re.findall(rf"^rule {rule}:\n(.*?)(?=^\S|\Z)", text, re.MULTILINE | re.DOTALL)
     [benchmark] = re.findall(r'benchmark:\s*\n\s*"([^"]+)\.tsv"', body)
-    key = benchmark.format(profile=profile, **wildcards).removeprefix(f"results/{profile}/benchmarks/")
+    key = benchmark.format(preset=preset, **wildcards).removeprefix(f"results/{preset}/benchmarks/")
     first, rest = key.split("/", 1)
     return {"rule": first, "job": rest, "wall_s": 1.0}
 
 
-def test_a_policys_job_is_of_all_only_for_a_variant_of_all_at_one_of_the_profiles_seeds():
+def test_a_policys_job_is_of_all_only_for_a_variant_of_all_at_one_of_the_presets_seeds():
     """The study a recorded job is counted in (README's provenance, docs/gpu.md): the starts' evaluations of
     `all`'s pair (what learning adds) are of `all`, a lever's start is not; the reference's spread seeds
-    (`snakemake seed_spread`, beyond the profile's seeds) are outside `all` whichever rule ran them."""
-    from egosearch.report.workflow_jobs import job_study, profile_seeds, variants_of_all
+    (`snakemake seed_spread`, beyond the preset's seeds) are outside `all` whichever rule ran them."""
+    from egosearch.report.workflow_jobs import job_study, preset_seeds, variants_of_all
 
     config = yaml.safe_load((REPO / "egosearch/workflow/config.yaml").read_text())
-    assert profile_seeds(config, "cpu") == [0, 1, 2] and profile_seeds(config, "smoke") == [0]
-    assert profile_seeds({**config, "profile": "smoke"}) == [0]
+    assert preset_seeds(config, "cpu") == [0, 1, 2] and preset_seeds(config, "smoke") == [0]
+    assert preset_seeds({**config, "preset": "smoke"}) == [0]
     lever = "head_on_tuned_teacher_geodesic_contact"
     assert (REPO / "ablations" / f"{lever}.yaml").is_file() and lever not in variants_of_all(config)
     assert {"head_on", "head_off"} <= set(variants_of_all(config))
     cell = {"layout": "kitchen_living", "placement": "everywhere", "height": "1.05"}
 
-    def study(rule, variant, seed, profile="cpu"):
-        job = recorded_job(rule, profile, variant=variant, seed=seed, **cell)
-        return job_study(job, config, profile)
+    def study(rule, variant, seed, preset="cpu"):
+        job = recorded_job(rule, preset, variant=variant, seed=seed, **cell)
+        return job_study(job, config, preset)
 
     start = recorded_job("evaluate_start", "cpu", variant="head_on", seed=0, **cell)
     assert start == {"rule": "eval_start", "job": "head_on/seed0/kitchen_living/everywhere/h1.05", "wall_s": 1.0}
@@ -391,21 +391,21 @@ def test_a_policys_job_is_of_all_only_for_a_variant_of_all_at_one_of_the_profile
         assert study(rule, "head_on", 3) == "other" and study(rule, "head_on", 4) == "other"
         assert study(rule, lever, 0) == "other"
         assert study(rule, "head_on_generated_homes", 0) == "generalise"
-        # the smoke profile's `all` trains seed 0 alone
+        # the smoke preset's `all` trains seed 0 alone
         assert study(rule, "head_on", 0, "smoke") == "all" and study(rule, "head_on", 1, "smoke") == "other"
-    # the profile is the job's, not the config's: a cpu record read with a smoke config
+    # the preset is the job's, not the config's: a cpu record read with a smoke config
     job = recorded_job("train", "cpu", variant="head_on", seed=1)
-    assert job_study(job, {**config, "profile": "smoke"}, "cpu") == "all"
-    assert job_study(job, {**config, "profile": "smoke"}) == "other"
-    # a record of a profile the config does not list: its seeds are unknown, so every seed counts
-    with pytest.raises(ValueError, match="profile 'p' is not in the config"):
-        profile_seeds(config, "p")
+    assert job_study(job, {**config, "preset": "smoke"}, "cpu") == "all"
+    assert job_study(job, {**config, "preset": "smoke"}) == "other"
+    # a record of a preset the config does not list: its seeds are unknown, so every seed counts
+    with pytest.raises(ValueError, match="preset 'p' is not in the config"):
+        preset_seeds(config, "p")
     assert job_study(recorded_job("train", "p", variant="head_on", seed=3), config, "p") == "all"
 
 
 def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_random_decisions():
-    """At the cpu profile (a modular searcher): head_on against modular_random, head_off against
-    modular_random_head_off, every seed against the floor's one, on the stored sets; nothing at a profile
+    """At the cpu preset (a modular searcher): head_on against modular_random, head_off against
+    modular_random_head_off, every seed against the floor's one, on the stored sets; nothing at a preset
     whose pair acts at every body step."""
     out = run(["-n", "-p", "decisions_floor", "-R", "decisions_floor_compare"])
     assert out.returncode == 0, out.stderr
@@ -415,14 +415,14 @@ def test_the_decisions_floor_compares_the_modular_pair_with_the_same_walk_on_ran
         assert f"results/cpu/eval/{floor}/seed0/bedroom_bath/everywhere/h1.65.csv" in text
         assert f"results/cpu/eval/{variant}/seed2/kitchen_living/no_low_cabinets/h0.45.csv" in text
     assert f"eval/{floor}/seed1/" not in text
-    smoke = run(["-n", "-p", "decisions_floor", "--config", "profile=smoke"])
+    smoke = run(["-n", "-p", "decisions_floor", "--config", "preset=smoke"])
     assert smoke.returncode == 0 and "report compare" not in smoke.stdout + smoke.stderr
 
 
 def test_learning_adds_compares_the_pair_with_its_own_start_on_the_same_sets(checkout):
     """`learning_adds`: every seed's start (actor_start.pt, beside the actor.pt the train rule makes) on every
     Table 1 cell under eval_start/, and each variant of the pair against it, seed by seed."""
-    out = run(["-n", "-p", "learning_adds", "--config", "profile=smoke"], cwd=checkout)
+    out = run(["-n", "-p", "learning_adds", "--config", "preset=smoke"], cwd=checkout)
     assert out.returncode == 0, out.stderr
     text = out.stdout + out.stderr
     for variant in ("head_on", "head_off"):

@@ -89,6 +89,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"egosearch: error: {hint}", file=sys.stderr)
         return 2
     args = build_parser().parse_args(argv)
+    if parsers.uses_old_preset_flag(argv):
+        print(parsers.OLD_PRESET_NOTE, file=sys.stderr)
     notice = rasterbuild.notice_once(NOTICE_MARKER)
     if notice:
         print(notice, file=sys.stderr)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import torch
 
-from egosearch.cli.checks import at_least, learner_profile_of
+from egosearch.cli.checks import at_least, learner_preset_of
 from egosearch.envs import ALL_ENV_IDS, env_options
 from egosearch.report.workflow_jobs import workflow_config
 from egosearch.rl.actor import ActorPolicy
@@ -37,7 +37,7 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
     is the one it was trained in), and the options a trained actor's file records with ``env_kwargs`` (the
     caller's, :data:`egosearch.envs.OBSERVATION_OPTIONS`) on top. An actor that cannot act in the env id
     with those options is refused here, before any episode, and so are weights given to a policy that has
-    none; an actor trained at another learner profile than the results ``out`` is written beside gets a
+    none; an actor trained at another learner preset than the results ``out`` is written beside gets a
     note."""
     given = dict(env_kwargs or {})
     if kind in searchers.SEARCHERS:
@@ -60,7 +60,7 @@ def policy_factory(kind: str, weights: str | None, seed: int, env_id: str | None
             raise ValueError("--policy actor needs --weights PATH/actor.pt")
         actor = ActorPolicy(weights)
         trained = actor.trained_env_id()
-        note_profile(weights, actor, reference_profile(out))
+        note_preset(weights, actor, reference_preset(out))
         options = {**actor.env_kwargs, **given}
         if trained in BODY_ENV_IDS and env_id in (None, BODY_ENV_IDS[trained]):
             # a modular searcher's decisions act step by step in the body env (ModularPolicy), so that
@@ -94,27 +94,27 @@ def check_searcher_env(kind: str, env_id: str | None) -> None:
                          f"that name; leave --env-id out{hint}")
 
 
-STORED_PROFILE = "cpu"
-"""The learner profile of the stored results (Table 1, compare, Figure 7)."""
+STORED_PRESET = "cpu"
+"""The learner preset of the stored results (Table 1, compare, Figure 7)."""
 
 
-def reference_profile(out: str | None) -> str:
-    """The learner profile of the results an output is read beside: the one of the
-    ``results/<profile>/`` folder it is written into (the DAG's jobs), else the stored results'."""
+def reference_preset(out: str | None) -> str:
+    """The learner preset of the results an output is read beside: the one of the
+    ``results/<preset>/`` folder it is written into (the DAG's jobs), else the stored results'."""
     parts = Path(os.path.abspath(out)).parts if out else ()
-    profiles = workflow_config()["profiles"]
-    for folder, profile in zip(parts[-3::-1], parts[-2::-1]):  # the innermost results/<profile>/ first
-        if folder == "results" and profile in profiles:
-            return profiles[profile]["learner"]
-    return STORED_PROFILE
+    presets = workflow_config()["presets"]
+    for folder, preset in zip(parts[-3::-1], parts[-2::-1]):  # the innermost results/<preset>/ first
+        if folder == "results" and preset in presets:
+            return presets[preset]["learner"]
+    return STORED_PRESET
 
 
-def note_profile(weights: str, actor: ActorPolicy, reference: str = STORED_PROFILE) -> None:
-    """One note line when the actor was not trained at the ``reference`` learner profile: a smoke
+def note_preset(weights: str, actor: ActorPolicy, reference: str = STORED_PRESET) -> None:
+    """One note line when the actor was not trained at the ``reference`` learner preset: a smoke
     actor's rows look like any other's, and beside the cpu results they would pass for a poor variant."""
     if not isinstance(actor.config, dict):
         return
-    profile, how = learner_profile_of(actor.config, actor.variant)
-    if profile not in (None, reference):
-        print(f"note: {weights} was trained at the {profile} learner profile ({how}), not at {reference}: do not "
-              f"read its results beside the {reference} profile's", file=sys.stderr)
+    preset, how = learner_preset_of(actor.config, actor.variant)
+    if preset not in (None, reference):
+        print(f"note: {weights} was trained at the {preset} learner preset ({how}), not at {reference}: do not "
+              f"read its results beside the {reference} preset's", file=sys.stderr)

@@ -18,7 +18,7 @@ from egosearch.sim import bench_env as bench
 from egosearch.variants import resolve_variant
 
 GPU_CHECK_VARIANT = "head_on"
-"""The variant whose paper-profile training ``bench gpu`` times (seed 0)."""
+"""The variant whose paper-preset training ``bench gpu`` times (seed 0)."""
 
 DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds": 150.0, "baseline_seconds": 0.0,
             "seeds": 3}
@@ -102,11 +102,11 @@ def run(args) -> None:
 
 def check_gpu_options(args) -> None:
     if not args.out_dir:
-        raise ValueError("bench gpu needs --out-dir (the paper-profile training's folder)")
+        raise ValueError("bench gpu needs --out-dir (the paper-preset training's folder)")
     if args.side_by_side is not None:
         at_least("--side-by-side", args.side_by_side, 2, "the trainings side by side on one GPU")
         if args.cuda_graph:
-            raise ValueError("--cuda-graph is not read with --side-by-side: its trainings run the paper profile as "
+            raise ValueError("--cuda-graph is not read with --side-by-side: its trainings run the paper preset as "
                              "the DAG does (cuda_graph on)")
     if args.stacked is not None:
         at_least("--stacked", args.stacked, 2, "the seeds stacked in one training")
@@ -118,7 +118,7 @@ def check_gpu_options(args) -> None:
     if not args.baseline_seconds >= 0:
         raise ValueError(f"--baseline-seconds must be a number >= 0, got {args.baseline_seconds}")
     if not torch.cuda.is_available():
-        # on the CPU it would time the paper profile there, record cuda_graph True, and could replace
+        # on the CPU it would time the paper preset there, record cuda_graph True, and could replace
         # the stored GPU record with the numbers of a machine that has none
         built = f"built with CUDA {torch.version.cuda}" if torch.version.cuda else "a CPU-only build"
         raise ValueError(f"bench gpu needs a CUDA GPU, and torch {torch.__version__} ({built}) sees none on this "
@@ -132,7 +132,7 @@ def measure_side_by_side(args) -> dict:
     from egosearch.report.workflow_jobs import variants_of_all, workflow_config
 
     config = workflow_config()
-    seeds = config["profiles"]["paper"]["seeds"]
+    seeds = config["presets"]["paper"]["seeds"]
     variants = variants_of_all(config)
     steps = sum(resolve_variant(v, "paper").config.total_env_steps for v in variants) * len(seeds)
     return run_side_by_side(args.side_by_side, args.seconds, args.out_dir, variant=GPU_CHECK_VARIANT,

@@ -16,7 +16,7 @@ PathLike = str | os.PathLike
 
 IGNORED_CONFIG_FIELDS = ("seed", "device", "num_threads", "compile", "cuda_graph", "keep_checkpoint",
                          "checkpoint_every")
-"""Learner config fields that say how or where a run ran, not what it learned: never a profile's mark."""
+"""Learner config fields that say how or where a run ran, not what it learned: never a preset's mark."""
 
 
 def _num(x: int | float) -> str:
@@ -108,13 +108,13 @@ def check_npz_files(option: str, paths: Iterable[PathLike]) -> None:
             raise ValueError(f"{option}: {path} {shown}; a trace file is written by `egosearch evaluate --traces`")
 
 
-def learner_profile_of(config: dict, variant: str | None = None) -> tuple[str | None, str]:
-    """(the learner profile, smoke, cpu or paper, whose config ``config`` is, how that was read)
-    for a trained run's recorded config: the profile whose config, with the run's variant's
+def learner_preset_of(config: dict, variant: str | None = None) -> tuple[str | None, str]:
+    """(the learner preset, smoke, cpu or paper, whose config ``config`` is, how that was read)
+    for a trained run's recorded config: the preset whose config, with the run's variant's
     overrides when its file is known, differs from it in the fewest fields (runs recorded before a
-    field existed are read on the fields they have). None when two profiles are as near."""
+    field existed are read on the fields they have). None when two presets are as near."""
     # local: the learner's config module is plain data, but the variants layer loads gymnasium's registry
-    from egosearch.rl.config import PROFILES, load_variant_config
+    from egosearch.rl.config import PRESETS, load_variant_config
     from egosearch.variants import load_variant
 
     overrides: dict = {}
@@ -124,17 +124,17 @@ def learner_profile_of(config: dict, variant: str | None = None) -> tuple[str | 
         except ValueError:
             overrides = {}
     distance = {}
-    for profile in PROFILES:
+    for preset in PRESETS:
         try:
-            wanted = load_variant_config(profile, overrides).to_dict()
+            wanted = load_variant_config(preset, overrides).to_dict()
         except ValueError:
-            wanted = load_variant_config(profile).to_dict()
-        distance[profile] = sum(1 for key, value in config.items()
+            wanted = load_variant_config(preset).to_dict()
+        distance[preset] = sum(1 for key, value in config.items()
                                 if key in wanted and key not in IGNORED_CONFIG_FIELDS and wanted[key] != value)
     ranked = sorted(distance, key=distance.get)
     if len(ranked) > 1 and distance[ranked[0]] == distance[ranked[1]]:
         return None, ""
     own = f" with {variant}'s overrides" if overrides else ""
-    how = (f"its config is the {ranked[0]} profile's{own}" if distance[ranked[0]] == 0 else
-           f"its config is nearest the {ranked[0]} profile's{own}: {distance[ranked[0]]} field(s) differ")
+    how = (f"its config is the {ranked[0]} preset's{own}" if distance[ranked[0]] == 0 else
+           f"its config is nearest the {ranked[0]} preset's{own}: {distance[ranked[0]]} field(s) differ")
     return ranked[0], how

@@ -29,24 +29,24 @@ def run(args) -> None:
         if variant.config.get("algorithm", args.algorithm) != args.algorithm:
             raise ValueError(f"--variant {args.variant} trains algorithm {variant.config['algorithm']}, not "
                              f"{args.algorithm}: show that one")
-        trained = load_variant_config(args.profile).algorithm  # at smoke, the cpu profile's learner
+        trained = load_variant_config(args.preset).algorithm  # at smoke, the cpu preset's learner
         if "algorithm" not in variant.config and trained != args.algorithm:
-            # the variant names no learner: it trains the profile's, and this table would pass for its config
-            raise ValueError(f"--variant {args.variant} trains algorithm {trained} at the {args.profile} profile "
-                             f"(the profile's learner), not {args.algorithm}: show that one (egosearch config show "
-                             f"{trained} --profile {args.profile} --variant {args.variant})")
+            # the variant names no learner: it trains the preset's, and this table would pass for its config
+            raise ValueError(f"--variant {args.variant} trains algorithm {trained} at the {args.preset} preset "
+                             f"(the preset's learner), not {args.algorithm}: show that one (egosearch config show "
+                             f"{trained} --preset {args.preset} --variant {args.variant})")
     try:
-        rows = config_sources(args.algorithm, args.profile, overrides, name, set_overrides)
+        rows = config_sources(args.algorithm, args.preset, overrides, name, set_overrides)
     except ValueError as err:
         if not set_overrides:
             raise
         # the value out of range may be the command line's: say so, as egosearch train does
         raise ValueError(f"--set {format_set(set_overrides)}: {err}") from None
     files = sorted({row["declared_in"].rsplit(".", 1)[0] for row in rows})
-    print(f"{args.algorithm} at profile {args.profile}{f' with variant {name}' if name else ''}"
+    print(f"{args.algorithm} at preset {args.preset}{f' with variant {name}' if name else ''}"
           f"{f' and --set {format_set(set_overrides)}' if set_overrides else ''}: {len(rows)} fields, "
           f"declared in {', '.join(f.replace('.', '/') + '.py' for f in files)}")
-    for line in environment_lines(variant, args.algorithm, args.profile, set_overrides):
+    for line in environment_lines(variant, args.algorithm, args.preset, set_overrides):
         print(line)
     if args.full:
         print_full(rows)
@@ -59,13 +59,13 @@ def run(args) -> None:
         print(f"{cells}  {row['declared_in'].rsplit('.', 1)[1]}: {row['doc']}")
 
 
-def environment_lines(variant, algorithm: str, profile: str, set_overrides: dict) -> list[str]:
+def environment_lines(variant, algorithm: str, preset: str, set_overrides: dict) -> list[str]:
     """What a training takes from the variant file besides its config: the env id it trains and is evaluated in
     (the variant's ``env_id``, or the form its config's observation options turn it into) and the training env's
     keyword arguments (``train_env``); without a variant, where they come from."""
     if variant is None:
         return ["env_id, train_env: a variant's (ablations/NAME.yaml); give --variant to see them"]
-    resolved = resolve_variant(variant, profile, {"algorithm": algorithm}, set_overrides)
+    resolved = resolve_variant(variant, preset, {"algorithm": algorithm}, set_overrides)
     observed = "" if resolved.env_id == variant.env_id else (
         f" (its config's observation makes it {resolved.env_id}: the id it trains and is evaluated in)")
     train_env = ", ".join(f"{key}={value!r}" for key, value in variant.train_env.items())

@@ -23,17 +23,17 @@ def run(args) -> None:
                              "documented bound; --allow-long allows more")
     check_seed("--seed", args.seed)
     set_overrides = parse_set(args.set)
-    resolved = resolve_variant(args.variant, args.profile, {"seed": args.seed}, set_overrides)
+    resolved = resolve_variant(args.variant, args.preset, {"seed": args.seed}, set_overrides)
     if args.episodes is None:
-        check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
+        check_learner_config(resolved.variant, args.preset, allow_long=args.allow_long, set_overrides=set_overrides)
     episodes = args.episodes if args.episodes is not None else resolved.config.demo_episodes
     if episodes < 1:
-        raise ValueError(f"--variant={args.variant} at the {args.profile} profile learns from no demonstrations "
+        raise ValueError(f"--variant={args.variant} at the {args.preset} preset learns from no demonstrations "
                          "(its demo_episodes is 0): give --episodes N to collect them anyway")
     if resolved.config.modular_searcher:
         # its training could not read them (demo_episodes must be 0 there), and collecting them fails
         # half-way with numpy's reshape error: a decision is not a body step
-        raise ValueError(f"--variant={args.variant} at the {args.profile} profile is a modular searcher (its env step "
+        raise ValueError(f"--variant={args.variant} at the {args.preset} preset is a modular searcher (its env step "
                          "is a decision, not a body step): demonstrations are the frontier searcher's body steps, "
                          "which it cannot learn from; give a variant that acts at every body step (e.g. "
                          "head_on_from_scratch)")

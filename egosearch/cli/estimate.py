@@ -16,12 +16,13 @@ from pathlib import Path
 from egosearch.cli.checks import read_json_object
 from egosearch.core.machine import measured_on, with_machine
 from egosearch.core.outputs import check_outputs, check_overwrites
+from egosearch.core.preset_word import recorded_preset
 from egosearch.cost.calibration import BUSY_CORES, calibrate, this_machine
 from egosearch.cost.estimate import estimate_all
-from egosearch.cost.rates import steps_of_bench, steps_of_profile
+from egosearch.cost.rates import steps_of_bench, steps_of_preset
 from egosearch.cost.run_log import RunLog, read_run_log
 from egosearch.cost.schedule import machine_key
-from egosearch.cost.schedule_check import run_profile, schedule_check
+from egosearch.cost.schedule_check import run_preset, schedule_check
 from egosearch.workflow.dag import rule_names
 
 CHECK_ONLY = {"log": "--log", "record": "--record", "target": "--target"}
@@ -32,7 +33,7 @@ MAX_CORES = 1024
 """Most cores an estimate is made for: snakemake's ``--cores`` on one machine (the DAG has a few hundred
 jobs; a larger figure is a typo, and the estimate would be the DAG's longest chain without a word)."""
 RECORD_FILE = ("a provenance record is the JSON file `egosearch report provenance` writes "
-               "(results/<profile>/provenance.json)")
+               "(results/<preset>/provenance.json)")
 BENCH_FILE = "a learner benchmark record is the JSON file `egosearch bench learner --out` writes"
 
 
@@ -62,29 +63,29 @@ def run(args) -> None:
     if args.what == "check":
         check_target(args.target)
         run_log = read_log(args.log)
-        profile = checked_run_profile(args.log, run_log, args.profile)
+        preset = checked_run_preset(args.log, run_log, args.preset)
     else:
-        run_log, profile = None, args.profile or "cpu"
-    results = Path("results") / profile
+        run_log, preset = None, args.preset or "cpu"
+    results = Path("results") / preset
     record_path = Path(args.record) if args.record else results / "provenance.json"
     if not args.record and not record_path.is_file() and args.what == "check":
-        raise FileNotFoundError(f"{record_path} not found: the jobs of {args.log} ran at the {profile} profile, and "
-                                "the check judges them against that profile's recorded job times: give --record, a "
-                                f"record of the {profile} profile")
+        raise FileNotFoundError(f"{record_path} not found: the jobs of {args.log} ran at the {preset} preset, and "
+                                "the check judges them against that preset's recorded job times: give --record, a "
+                                f"record of the {preset} preset")
     if not args.record and not record_path.is_file():
         raise FileNotFoundError(f"{record_path} not found: the estimate scales the stored run's job times "
-                                "(run it in the project's root, at a profile with a stored run)")
+                                "(run it in the project's root, at a preset with a stored run)")
     record = read_record("--record" if args.record else "the stored record", record_path)
     if not record.get("jobs"):
         # every job would be taken at 0 s: "about 0.0 h" (results/paper/ holds its GPU check, not a run)
-        raise ValueError(f"{record_path} records no job's time: the {profile} profile has no stored run to "
-                         "scale" + ("" if args.record else " (--profile cpu has one)"))
+        raise ValueError(f"{record_path} records no job's time: the {preset} preset has no stored run to "
+                         "scale" + ("" if args.record else " (--preset cpu has one)"))
     if args.what == "check":
-        if record.get("profile") not in (None, profile):
-            raise ValueError(f"--record: {record_path} holds the {record['profile']} profile's job times, but the "
-                             f"jobs of {args.log} ran at the {profile} profile: give a record of the {profile} "
-                             "profile")
-        figures = schedule_check(args.log, record, profile, args.target or "all", args.cores, record_path,
+        if recorded_preset(record) not in (None, preset):
+            raise ValueError(f"--record: {record_path} holds the {recorded_preset(record)} preset's job times, but the "
+                             f"jobs of {args.log} ran at the {preset} preset: give a record of the {preset} "
+                             "preset")
+        figures = schedule_check(args.log, record, preset, args.target or "all", args.cores, record_path,
                                  run_log=run_log)
     else:
         figures = _estimate_all_here(args, record, results)
@@ -145,14 +146,14 @@ def check_target(target: str | None) -> None:
                          "table1 or screen (`snakemake --list-target-rules` lists them)")
 
 
-def checked_run_profile(log_path: str, run_log: RunLog, asked: str | None) -> str:
-    """The profile ``estimate check`` judges the run at: the one its jobs ran at, which ``--profile``, when
-    given, must be (a run at another profile judged against this one's job times reads as a slow or fast
-    run without a word), else ``--profile``, else cpu."""
-    ran = run_profile(run_log)
+def checked_run_preset(log_path: str, run_log: RunLog, asked: str | None) -> str:
+    """The preset ``estimate check`` judges the run at: the one its jobs ran at, which ``--preset``, when
+    given, must be (a run at another preset judged against this one's job times reads as a slow or fast
+    run without a word), else ``--preset``, else cpu."""
+    ran = run_preset(run_log)
     if asked and ran and asked != ran:
-        raise ValueError(f"--profile={asked}: the jobs of {log_path} ran at the {ran} profile (their paths say so): "
-                         f"leave --profile out, or give the log of a {asked} run")
+        raise ValueError(f"--preset={asked}: the jobs of {log_path} ran at the {ran} preset (their paths say so): "
+                         f"leave --preset out, or give the log of a {asked} run")
     return ran or asked or "cpu"
 
 
@@ -168,21 +169,21 @@ def _estimate_all_here(args, record: dict, results: Path) -> dict:
         if not rate:
             raise FileNotFoundError(f"--from-bench: {bench_path} holds no learner benchmark "
                                     "(egosearch bench learner --out writes one)")
-        profile = args.profile or "cpu"
-        if steps_of_bench(bench) != steps_of_profile(profile):
-            raise ValueError(f"--from-bench: {bench_path} timed the cpu profile's {steps_of_bench(bench)}, but the "
-                             f"{profile} profile's env steps are {steps_of_profile(profile)} "
-                             "(egosearch bench learner --out times today's profile)")
+        preset = args.preset or "cpu"
+        if steps_of_bench(bench) != steps_of_preset(preset):
+            raise ValueError(f"--from-bench: {bench_path} timed the cpu preset's {steps_of_bench(bench)}, but the "
+                             f"{preset} preset's env steps are {steps_of_preset(preset)} "
+                             "(egosearch bench learner --out times today's preset)")
         how = f"recorded in {bench_path}"
         where = f"on {machine_key(bench.get('machine'))}"
     busy = None
     if rate is None:
-        print("calibrating: a short cpu-profile training (about a minute, as `egosearch bench learner` times) ...",
+        print("calibrating: a short cpu-preset training (about a minute, as `egosearch bench learner` times) ...",
               file=sys.stderr, flush=True)
         rate, busy = calibrate()
         how = "measured now"
         where = f"on this machine ({machine_key(this_machine())})"
-    figures = estimate_all(record, results, args.cores, args.profile or "cpu", rate=rate, rate_source=how,
+    figures = estimate_all(record, results, args.cores, args.preset or "cpu", rate=rate, rate_source=how,
                            bench=bench_path, where=where)
     if busy is not None:
         figures["other_load_cores_while_calibrating"] = busy
@@ -195,9 +196,9 @@ def _estimate_all_here(args, record: dict, results: Path) -> dict:
 
 def _command(args) -> str:
     """The estimate's command as a user would type it again (what it was calibrated or given)."""
-    # check without --profile judges the run at its own profile: the command says what was typed
-    profile = args.profile or ("cpu" if args.what == "all" else None)
-    words = ["egosearch estimate", args.what, f"--cores {args.cores}"] + ([f"--profile {profile}"] if profile else [])
+    # check without --preset judges the run at its own preset: the command says what was typed
+    preset = args.preset or ("cpu" if args.what == "all" else None)
+    words = ["egosearch estimate", args.what, f"--cores {args.cores}"] + ([f"--preset {preset}"] if preset else [])
     words += [f"--rate {args.rate:g}"] if args.rate is not None else []
     words += ["--from-bench"] if args.from_bench else []
     for flag, value in (("--bench", args.bench), ("--log", args.log), ("--record", args.record),

@@ -23,9 +23,9 @@ def run(args) -> None:
                          "levels must run the same ones; leave --seed out")
     args.seed = 0 if args.seed is None else args.seed
     check_seed("--seed", args.seed)
-    if not args.curve_of and args.profile != "cpu":
-        raise ValueError(f"--profile={args.profile} is read with --curve-of only (a scenario file needs no profile)")
-    curve = curve_set(args.curve_of, args.profile, args.allow_long) if args.curve_of else None
+    if not args.curve_of and args.preset != "cpu":
+        raise ValueError(f"--preset={args.preset} is read with --curve-of only (a scenario file needs no preset)")
+    curve = curve_set(args.curve_of, args.preset, args.allow_long) if args.curve_of else None
     check_threads(args.threads)
     if args.env_id is not None and args.env_id not in ALL_ENV_IDS:  # '' too: it would read as no --env-id
         raise ValueError(f"--env-id={args.env_id!r}; allowed: {', '.join(ALL_ENV_IDS)}")
@@ -52,14 +52,14 @@ def run(args) -> None:
 
 
 
-def curve_set(variant: str, profile: str, allow_long: bool = False) -> list:
-    """The scenarios ``variant``'s training curve is evaluated on at ``profile`` (what ``egosearch train``
+def curve_set(variant: str, preset: str, allow_long: bool = False) -> list:
+    """The scenarios ``variant``'s training curve is evaluated on at ``preset`` (what ``egosearch train``
     hands the learner): its curve homes, its training placement, ``eval_episodes`` of them."""
     # local: resolving a variant loads the learner registry (torch), which a scenario-file run never needs
     from egosearch.sim.home_pool import curve_homes
     from egosearch.variants import check_learner_config, resolve_variant
 
-    resolved = resolve_variant(variant, profile)
-    check_learner_config(resolved.variant, profile, allow_long=allow_long)
+    resolved = resolve_variant(variant, preset)
+    check_learner_config(resolved.variant, preset, allow_long=allow_long)
     env = resolved.train_env
     return curve_scenarios(curve_homes(env), env["placement"], resolved.config.eval_episodes)

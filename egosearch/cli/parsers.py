@@ -7,7 +7,7 @@ body lives in ``egosearch/cli/<command>.py``, imported only when that command ru
 from __future__ import annotations
 
 from egosearch.rl.learner_registry import LEARNERS as REGISTERED_LEARNERS
-from egosearch.rl.profiles import PROFILES
+from egosearch.rl.presets import PRESETS
 from egosearch.scene.layouts import EASY_LAYOUTS, LAYOUT_NAMES
 from egosearch.scene.placement import PLACEMENT_SCHEMES
 from egosearch.searchers import searcher_registry as searchers
@@ -24,7 +24,25 @@ MAX_HOMES = 1_000
 POLICY_SEED = "seed of the random policy and of the env's per-step noise, >= 0 (default 0)"
 FORCE = ("overwrite stored results (files git tracks under results/ or paper_figs/): the DAG's own jobs pass it; "
          "without it such a file is refused")
-LEARNERS = "the profile's learner (SAC-DrQ at cpu, SAC+CURL at smoke and paper)"
+LEARNERS = "the preset's learner (SAC-DrQ at cpu, SAC+CURL at smoke and paper)"
+
+
+OLD_PRESET_FLAG = "--profile"
+"""The old name of ``--preset``, kept working for one release (until egosearch 0.2): Snakemake's ``--profile`` is
+a folder of its options (``profiles/``), a different thing."""
+OLD_PRESET_NOTE = ("egosearch: note: --profile is the old name of --preset (the learner preset: smoke, cpu or paper; "
+                   "not Snakemake's --profile); it works until egosearch 0.2")
+
+
+def add_preset(p, **kwargs) -> None:
+    """``--preset``, and its old name (:data:`OLD_PRESET_FLAG`) as an alias."""
+    kwargs["help"] = kwargs.get("help", "") + f" ({OLD_PRESET_FLAG}: its old name, until egosearch 0.2)"
+    p.add_argument("--preset", OLD_PRESET_FLAG, dest="preset", **kwargs)
+
+
+def uses_old_preset_flag(argv: list[str]) -> bool:
+    """Whether the command line spells ``--preset`` by its old name (then :data:`OLD_PRESET_NOTE` is printed)."""
+    return any(arg == OLD_PRESET_FLAG or arg.startswith(OLD_PRESET_FLAG + "=") for arg in argv)
 
 
 def add_force(p, also: str = "") -> None:
@@ -86,9 +104,9 @@ def add_evaluate(sub) -> None:
     which.add_argument("--scenarios", help="a scenario CSV written by `egosearch scenarios`")
     which.add_argument("--curve-of", metavar="VARIANT",
                        help="instead of --scenarios: the held-out scenarios VARIANT's training curve is evaluated on "
-                            "at --profile, each episode seeded as the curve's (Figure 6's levels; the CSV gains the "
+                            "at --preset, each episode seeded as the curve's (Figure 6's levels; the CSV gains the "
                             "home and height, as scenario ids restart in each)")
-    p.add_argument("--profile", default="cpu", help="with --curve-of: the learner profile (default: cpu)")
+    add_preset(p, default="cpu", help="with --curve-of: the learner preset (default: cpu)")
     p.add_argument("--policy", default="actor", help=policy_help())
     p.add_argument("--weights", help="actor.pt written by `egosearch train` (for --policy actor only)")
     p.add_argument("--env-id", help=env_id_help())
@@ -116,7 +134,7 @@ def add_train(sub) -> None:
     about = f"train a variant's search policy with {LEARNERS} (resumable)"
     p = sub.add_parser("train", help=about, description=about)
     p.add_argument("--variant", required=True, help=VARIANT_HELP)
-    p.add_argument("--profile", default="cpu", help="learner profile: smoke, cpu or paper (default: cpu)")
+    add_preset(p, default="cpu", help="learner preset: smoke, cpu or paper (default: cpu)")
     p.add_argument("--set", action="append", metavar="FIELD=VALUE",
                    help=SET_HELP + "; recorded in the run's config.json as `set`, and a resume refuses other ones")
     p.add_argument("--seed", type=int, default=0, help="training seed (default 0)")
@@ -142,10 +160,10 @@ def add_demos(sub) -> None:
     p.add_argument("--variant", required=True, help=VARIANT_HELP + ": its training homes, heights and observation")
     p.add_argument("--set", action="append", metavar="FIELD=VALUE",
                    help=SET_HELP + " (the training's own --set: its demo_episodes, its observation)")
-    p.add_argument("--profile", default="cpu", help="learner profile whose observation is stored: smoke, cpu or "
+    add_preset(p, default="cpu", help="learner preset whose observation is stored: smoke, cpu or "
                                                     "paper (default: cpu)")
     p.add_argument("--episodes", type=int, help="demonstration episodes (default: the variant's demo_episodes at "
-                   "--profile, what its training collects)")
+                   "--preset, what its training collects)")
     p.add_argument("--seed", type=int, default=0, help="seed of the episodes (default 0)")
     p.add_argument("--out", required=True, metavar="FILE.replay.npz",
                    help="the transitions (git-ignored); a summary goes beside it as FILE.json")
@@ -159,8 +177,8 @@ def add_config(sub) -> None:
     actions = p.add_subparsers(dest="action", required=True)
     show = actions.add_parser("show", help=about, description=about)
     show.add_argument("algorithm", choices=list(REGISTERED_LEARNERS), help="the learner (LearnerConfig.algorithm)")
-    show.add_argument("--profile", default="cpu", choices=list(PROFILES),
-                      help="learner profile: smoke, cpu or paper (default: cpu)")
+    add_preset(show, default="cpu", choices=list(PRESETS),
+                      help="learner preset: smoke, cpu or paper (default: cpu)")
     show.add_argument("--variant", help=VARIANT_HELP + ": its config overrides shown on top, its env_id and "
                                         "train_env above the fields")
     show.add_argument("--set", action="append", metavar="FIELD=VALUE", help=SET_HELP + ", shown on top of the variant")
@@ -191,8 +209,8 @@ def add_variant(sub) -> None:
     v.add_argument("--from", dest="template", default="head_on", help="the variant to copy (default: head_on)")
     v = variants.add_parser("check", help="check variant files, learner config included, before running them")
     v.add_argument("names", nargs="+", help="variant names (files in ablations/) or paths of .yaml files")
-    v.add_argument("--profile", nargs="+", default=["smoke", "cpu", "paper"],
-                   help="learner profiles to check the config against (default: all three)")
+    add_preset(v, nargs="+", default=["smoke", "cpu", "paper"],
+                   help="learner presets to check the config against (default: all three)")
     add_allow_long(v)
 
 
@@ -220,9 +238,9 @@ def add_bench(sub) -> None:
     p.add_argument("what", choices=("env", "homes", "learner", "gpu", "stacked"),
                    help="env: sensor frames/s and env steps/s on one core; homes: a generated home's build time "
                         f"against a training episode; learner: updates/s of {LEARNERS}, and of SAC+CURL at Table "
-                        "2's sizes; gpu (needs CUDA): the learner benchmarks and a paper-profile training of "
+                        "2's sizes; gpu (needs CUDA): the learner benchmarks and a paper-preset training of "
                         "--seconds on this machine's GPU (results/paper/gpu_check); stacked: --seeds seeds' updates "
-                        "stacked as one model against their separate updates, at the cpu profile")
+                        "stacked as one model against their separate updates, at the cpu preset")
     p.add_argument("--layout", help=f"env: the home ({LAYOUTS}; default kitchen_living)")
     p.add_argument("--seeds", type=int, help="stacked: the seeds stacked, >= 2 (default 3)")
     p.add_argument("--frames", type=int, help="env: sensor frames to time, >= 1 (default 3000)")
@@ -231,13 +249,13 @@ def add_bench(sub) -> None:
     p.add_argument("--out-dir", help="gpu: the training's folder (curve.csv, train.csv, config.json, checkpoint)")
     p.add_argument("--cuda-graph", action="store_true",
                    help="gpu: train with the update recorded as CUDA graphs (learner.cuda_graph=true, which the "
-                        "paper profile sets anyway)")
+                        "paper preset sets anyway)")
     p.add_argument("--baseline-seconds", type=float,
                    help="gpu: also train this long with the update launched eagerly (cuda_graph false; in "
                         "<out-dir>/baseline), for the ratio on one machine; with --side-by-side: the N trainings "
                         "side by side without CUDA MPS this long first; default 0: none")
     p.add_argument("--side-by-side", type=int, metavar="N",
-                   help="gpu: instead of the learner benchmarks, one paper-profile training alone (all cores), then "
+                   help="gpu: instead of the learner benchmarks, one paper-preset training alone (all cores), then "
                         "N side by side (cores / N threads each; each `egosearch train --max-wall-s` in "
                         "<out-dir>/side_by_side/<i>), under CUDA MPS where the command can start it; --out defaults "
                         "to results/paper/gpu_check/side_by_side.json (aggregate env steps/s, the paper `all`'s "
@@ -266,19 +284,19 @@ def add_estimate(sub) -> None:
                    help="all: the target `snakemake all` builds; check: a finished run (--log) against the "
                         "simulation of its own jobs")
     p.add_argument("--cores", type=int, default=2, help="the cores snakemake gets (--cores N, 1 to 1024; default 2)")
-    p.add_argument("--profile", choices=("cpu", "paper"),
-                   help="the profile whose stored run gives the job times (default cpu; check: the profile the "
-                        "log's jobs ran at, which --profile must then be)")
+    add_preset(p, choices=("cpu", "paper"),
+                   help="the preset whose stored run gives the job times (default cpu; check: the preset the "
+                        "log's jobs ran at, which --preset must then be)")
     p.add_argument("--rate", type=float, help="this machine's learner benchmark in env steps per CPU-second (what "
                                               "`egosearch bench learner` prints as env_steps_per_core_s_cpu_profile): "
                                               "skips the calibration")
     p.add_argument("--from-bench", action="store_true",
                    help="take the rate recorded in --bench instead of calibrating (the README's figure)")
     p.add_argument("--bench", help="the learner benchmark record whose machine's ratio of a real training to the "
-                                   "benchmark is used (default results/<profile>/bench/learner.json)")
+                                   "benchmark is used (default results/<preset>/bench/learner.json)")
     p.add_argument("--log", help="check: the run's Snakemake log (.snakemake/log/<date>.snakemake.log)")
     p.add_argument("--record", help="check: the provenance record whose job times predict the run (default "
-                                    "results/<profile>/provenance.json; before a run rewrites it, keep a copy)")
+                                    "results/<preset>/provenance.json; before a run rewrites it, keep a copy)")
     p.add_argument("--target", help="check: the target the run built (default all): its DAG gives the jobs' "
                                     "dependencies")
     add_record_outputs(p, "also print the figures as one JSON object", "the figures as JSON, with the command, "
@@ -322,7 +340,7 @@ def add_report(sub) -> None:
     """One sub-command per report, each with its own options and ``--help``."""
     p = sub.add_parser("report", help="tables, figures, comparisons and provenance from result CSVs")
     reports = p.add_subparsers(dest="what", required=True, metavar="REPORT")
-    profile = dict(default="cpu", help="profile: smoke, cpu or paper (default: cpu)")
+    preset = dict(default="cpu", help="preset: smoke, cpu or paper (default: cpu)")
     prefix = "output path without extension, or a folder (writes {})"
 
     r = reports.add_parser("table1", help="Table 1 (success per height and placement) from evaluation CSVs")
@@ -338,8 +356,8 @@ def add_report(sub) -> None:
                                                          "what its learning adds, said in the notes")
     add_force(r)
 
-    r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner profile")
-    r.add_argument("--profile", **profile)
+    r = reports.add_parser("table2", help="Table 2 (learner settings) from a learner preset")
+    add_preset(r, **preset)
     r.add_argument("--out-prefix", required=True, help=prefix.format(".md and .tex"))
     add_force(r)
 
@@ -362,7 +380,7 @@ def add_report(sub) -> None:
     r.add_argument("--run", action="append", required=True, metavar="SETTING=CURVE_CSV:EVAL_CSV",
                    help="one training run of a setting: its curve.csv and its per-episode CSV at the cell "
                         "(repeat per seed and setting)")
-    r.add_argument("--chosen", help="the setting the profile uses (drawn filled): one of the --run settings")
+    r.add_argument("--chosen", help="the setting the preset uses (drawn filled): one of the --run settings")
     r.add_argument("--out-prefix", required=True, help=prefix.format(".png, .pdf and .csv"))
     add_force(r)
 
@@ -438,7 +456,7 @@ def add_report(sub) -> None:
     add_force(r)
 
     r = reports.add_parser("provenance", help="commit, machine, date and job wall times of a results folder")
-    r.add_argument("--profile", **profile)
+    add_preset(r, **preset)
     r.add_argument("--results", default="results/cpu", help="the results folder (default: results/cpu)")
     r.add_argument("--out", required=True, help="the provenance JSON to write")
     r.add_argument("--note", help="free text kept in the record (e.g. how the run was resumed)")
@@ -476,20 +494,20 @@ def add_report(sub) -> None:
 
     r = reports.add_parser("reread-screens", help="every stored screen read again with the seed-spread test, beside "
                                                 "its stored verdict (docs/ablations/reread.md)")
-    r.add_argument("--profile", **profile)
+    add_preset(r, **preset)
     r.add_argument("--out", required=True, help="the re-read's CSV")
     add_force(r)
 
-    r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a profile (seconds)")
-    r.add_argument("--profile", **profile)
+    r = reports.add_parser("regenerate", help="every table and figure from the stored CSVs of a preset (seconds)")
+    add_preset(r, **preset)
     r.add_argument("--variant", help="the variant of Table 1 (default: the workflow config's reference_variant)")
 
     r = reports.add_parser("verify", help="check every stored result file against the sha256 in its provenance")
-    r.add_argument("--profile", **profile)
+    add_preset(r, **preset)
 
     r = reports.add_parser("readme", help="rewrite the generated blocks of the README and the docs pages from the "
                                           "stored results")
-    r.add_argument("--profile", **profile)
+    add_preset(r, **preset)
     r.add_argument("--readme", help="the one page whose marked blocks are rewritten (default: README.md and every "
                                     "page under docs/ of the current folder)")
     r.add_argument("--check", action="store_true", help="only check that the blocks are up to date (exit 2 if not)")

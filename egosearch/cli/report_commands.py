@@ -30,7 +30,7 @@ from egosearch.report.searches import searches_report
 from egosearch.report.tables import stuck_path
 from egosearch.report.workflow_jobs import (
     bound_eval_files,
-    profile_seeds,
+    preset_seeds,
     variants_of_all,
     workflow_config,
     workflow_heights,
@@ -144,7 +144,7 @@ def _bounds_hint(option: str, path: str) -> str:
     likely typo (``--bounds frontier``)."""
     if option != "--bounds":
         return ""
-    pattern = "results/<profile>/eval/{}/seed<N>/<home>/<placement>/h<height>.csv"
+    pattern = "results/<preset>/eval/{}/seed<N>/<home>/<placement>/h<height>.csv"
     if path in searchers.SEARCHERS:
         return f"; --bounds takes evaluation CSV paths, not a searcher's name: {path}'s are {pattern.format(path)}"
     return (f"; --bounds takes the evaluation CSV paths of the searchers ({', '.join(searchers.bounds())}): "
@@ -246,19 +246,19 @@ def _check_budget(args) -> None:
 
 
 def _check_compare(args) -> None:
-    """A candidate whose actors trained at another learner profile than the reference's (a smoke run
-    in a cpu results folder) is refused: its rows would read as a worse variant. The profile is read
+    """A candidate whose actors trained at another learner preset than the reference's (a smoke run
+    in a cpu results folder) is refused: its rows would read as a worse variant. The preset is read
     from each actor's ``config.json``, found beside the evaluation as the DAG lays them out. A candidate
     file with the same content as a reference file (a copy) is refused without ``--force``: a table of
     +0.000 would read as a result."""
-    sides = {option: actor_profiles(files) for option, files in (("--reference", args.reference),
+    sides = {option: actor_presets(files) for option, files in (("--reference", args.reference),
                                                                  ("--candidate", args.candidate))}
-    for file, (profile, config) in sides["--candidate"].items():
-        reference = {p for p, _ in sides["--reference"].values()} - {profile}
+    for file, (preset, config) in sides["--candidate"].items():
+        reference = {p for p, _ in sides["--reference"].values()} - {preset}
         if reference:
-            raise ValueError(f"--candidate: {file} was evaluated from an actor trained at the {profile} learner "
-                             f"profile ({config}), the reference's at {', '.join(sorted(reference))}: compare "
-                             "variants trained at one profile")
+            raise ValueError(f"--candidate: {file} was evaluated from an actor trained at the {preset} learner "
+                             f"preset ({config}), the reference's at {', '.join(sorted(reference))}: compare "
+                             "variants trained at one preset")
     if not args.force:
         reference_by_content = {_sha256(path): path for path in args.reference}
         for path in args.candidate:
@@ -274,13 +274,13 @@ def _sha256(path: str) -> str:
         return hashlib.file_digest(f, "sha256").hexdigest()
 
 
-def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
-    """``{evaluation file: (its actor's learner profile, the actor's config.json)}`` for the files
+def actor_presets(files: list[str]) -> dict[str, tuple[str, Path]]:
+    """``{evaluation file: (its actor's learner preset, the actor's config.json)}`` for the files
     whose actor's run folder, ``<results>/train/<variant>/seed<N>/``, is there to tell it."""
-    # local: reading a run's profile loads the variants layer (gymnasium's registry)
+    # local: reading a run's preset loads the variants layer (gymnasium's registry)
     import json
 
-    from egosearch.cli.checks import learner_profile_of
+    from egosearch.cli.checks import learner_preset_of
 
     out, known = {}, {}
     for file in files:
@@ -298,9 +298,9 @@ def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
             except (OSError, ValueError):
                 known[config] = None
             else:
-                profile, _ = (learner_profile_of(record["config"], record.get("variant"))
+                preset, _ = (learner_preset_of(record["config"], record.get("variant"))
                               if isinstance(record, dict) and isinstance(record.get("config"), dict) else (None, ""))
-                known[config] = profile
+                known[config] = preset
         if known[config] is not None:
             out[file] = (known[config], config)
     return out
@@ -309,13 +309,13 @@ def actor_profiles(files: list[str]) -> dict[str, tuple[str, Path]]:
 def _check_failures(args) -> None:
     """Each trace is one method's, seed's and cell's, laid out as the workflow lays them
     (``.../<method>/seed<N>/<home>/<placement>/h<height>.npz``: the method is the fifth part from the end),
-    of one profile, given once, and holds episodes; each ``--stuck-read`` method once."""
+    of one preset, given once, and holds episodes; each ``--stuck-read`` method once."""
     # local: the simulator's body sizes are plain data, but its package is the CLI's to load
     from egosearch.report.failures import check_trace_file
     from egosearch.report.tables import PLACEMENT_LABELS
     from egosearch.sim.body import HEIGHT_RANGE
 
-    seen, profiles = {}, {}
+    seen, presets = {}, {}
     for path in args.files:
         where = parse_trace_path(path)
         if where["placement"] not in PLACEMENT_LABELS:
@@ -333,13 +333,13 @@ def _check_failures(args) -> None:
             raise ValueError(f"the input files: {both}: give each trace once (its episodes would count twice)")
         seen[key] = path
         parts = Path(path).resolve().parts
-        for folder, profile, traces in zip(parts, parts[1:], parts[2:]):
+        for folder, preset, traces in zip(parts, parts[1:], parts[2:]):
             if folder == "results" and traces == "traces":
-                profiles.setdefault(profile, path)
-        if len(profiles) > 1:
-            (one, first), (other, second) = list(profiles.items())[:2]
-            raise ValueError(f"the input files mix profiles: {first} is {one}'s, {second} is {other}'s; a failure "
-                             "table reads one profile's traces")
+                presets.setdefault(preset, path)
+        if len(presets) > 1:
+            (one, first), (other, second) = list(presets.items())[:2]
+            raise ValueError(f"the input files mix presets: {first} is {one}'s, {second} is {other}'s; a failure "
+                             "table reads one preset's traces")
     for method in args.stuck_read:
         if args.stuck_read.count(method) > 1:
             raise ValueError(f"--stuck-read: {method} is given twice; each method's section is written once")
@@ -376,7 +376,7 @@ def _table1(args) -> None:
 
 
 def _table2(args) -> None:
-    cfg = load_variant_config(args.profile)  # what a variant that pins nothing trains there (smoke: the cpu learner)
+    cfg = load_variant_config(args.preset)  # what a variant that pins nothing trains there (smoke: the cpu learner)
     report.cmd_table2(table2_rows(cfg), args.out_prefix, departure_rows(cfg))
 
 
@@ -488,7 +488,7 @@ def _searches(args) -> None:
 
 
 def _provenance(args) -> None:
-    record = write_provenance(args.profile, args.results, args.out, note=args.note or "")
+    record = write_provenance(args.preset, args.results, args.out, note=args.note or "")
     # The same line whether the record was rewritten or kept (no stored file changed): the
     # workflow commits this log, and a rerun that changes nothing must leave it as it was.
     print(f"{args.out}: sha256 of {len(record['files'])} stored files, {len(record['jobs'])} jobs, "
@@ -504,11 +504,11 @@ def _regenerate(args) -> None:
             load_variant(args.variant)
         except ValueError as err:
             raise ValueError(f"--variant: {err}") from None
-    regenerate(args.profile, args.variant)
+    regenerate(args.preset, args.variant)
 
 
 def _verify(args) -> None:
-    results = f"results/{args.profile}"
+    results = f"results/{args.preset}"
     ok, problems = verify(results)
     for problem in problems:
         print(problem, file=sys.stderr)
@@ -523,19 +523,19 @@ def _readme(args) -> None:
         raise FileNotFoundError(f"--readme: {args.readme} not found; a page of marked blocks (README.md, docs/*.md)")
     if args.readme:
         checked = [args.readme]
-        stale = [] if update_readme(args.readme, args.profile, check=args.check) else checked
+        stale = [] if update_readme(args.readme, args.preset, check=args.check) else checked
     else:
-        checked, stale = pages("."), update_pages(".", args.profile, check=args.check)
+        checked, stale = pages("."), update_pages(".", args.preset, check=args.check)
         if not checked:
             raise ValueError("no README.md and no docs/*.md here: run it in the project's root, or give --readme")
     names = ", ".join(str(page) for page in (stale or checked))
     if not stale:
-        print(f"{names}: results blocks match results/{args.profile} and paper_figs/{args.profile}")
+        print(f"{names}: results blocks match results/{args.preset} and paper_figs/{args.preset}")
     elif args.check:
         raise ValueError(f"{names} out of date with the stored results; "
-                         f"run `egosearch report readme --profile {args.profile}`")
+                         f"run `egosearch report readme --preset {args.preset}`")
     else:
-        print(f"rewrote the results blocks of {names} from the {args.profile} results")
+        print(f"rewrote the results blocks of {names} from the {args.preset} results")
 
 
 def _failures(args) -> None:
@@ -581,7 +581,7 @@ def _null_screen(args) -> None:
         raise ValueError(f"null-screen: the files are of {len(variants)} variants ({', '.join(variants)}); give one")
     if args.simulations is not None and args.simulations < 1:
         raise ValueError(f"--simulations={args.simulations}: must be 1 or more")
-    # results/<profile>/eval/<variant>/seed<N>/<home>/<placement>/h<height>.csv
+    # results/<preset>/eval/<variant>/seed<N>/<home>/<placement>/h<height>.csv
     results = Path(args.files[0]).resolve().parents[5]
     record = json.loads((results / "provenance.json").read_text(encoding="utf-8"))
     summary = seed_spread_summary(files, record, variants[0], n_sims=args.simulations or SIMULATIONS)
@@ -606,7 +606,7 @@ def _null_screen(args) -> None:
 def _reread_screens(args) -> None:
     from egosearch.report.reread import reread_screens
 
-    results = Path("results") / args.profile
+    results = Path("results") / args.preset
     if not (results / "compare").is_dir():
         raise FileNotFoundError(f"{results / 'compare'}: no stored comparisons (run it in the project's root)")
     df = reread_screens(results / "compare", results / "eval", args.out)
@@ -624,32 +624,32 @@ REPORTS = {"table1": _table1, "table2": _table2, "fig6": _fig6, "fig7": _fig7, "
 """Each ``egosearch report`` sub-command (its parser: :func:`egosearch.cli.parsers.add_report`)."""
 
 
-def regenerate(profile: str, reference: str | None) -> None:
-    """Tables and figures from the CSVs already in results/<profile>/: seconds, no training. The
+def regenerate(preset: str, reference: str | None) -> None:
+    """Tables and figures from the CSVs already in results/<preset>/: seconds, no training. The
     variants and the reference come from the workflow config, as in the DAG, so regenerating gives
     the files `snakemake all` would. A file rewritten with the bytes it had keeps its file time:
     Snakemake then sees nothing new, and `snakemake all` after it has nothing to do."""
-    folders = [Path("paper_figs") / profile, Path("results") / profile / "pathlength"]
+    folders = [Path("paper_figs") / preset, Path("results") / preset / "pathlength"]
     before = {path: (path.read_bytes(), path.stat()) for folder in folders if folder.is_dir()
               for path in folder.rglob("*") if path.is_file()}
-    _regenerate_files(profile, reference)
+    _regenerate_files(preset, reference)
     for path, (data, stat) in before.items():
         if path.is_file() and path.read_bytes() == data:
             os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
 
 
-def _regenerate_files(profile: str, reference: str | None) -> None:
+def _regenerate_files(preset: str, reference: str | None) -> None:
     config = workflow_config()
-    if profile not in config["profiles"]:
-        raise ValueError(f"--profile={profile!r}; allowed: {', '.join(config['profiles'])}")
+    if preset not in config["presets"]:
+        raise ValueError(f"--preset={preset!r}; allowed: {', '.join(config['presets'])}")
     reference = reference or config["reference_variant"]
-    results, figs = Path("results") / profile, Path("paper_figs") / profile
+    results, figs = Path("results") / preset, Path("paper_figs") / preset
     check_outputs(dirs={"the figures folder": figs, "the path-length folder": results / "pathlength"})
     # Table 1's homes only, as the DAG's rules: eval/ also holds the generalisation groups
     homes = set(config["homes"])
-    # the profile's seeds only: the reference's spread seeds beyond them (snakemake seed_spread) are no
+    # the preset's seeds only: the reference's spread seeds beyond them (snakemake seed_spread) are no
     # part of Table 1, Figure 6 or the path-length tables, as in the DAG
-    seeds = {f"seed{s}" for s in profile_seeds(config, profile)}
+    seeds = {f"seed{s}" for s in preset_seeds(config, preset)}
     evals = sorted(str(p) for p in (results / "eval" / reference).glob("seed*/*/*/h*.csv")
                    if Path(p).parts[-3] in homes and Path(p).parts[-4] in seeds)
     curves = {v: sorted(str(p) for p in (results / "train" / v).glob("seed*/curve.csv") if p.parts[-2] in seeds)
@@ -686,6 +686,6 @@ def _regenerate_files(profile: str, reference: str | None) -> None:
         if variant_evals and scenarios:
             report.cmd_pathlength(variant_evals, scenarios, success_radius(), figs / f"pathlength_{variant}",
                                   out_csv=results / "pathlength" / f"{variant}.csv", bounds=bounds)
-    learner = config["profiles"][profile]["learner"]
+    learner = config["presets"][preset]["learner"]
     learner_cfg = load_variant_config(learner)
     report.cmd_table2(table2_rows(learner_cfg), figs / "table2", departure_rows(learner_cfg))

@@ -1,4 +1,4 @@
-"""``egosearch bench gpu --side-by-side N``: one paper-profile training alone, then N side by side on the
+"""``egosearch bench gpu --side-by-side N``: one paper-preset training alone, then N side by side on the
 same GPU, each ``egosearch train --max-wall-s`` in a process and folder of its own (all the cores for the
 one alone, cores / N threads each side by side), under CUDA MPS where this command can start it. With
 ``--baseline-seconds`` the N also run side by side without MPS first, so that both aggregates come from one
@@ -39,9 +39,9 @@ class Training:
 
 
 def training(out_dir: Path, log: Path, seed: int, threads: int, seconds: float, variant: str, env: dict) -> Training:
-    """A paper-profile training of ``variant`` for ``seconds`` of wall time (stopped with a checkpoint),
+    """A paper-preset training of ``variant`` for ``seconds`` of wall time (stopped with a checkpoint),
     its torch, OpenMP and MKL threads ``threads``."""
-    argv = [sys.executable, "-c", ENTRY, "train", "--variant", variant, "--profile", "paper", "--seed", str(seed),
+    argv = [sys.executable, "-c", ENTRY, "train", "--variant", variant, "--preset", "paper", "--seed", str(seed),
             "--threads", str(threads), "--out-dir", str(out_dir), "--max-wall-s", f"{seconds:g}"]
     env = {**env, "OMP_NUM_THREADS": str(threads), "MKL_NUM_THREADS": str(threads)}
     return Training(str(out_dir), str(log), seed, threads, argv, env)
@@ -49,7 +49,7 @@ def training(out_dir: Path, log: Path, seed: int, threads: int, seconds: float, 
 
 def stacked_training(out_dir: Path, log: Path, seeds: int, threads: int, seconds: float, variant: str,
                      env: dict) -> Training:
-    """One process training seeds 0..``seeds``-1 of ``variant`` at the paper profile, their updates stacked
+    """One process training seeds 0..``seeds``-1 of ``variant`` at the paper preset, their updates stacked
     (``egosearch train --stack-seeds``), each seed in ``out_dir/seed<k>``, for ``seconds`` of wall time."""
     run = training(out_dir / "seed{seed}", log, 0, threads, seconds, variant, env)
     at = run.argv.index("--seed")

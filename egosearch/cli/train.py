@@ -1,4 +1,4 @@
-"""``egosearch train``: a variant resolved at a learner profile, trained resumably."""
+"""``egosearch train``: a variant resolved at a learner preset, trained resumably."""
 
 from __future__ import annotations
 
@@ -30,8 +30,8 @@ def run(args) -> None:
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     overrides = {"seed": args.seed, **({"num_threads": args.threads} if args.threads else {})}
     set_overrides = parse_set(args.set)
-    resolved = resolve_variant(args.variant, args.profile, overrides, set_overrides)
-    check_learner_config(resolved.variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
+    resolved = resolve_variant(args.variant, args.preset, overrides, set_overrides)
+    check_learner_config(resolved.variant, args.preset, allow_long=args.allow_long, set_overrides=set_overrides)
     env = resolved.train_env
     evaluator = LazyEvaluator(lambda: scenario_evaluator(resolved.env_id, curve_homes(env), env["placement"],
                                                          n=resolved.config.eval_episodes,
@@ -41,7 +41,7 @@ def run(args) -> None:
             check_published_run(Path(args.out_dir), resolved)
         except CheckpointError as err:
             raise ValueError(f"--out-dir: {err}") from None
-    line = training_time_line(resolved.config.total_env_steps, args.profile, resolved.config)
+    line = training_time_line(resolved.config.total_env_steps, args.preset, resolved.config)
     if line:
         print(line, flush=True)
     try:
@@ -49,7 +49,7 @@ def run(args) -> None:
                         evaluate_fn=evaluator, variant=resolved.name, max_wall_s=args.max_wall_s,
                         set_overrides=resolved.set_overrides)
     except CheckpointError as err:
-        # another run's folder (variant, profile or seed): the trainer refuses it before writing anything
+        # another run's folder (variant, preset or seed): the trainer refuses it before writing anything
         raise ValueError(f"{'--work-dir' if args.work_dir else '--out-dir'}: {err}") from None
     finally:
         evaluator.close()
@@ -124,8 +124,8 @@ def run_stacked(args) -> None:
     at_least("--threads", args.threads, 0, "a number of threads (0: all cores)")
     threads = {"num_threads": args.threads} if args.threads else {}
     set_overrides = parse_set(args.set)
-    resolved = [resolve_variant(args.variant, args.profile, {"seed": s, **threads}, set_overrides) for s in seeds]
-    check_learner_config(resolved[0].variant, args.profile, allow_long=args.allow_long, set_overrides=set_overrides)
+    resolved = [resolve_variant(args.variant, args.preset, {"seed": s, **threads}, set_overrides) for s in seeds]
+    check_learner_config(resolved[0].variant, args.preset, allow_long=args.allow_long, set_overrides=set_overrides)
     env = resolved[0].train_env
     evaluators = [LazyEvaluator(lambda r=r: scenario_evaluator(r.env_id, curve_homes(env), env["placement"],
                                                                n=r.config.eval_episodes,

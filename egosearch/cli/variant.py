@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from egosearch.core.outputs import check_outputs
-from egosearch.rl.config import PROFILES
+from egosearch.rl.config import PRESETS
 from egosearch.variants import ABLATIONS_DIR, VariantError, check_learner_config, load_variant, new_variant
 
 
@@ -20,14 +20,14 @@ def run(args) -> None:
               f"`snakemake --cores 2 screen --config variant={args.name}`; a variant that passes its screen gets "
               f"`snakemake --cores 2 compare --config variant={args.name}` (every seed; docs/ablations.md)")
         return
-    for profile in args.profile:
-        # else the profile's error reads as a fault of the first variant file
-        if profile not in PROFILES:
-            raise ValueError(f"--profile={profile!r}; allowed: {', '.join(PROFILES)}")
-        if args.profile.count(profile) > 1:
-            raise ValueError(f"--profile: {profile} is given twice; each profile is checked once")
+    for preset in args.preset:
+        # else the preset's error reads as a fault of the first variant file
+        if preset not in PRESETS:
+            raise ValueError(f"--preset={preset!r}; allowed: {', '.join(PRESETS)}")
+        if args.preset.count(preset) > 1:
+            raise ValueError(f"--preset: {preset} is given twice; each preset is checked once")
     for name in args.names:
         variant = load_variant(name)
-        for profile in args.profile:
-            check_learner_config(variant, profile, allow_long=args.allow_long)
-        print(f"{variant.path}: valid at the {', '.join(args.profile)} learner profile(s)")
+        for preset in args.preset:
+            check_learner_config(variant, preset, allow_long=args.allow_long)
+        print(f"{variant.path}: valid at the {', '.join(args.preset)} learner preset(s)")

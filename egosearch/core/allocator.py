@@ -4,7 +4,7 @@ A SAC-DrQ update allocates and frees the same few-megabyte tensors (conv maps, t
 time. glibc serves blocks above its mmap threshold (128 KiB at start, raised on the fly) with fresh
 pages from the kernel and gives the top of the heap back when more than its trim threshold is free.
 Either way the next update page-faults the same memory back in, zero-filled: about a third of the cpu
-profile's update time with glibc's defaults. The math is untouched; only where the bytes live changes.
+preset's update time with glibc's defaults. The math is untouched; only where the bytes live changes.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Several paper-profile trainings on one GPU (issue 47): how many the DAG runs side by side and the CPU
+"""Several paper-preset trainings on one GPU (issue 47): how many the DAG runs side by side and the CPU
 threads each takes, whether a CUDA MPS control daemon runs here, the one line a run says when trainings
 share a GPU without one, and the arithmetic of the side-by-side measurement's record
 (``egosearch bench gpu --side-by-side N``, :data:`SIDE_BY_SIDE`). Standard library only: the workflow's
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 DEFAULT_TRAININGS_PER_GPU = 6
-"""Paper-profile trainings side by side on one GPU when config ``trainings_per_gpu`` is ``auto`` and the
+"""Paper-preset trainings side by side on one GPU when config ``trainings_per_gpu`` is ``auto`` and the
 run is on one machine: the six trainings of ``all``, the count :data:`MEASURED` was measured with."""
 
 MEASURED = {
@@ -30,7 +30,7 @@ MEASURED = {
     "alone_env_steps_per_s": 131.0,
     "without_mps": {"per_training_env_steps_per_s": 34.7, "aggregate_env_steps_per_s": 208.0},
     "with_mps": {"per_training_env_steps_per_s": 90.0, "aggregate_env_steps_per_s": 541.0},
-    "source": "issue 47's measurement: one NVIDIA H200 with 16 cores, the paper profile, `egosearch train "
+    "source": "issue 47's measurement: one NVIDIA H200 with 16 cores, the paper preset, `egosearch train "
               "--max-wall-s`, median env steps/s while updating; one training alone with 16 threads, then six "
               "side by side with 2 threads each, without MPS and under it",
 }
@@ -64,12 +64,12 @@ def resolve_trainings_per_gpu(value, local: bool) -> int:
     return value
 
 
-def train_threads(profile: str, cores: int | None, trainings_per_gpu: int) -> int:
+def train_threads(preset: str, cores: int | None, trainings_per_gpu: int) -> int:
     """The CPU threads a training job takes (its ``threads:`` and ``egosearch train --threads``): at the
-    paper profile on one machine a fair share of ``cores``, ``cores // trainings_per_gpu`` (at least 1);
-    1 at the other profiles (their trainings run one per core) and where no ``cores`` are known (a cluster
+    paper preset on one machine a fair share of ``cores``, ``cores // trainings_per_gpu`` (at least 1);
+    1 at the other presets (their trainings run one per core) and where no ``cores`` are known (a cluster
     executor's run: ``--set-threads train=N`` gives more)."""
-    if profile != "paper" or not cores:
+    if preset != "paper" or not cores:
         return 1
     return max(1, cores // max(1, trainings_per_gpu))
 
@@ -164,12 +164,12 @@ def sharing_rates(record: dict | None) -> dict:
 
 
 def sharing_line(trainings_per_gpu: int, status: MpsStatus, record: dict | None = None) -> str | None:
-    """The line a paper-profile run says before its first job when its trainings share one GPU: under
+    """The line a paper-preset run says before its first job when its trainings share one GPU: under
     MPS, that they do; without it (or where that cannot be told), what it costs and how to start it.
     None when the trainings run one at a time."""
     if trainings_per_gpu <= 1:
         return None
-    share = f"Up to {trainings_per_gpu} paper-profile trainings run side by side on one GPU (trainings_per_gpu)"
+    share = f"Up to {trainings_per_gpu} paper-preset trainings run side by side on one GPU (trainings_per_gpu)"
     if status.running:
         return f"{share}, under CUDA MPS ({status.evidence})."
     r = sharing_rates(record)
@@ -197,11 +197,11 @@ def say_once(line: str | None, stream=None) -> bool:
     return True
 
 
-def warn_gpu_sharing(profile: str, trainings_per_gpu: int, root: Path = Path("."), env=None,
+def warn_gpu_sharing(preset: str, trainings_per_gpu: int, root: Path = Path("."), env=None,
                      proc: Path = Path("/proc"), stream=None) -> bool:
-    """What the Snakefile's cost line adds before a paper-profile run's first job: :func:`sharing_line`
+    """What the Snakefile's cost line adds before a paper-preset run's first job: :func:`sharing_line`
     for this machine's MPS daemon and the stored record, once. True when a line was printed."""
-    if profile != "paper" or trainings_per_gpu <= 1:
+    if preset != "paper" or trainings_per_gpu <= 1:
         return False
     return say_once(sharing_line(trainings_per_gpu, mps_status(env, proc), read_side_by_side(root)), stream)
 
@@ -251,7 +251,7 @@ def side_by_side_result(alone: dict, side: list[dict], *, all_env_steps: int, al
     rates = _rates(side, "side by side")
     aggregate = sum(rates)
     result = {
-        "variant": variant, "profile": "paper", "seconds": seconds, "side_by_side": len(side),
+        "variant": variant, "preset": "paper", "seconds": seconds, "side_by_side": len(side),
         "threads_alone": alone.get("threads"), "threads_per_training": side[0].get("threads") if side else None,
         "alone_env_steps_per_s": round(alone_rate, 1),
         "per_training_env_steps_per_s": [round(r, 1) for r in rates],

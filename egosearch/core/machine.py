@@ -25,7 +25,7 @@ def cpu_model() -> str:
 def cpu_vector_unit(cpuinfo: Path = Path("/proc/cpuinfo")) -> str | None:
     """The widest x86 vector unit the CPU offers ("AVX-512", "AVX2", "AVX"), from /proc/cpuinfo's
     flags; None where they cannot be read. Two CPUs of one model name can differ here (an "AMD
-    EPYC" with AVX-512 ran the cpu profile's training about three times as fast as one without),
+    EPYC" with AVX-512 ran the cpu preset's training about three times as fast as one without),
     so speed records carry it beside the name."""
     try:
         for line in cpuinfo.read_text().splitlines():

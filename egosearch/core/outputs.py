@@ -8,7 +8,7 @@ read-only file systems and for pseudo file systems such as /proc.
 It also refuses to overwrite what is kept (:func:`check_overwrites`): an output that is one of the
 command's own inputs, and, unless ``--force``, a stored result. A stored result is a file under
 ``results/`` or ``paper_figs/`` that git tracks, or, where there is no git checkout to ask (an
-unpacked archive, git not installed), one that ``results/<profile>/provenance.json`` lists (and, in
+unpacked archive, git not installed), one that ``results/<preset>/provenance.json`` lists (and, in
 ``paper_figs/``, any file beside a results folder that holds such a record). A file that does not
 exist yet is never a stored result.
 """
@@ -131,7 +131,7 @@ def _git_tracked(root: Path, rels: list[str]) -> set[str] | None:
 
 
 def _provenance_listed(root: Path, rels: list[str]) -> set[str]:
-    """Without git: the files among ``rels`` that a ``results/<profile>/provenance.json`` vouches
+    """Without git: the files among ``rels`` that a ``results/<preset>/provenance.json`` vouches
     for, and every existing file under ``paper_figs/`` when some results folder holds such a record."""
     recorded: dict[str, set[str]] = {}
     for record in sorted((root / "results").glob("*/provenance.json")):

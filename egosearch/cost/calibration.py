@@ -1,4 +1,4 @@
-"""This machine's learner rate: a short real cpu-profile training (``egosearch estimate all`` runs it
+"""This machine's learner rate: a short real cpu-preset training (``egosearch estimate all`` runs it
 when no rate is given), remembered in a cache so that ``snakemake all`` and ``egosearch train`` can say
 how long a run takes here without a minute's wait.
 """
@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 from egosearch.core.machine import cpu_model, cpu_seconds_all, cpu_vector_unit, own_cpu_seconds
-from egosearch.cost.rates import steps_of_profile
+from egosearch.cost.rates import steps_of_preset
 from egosearch.cost.schedule import machine_key
 from egosearch.rl.config import BODY_STEPS
 
@@ -27,23 +27,23 @@ def this_machine() -> dict:
 
 
 def calibrate() -> tuple[float, float | None]:
-    """This machine's env steps per CPU-second in a short real cpu-profile training (~a minute),
+    """This machine's env steps per CPU-second in a short real cpu-preset training (~a minute),
     remembered in :data:`CALIBRATION_CACHE` for this machine, and the cores other processes kept busy
     meanwhile (as ``egosearch bench learner`` records it; None where the system does not say). The
     training's own lines (its evaluations, its config) are held back: the estimate is the answer."""
     # local: loads torch and the simulator, which an estimate from a given --rate never needs
-    from egosearch.rl.bench_learner import cpu_profile_run_steps, training_throughput
+    from egosearch.rl.bench_learner import cpu_preset_run_steps, training_throughput
 
     busy0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
     with contextlib.redirect_stdout(io.StringIO()):
-        rate = float(training_throughput("cpu", env_steps=cpu_profile_run_steps())["env_steps_per_core_s"])
+        rate = float(training_throughput("cpu", env_steps=cpu_preset_run_steps())["env_steps_per_core_s"])
     wall, busy1, own = time.perf_counter() - wall0, cpu_seconds_all(), own_cpu_seconds() - own0
     other = (round(max(0.0, busy1 - busy0 - own) / wall, 2)
              if busy0 is not None and busy1 is not None and wall > 0 else None)
     try:
         CALIBRATION_CACHE.parent.mkdir(parents=True, exist_ok=True)
         CALIBRATION_CACHE.write_text(json.dumps({"machine": machine_key(this_machine()), "rate": rate,
-                                                 "steps": steps_of_profile("cpu"), "other_load_cores": other}))
+                                                 "steps": steps_of_preset("cpu"), "other_load_cores": other}))
     except OSError:
         pass  # a read-only home: the next estimate calibrates again
     return rate, other
@@ -57,7 +57,7 @@ a busy machine: the calibration counts this process's CPU time, but shared cache
 def cached_calibration() -> dict | None:
     """This machine's last calibration as stored (its ``rate`` and the ``other_load_cores`` meanwhile);
     None when it has none, it was another machine's, or it timed another kind of env step than the cpu
-    profile's today."""
+    preset's today."""
     try:
         cached = json.loads(CALIBRATION_CACHE.read_text())
     except (OSError, ValueError):
@@ -65,7 +65,7 @@ def cached_calibration() -> dict | None:
     if not isinstance(cached, dict):
         return None
     here = machine_key(this_machine())
-    same = cached.get("machine") == here and cached.get("steps", BODY_STEPS) == steps_of_profile("cpu")
+    same = cached.get("machine") == here and cached.get("steps", BODY_STEPS) == steps_of_preset("cpu")
     return cached if same and cached.get("rate") else None
 
 

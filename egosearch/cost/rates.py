@@ -19,15 +19,15 @@ from egosearch.report.workflow_jobs import job_cost_s
 from egosearch.rl.config import BODY_STEPS, DECISIONS, field_defaults, load_config
 
 
-def steps_of_profile(profile: str) -> str:
-    """What an env step of ``profile``'s trainings counts (:data:`DECISIONS` at a modular searcher's
-    profile, the cpu profile's while it was one; else :data:`BODY_STEPS`, every profile's today)."""
-    return load_config(profile, {}).env_step_unit
+def steps_of_preset(preset: str) -> str:
+    """What an env step of ``preset``'s trainings counts (:data:`DECISIONS` at a modular searcher's
+    preset, the cpu preset's while it was one; else :data:`BODY_STEPS`, every preset's today)."""
+    return load_config(preset, {}).env_step_unit
 
 
 def steps_of_bench(bench: dict) -> str:
     """What the learner benchmark's ``env_steps_per_core_s_cpu_profile`` counts (records made before the
-    cpu profile became a modular searcher say nothing: body steps)."""
+    cpu preset became a modular searcher say nothing: body steps)."""
     return bench.get("result", {}).get("cpu_profile_steps", BODY_STEPS)
 
 
@@ -91,7 +91,7 @@ def cloning_cpu_s_per_update(results: Path) -> float | None:
 def stored_cpu_s_per_step(record: dict, results: Path, steps_kind: str) -> float | None:
     """The median CPU seconds per env step of the stored trainings whose env step is ``steps_kind``, on
     whatever machines they ran, None when none is stored: the price of a variant whose steps the
-    calibration (the profile's kind) does not measure."""
+    calibration (the preset's kind) does not measure."""
     rates = stored_training_rates(record, results, steps_kind)
     return statistics.median(1.0 / r for r in rates.values()) if rates else None
 

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 
+from egosearch.core.preset_word import with_preset_wildcard
+
 _STAMP = re.compile(r"^\[(\w{3} \w{3} +\d+ \d\d:\d\d:\d\d \d{4})\]$")
 _RULE = re.compile(r"^(?:local)?rule (\w+):$")
 _FIELD = re.compile(r"^\s+(jobid|benchmark|wildcards): (.*)$")
@@ -58,7 +60,8 @@ class RunLog:
 
 
 def _wildcards(text: str) -> dict[str, str]:
-    return dict(part.split("=", 1) for part in text.split(", ") if "=" in part)
+    # a log written before the preset's rename names the wildcard preset=
+    return with_preset_wildcard(dict(part.split("=", 1) for part in text.split(", ") if "=" in part))
 
 
 def read_run_log(path: str | Path) -> RunLog:
@@ -98,10 +101,10 @@ def read_run_log(path: str | Path) -> RunLog:
     return log
 
 
-def dag_id(job: LoggedJob, profile: str) -> str:
+def dag_id(job: LoggedJob, preset: str) -> str:
     """The id :func:`egosearch.workflow.dag.dag_jobs` gives the same job: its benchmark path relative to
-    ``results/<profile>/benchmarks/`` without ``.tsv``, else its rule and wildcard values."""
-    prefix = f"results/{profile}/benchmarks/"
+    ``results/<preset>/benchmarks/`` without ``.tsv``, else its rule and wildcard values."""
+    prefix = f"results/{preset}/benchmarks/"
     if job.benchmark and job.benchmark.startswith(prefix) and job.benchmark.endswith(".tsv"):
         return job.benchmark[len(prefix):-len(".tsv")]
-    return "/".join([job.rule, *(v for k, v in job.wildcards.items() if k != "profile")])
+    return "/".join([job.rule, *(v for k, v in job.wildcards.items() if k != "preset")])

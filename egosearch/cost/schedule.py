@@ -334,7 +334,7 @@ def _record_seconds(row: Mapping) -> float:
 
 def durations_from_provenance(record: Mapping, jobs: Iterable, scale: float | None = None,
                               other_scale: float = 1.0, own_cores: bool = False) -> Durations:
-    """Each DAG job's duration from a provenance record (``results/<profile>/provenance.json``): the
+    """Each DAG job's duration from a provenance record (``results/<preset>/provenance.json``): the
     wall time of the record's row with the job's (rule, job) key, the whole run's (``run_wall_s``)
     for a resumed training. Wall time, not CPU time: the time a user waits, as the record's runs
     spent it (a job that shared its core counts its waits). ``scale`` multiplies the learner-bound

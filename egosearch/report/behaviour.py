@@ -615,11 +615,11 @@ def behaviour_report(paths: Iterable[PathLike], out_prefix: PathLike, pairs: Ite
     return written
 
 
-def block_claims(root: Path, profile: str) -> str:
+def block_claims(root: Path, preset: str) -> str:
     """The README's claims block: the stored claims table, or a line saying it is not stored yet."""
-    path = Path(root) / "paper_figs" / profile / "behaviour_claims.csv"
+    path = Path(root) / "paper_figs" / preset / "behaviour_claims.csv"
     if not path.exists():
         return (f"*Not yet stored: `{path.relative_to(root)}` is missing (traces: "
-                f"`snakemake --cores 2 behaviour --config profile={profile}`).*\n")
+                f"`snakemake --cores 2 behaviour --config preset={preset}`).*\n")
     claims = pd.read_csv(path, keep_default_na=False, na_values=[""])
     return claims_markdown(claims) + f"\nFrom `{path.relative_to(root)}`.\n"

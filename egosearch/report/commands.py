@@ -71,7 +71,7 @@ def cmd_table1(episode_files: Mapping | Iterable[PathLike], out_prefix: PathLike
 def cmd_table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike,
                departures: Iterable[tuple[str, str, str, str]] = ()) -> None:
     """Table 2 from (parameter, setting) rows, e.g. ``egosearch.rl.config.table2_rows(cfg)``, and the
-    profile's departures from the paper (``egosearch.rl.config.departure_rows(cfg)``)."""
+    preset's departures from the paper (``egosearch.rl.config.departure_rows(cfg)``)."""
     table2(rows, out_prefix, departures=departures)
     base = output_base(out_prefix, "table2")
     _say(suffixed(base, e) for e in (".md", ".tex"))

@@ -5,9 +5,9 @@ or any other egosearch module (see ``ARCHITECTURE.md``).
 
 Path patterns (written by ``egosearch evaluate`` / ``train`` / ``fullbody``):
 
-- per-episode evaluation: ``results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv``
-- training curve:         ``results/{profile}/train/{variant}/seed{seed}/curve.csv``
-- full body:              ``results/{profile}/fullbody/{setting}/seed{seed}.csv``
+- per-episode evaluation: ``results/{preset}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv``
+- training curve:         ``results/{preset}/train/{variant}/seed{seed}/curve.csv``
+- full body:              ``results/{preset}/fullbody/{setting}/seed{seed}.csv``
 
 The functions below never glob: callers pass explicit file lists; the path is parsed only to
 learn the seed and which scenario file an episode came from.

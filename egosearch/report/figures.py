@@ -331,7 +331,7 @@ def figure6(curves: Mapping[str, Iterable[PathLike]], out_prefix: PathLike, labe
         ax.set_xlim(left=0)
         ax.yaxis.set_major_locator(MultipleLocator(0.2))
         ax.xaxis.set_major_formatter(FuncFormatter(_steps_formatter))
-        # Beside the axes: inside, any corner would hide a curve or a level at some profile's success rates.
+        # Beside the axes: inside, any corner would hide a curve or a level at some preset's success rates.
         ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), borderaxespad=0.0)
         outs = save_figure(fig, base)
     return [*outs, suffixed(base, ".csv")]

@@ -1,6 +1,6 @@
 """The fresh-set check: the reference's actors on scenario sets the project never stored.
 
-Table 1's scenario sets are fixed and stored, so a profile chosen by reading them could fit them.
+Table 1's scenario sets are fixed and stored, so a preset chosen by reading them could fit them.
 ``snakemake --cores 2 fresh`` draws new sets (another scenario seed, the same homes and cells)
 and evaluates the same actors there. Per cell, and pooled over the homes, this reports success
 on the stored sets, on the fresh sets, and fresh minus stored with an interval.

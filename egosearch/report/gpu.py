@@ -1,10 +1,10 @@
-"""The paper profile on a GPU: the stored GPU check and the projection of the paper profile's ``all``.
+"""The paper preset on a GPU: the stored GPU check and the projection of the paper preset's ``all``.
 
 ``egosearch bench gpu --seconds S --out-dir DIR --out results/paper/gpu_check/gpu_check.json`` on a
-GPU machine stores the learner benchmarks and a paper-profile training of S seconds (its curve.csv
+GPU machine stores the learner benchmarks and a paper-preset training of S seconds (its curve.csv
 and train.csv beside it); ``pytest -m gpu tests/test_cuda.py`` there writes ``cuda_tests.log`` and
 ``cuda_report.json``. This module renders them, and projects the wall time of
-``snakemake --config profile=paper all`` on one such machine from the measured rates, so that no
+``snakemake --config preset=paper all`` on one such machine from the measured rates, so that no
 figure of it is typed. JSON and CSV in, Markdown out.
 """
 
@@ -20,8 +20,8 @@ from egosearch.report.workflow_jobs import job_cost_s, job_study, variants_of_al
 
 GPU_CHECK = Path("results") / "paper" / "gpu_check"
 """Where the GPU check is stored, under the project root."""
-CPU_PROFILE_GPU_CHECK = Path("results") / "cpu" / "gpu_check"
-"""Where the CUDA tests of a later tree are stored, the default (``cpu``) profile's training among them:
+CPU_PRESET_GPU_CHECK = Path("results") / "cpu" / "gpu_check"
+"""Where the CUDA tests of a later tree are stored, the default (``cpu``) preset's training among them:
 ``cuda_tests.log`` and ``cuda_report.json`` as above (``pytest -q``: the summary line, no test names)."""
 
 
@@ -35,27 +35,27 @@ def _record(root: Path) -> dict | None:
     return json.loads(path.read_text(encoding="utf-8")) if path.exists() else None
 
 
-def fullbody_jobs(profile_config: dict) -> int:
-    """Full-body runs per setting of a profile: motion generators x seeds (rules/fullbody.smk)."""
-    fullbody = profile_config["fullbody"]
+def fullbody_jobs(preset_config: dict) -> int:
+    """Full-body runs per setting of a preset: motion generators x seeds (rules/fullbody.smk)."""
+    fullbody = preset_config["fullbody"]
     return len(fullbody["motion_generators"]) * len(fullbody["seeds"])
 
 
 def projection(root: Path) -> dict | None:
-    """Hours of ``snakemake --config profile=paper all`` on the GPU check's machine: its trainings one
+    """Hours of ``snakemake --config preset=paper all`` on the GPU check's machine: its trainings one
     at a time at the measured rate (curve evaluations included), plus the other jobs of ``all``, CPU
-    jobs, from the stored cpu run's recorded costs (the full-body ones scaled to the paper profile's
+    jobs, from the stored cpu run's recorded costs (the full-body ones scaled to the paper preset's
     count of runs) spread over the machine's cores. None without a GPU check."""
     record = _record(root)
     if record is None:
         return None
     run = record["result"]["training"]
     config = workflow_config()
-    paper = config["profiles"]["paper"]
+    paper = config["presets"]["paper"]
     evaluations = run["total_env_steps"] // run["eval_every"] + 1
     train_s = run["total_env_steps"] / run["env_steps_per_s_updating"] + evaluations * run["curve_evaluation_s_mean"]
     trainings = len(variants_of_all(config)) * len(paper["seeds"])
-    scale = fullbody_jobs(paper) / fullbody_jobs(config["profiles"]["cpu"])
+    scale = fullbody_jobs(paper) / fullbody_jobs(config["presets"]["cpu"])
     other_s, provenance = 0.0, root / "results" / "cpu" / "provenance.json"
     if provenance.exists():
         for job in json.loads(provenance.read_text(encoding="utf-8"))["jobs"]:
@@ -88,8 +88,8 @@ def _commit(record: dict) -> str:
     return record["commit"][:7]
 
 
-def block_gpu_projection(root: Path, profile: str) -> str:
-    """The README's lines: the projected wall time of the paper profile's ``all`` on one GPU."""
+def block_gpu_projection(root: Path, preset: str) -> str:
+    """The README's lines: the projected wall time of the paper preset's ``all`` on one GPU."""
     record, p = _record(root), projection(root)
     if record is None or p is None:
         return _missing(root)
@@ -97,10 +97,10 @@ def block_gpu_projection(root: Path, profile: str) -> str:
         return _side_by_side_projection(root, p)
     run = record["result"]["training"]
     return (f"On one {record['machine'].get('gpu', 'GPU')} ({record['machine']['cores']} CPU cores), "
-            f"`snakemake --cores {p['cores']} --config profile=paper all` is projected at **about "
+            f"`snakemake --cores {p['cores']} --config preset=paper all` is projected at **about "
             f"{p['total_h']:.0f} h**: {p['trainings']} trainings of {run['total_env_steps']:,} env steps, one at a "
             f"time, at the measured {run['env_steps_per_s_updating']:.1f} env steps/s"
-            + f" ({p['train_h']:.1f} h each" + ("; the update recorded as CUDA graphs, as the profile does"
+            + f" ({p['train_h']:.1f} h each" + ("; the update recorded as CUDA graphs, as the preset does"
                                                 if _graphed(run) else "") + "), "
             f"plus about {p['other_h']:.1f} h of CPU jobs. Derived from the stored GPU check "
             f"(`{GPU_CHECK}/`, {record['date_utc'][:10]}); how, and what `--executor slurm` needs: "
@@ -117,7 +117,7 @@ def _side_by_side_projection(root: Path, p: dict) -> str:
     side, q = read_side_by_side(root), p["side_by_side"]
     machine = side.get("machine") or {}
     return (f"On one {machine.get('gpu', 'GPU')} ({q['cores']} CPU cores), `snakemake --cores {q['cores']} --config "
-            f"profile=paper all` is projected at **about {q['total_h']:.1f} h**: {side['all_trainings']} trainings, "
+            f"preset=paper all` is projected at **about {q['total_h']:.1f} h**: {side['all_trainings']} trainings, "
             f"{side['all_env_steps']:,} env steps in all, {q['n']} side by side {_under_mps(side)} at the measured "
             f"{side['aggregate_env_steps_per_s']:.0f} env steps/s in all ({q['trainings_h']:.1f} h; one training "
             f"alone: {side['alone_env_steps_per_s']:.1f} env steps/s, "
@@ -185,7 +185,7 @@ def _tests_lines(root: Path) -> list[str]:
     lines += [f"- `{name}`: {status.lower()}" for name, status in results]
     if report.exists():
         r = json.loads(report.read_text(encoding="utf-8"))
-        for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu profile")):
+        for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu preset")):
             if key in r:
                 u = r[key]
                 lines.append(f"- one update, CUDA against CPU from the same weights, optimiser state and batch, TF32 "
@@ -219,7 +219,7 @@ def _baseline_sentence(base: dict, run: dict) -> str:
             f"{run['env_steps_per_s_updating'] / base['env_steps_per_s_updating']:.1f}x.")
 
 
-def block_gpu(root: Path, profile: str) -> str:
+def block_gpu(root: Path, preset: str) -> str:
     """docs/gpu.md: the machine, the CUDA tests, the learner's speed there, the training, the projection."""
     record, p = _record(root), projection(root)
     if record is None or p is None:
@@ -244,11 +244,11 @@ def block_gpu(root: Path, profile: str) -> str:
            f"{result['host_syncs_per_update_table2']} at Table 2"
            + (f" ({result['host_syncs_per_update_table2_graph']} with the graphs)"
               if "host_syncs_per_update_table2_graph" in result else "")
-           + f", {result['host_syncs_per_update_cpu_profile']} for the cpu profile's learner. One is the update's "
+           + f", {result['host_syncs_per_update_cpu_profile']} for the cpu preset's learner. One is the update's "
            "metrics, read back together; where the other comes from was not traced there (on the CPU, nothing "
            "else in an update reads a tensor back)."]
         + ([line] if (line := _compile_line(root)) else []),
-        [f"Paper-profile training (`{run['variant']}`, seed {run['seed']}, its envs on the machine's CPU, one env as "
+        [f"Paper-preset training (`{run['variant']}`, seed {run['seed']}, its envs on the machine's CPU, one env as "
          f"Table 2{', the update recorded as CUDA graphs' if _graphed(run) else ''}): "
          f"{run['env_steps']:,} env steps and {run['updates']:,} updates in "
          f"{run['wall_s']:.0f} s, stopped there with a checkpoint (`--max-wall-s`). "
@@ -257,14 +257,14 @@ def block_gpu(root: Path, profile: str) -> str:
          f"curve evaluation ({run['eval_episodes']} episodes) took {run['curve_evaluation_s_mean']:.1f} s. "
          "`curve.csv`, `train.csv` and `config.json` are beside the record."
          + (_baseline_sentence(result["training_baseline"], run) if "training_baseline" in result else "")],
-        ["Projection of `snakemake --config profile=paper all` on one such machine:", "",
-         f"- {p['trainings']} trainings (the `all` variants x the paper profile's seeds) of "
+        ["Projection of `snakemake --config preset=paper all` on one such machine:", "",
+         f"- {p['trainings']} trainings (the `all` variants x the paper preset's seeds) of "
          f"{run['total_env_steps']:,} env steps at {run['env_steps_per_s_updating']:.1f} env steps/s, with "
          f"{p['evaluations']} curve evaluations each: {p['train_h']:.1f} h a training, {p['trainings_h']:.1f} h "
          "one at a time;",
          f"- the other jobs of `all` are CPU jobs: {p['other_core_h']:.1f} core-hours by the stored cpu run's "
          f"recorded costs (`results/cpu/provenance.json`, full-body runs x{p['fullbody_scale']:.0f} for the paper "
-         f"profile's motion generators and seeds), {p['other_h']:.1f} h on {p['cores']} cores;",
+         f"preset's motion generators and seeds), {p['other_h']:.1f} h on {p['cores']} cores;",
          f"- **about {p['total_h']:.0f} h in all**, an estimate from the measured rates, not a measured run."],
     ]
     sections.append(_side_by_side_lines(root))
@@ -273,27 +273,27 @@ def block_gpu(root: Path, profile: str) -> str:
 
 
 def _cpu_profile_lines(root: Path) -> list[str]:
-    """The CUDA tests rerun on a later tree (:data:`CPU_PROFILE_GPU_CHECK`), and the learner benchmark made on
+    """The CUDA tests rerun on a later tree (:data:`CPU_PRESET_GPU_CHECK`), and the learner benchmark made on
     that machine (a ``bench/hosts/`` record with a GPU)."""
-    log, report = root / CPU_PROFILE_GPU_CHECK / "cuda_tests.log", root / CPU_PROFILE_GPU_CHECK / "cuda_report.json"
+    log, report = root / CPU_PRESET_GPU_CHECK / "cuda_tests.log", root / CPU_PRESET_GPU_CHECK / "cuda_report.json"
     if not log.exists():
         return []
     summary = re.findall(r"^=*\s*(\d+ (?:passed|failed).*?) in [\d.]+s", log.read_text(encoding="utf-8"), flags=re.M)
-    lines = [f"**The CUDA tests on a later tree** (`{CPU_PROFILE_GPU_CHECK}/cuda_tests.log`): "
+    lines = [f"**The CUDA tests on a later tree** (`{CPU_PRESET_GPU_CHECK}/cuda_tests.log`): "
              + (summary[-1] if summary else "no summary line") + "."]
     r = json.loads(report.read_text(encoding="utf-8")) if report.exists() else {}
     if "modular_cpu_profile" in r:
         m = r["modular_cpu_profile"]
-        lines.append(f"- the `cpu` profile of the time, a modular searcher, trained on CUDA in the decision env "
+        lines.append(f"- the `cpu` preset of the time, a modular searcher, trained on CUDA in the decision env "
                      f"({m['env_steps']} decisions, {m['updates']} updates), and its actor walked the body env on the "
                      "CPU as evaluation runs it")
     if "cpu_profile" in r:
         m = r["cpu_profile"]
-        lines.append(f"- the default `cpu` profile (the frontier searcher's demonstrations, the clone, then SAC "
+        lines.append(f"- the default `cpu` preset (the frontier searcher's demonstrations, the clone, then SAC "
                      f"fine-tuning at every body step) trained on CUDA ({m['bc_updates']} cloning steps, "
                      f"{m['env_steps']} env steps, {m['updates']} updates), and its actor and start walked the body "
                      "env on the CPU as evaluation runs them")
-    for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu profile")):
+    for key, label in (("update_paper", "SAC+CURL at Table 2 sizes"), ("update_cpu", "SAC-DrQ, the cpu preset")):
         if key in r:
             u = r[key]
             lines.append(f"- one update, CUDA against CPU ({label}): largest relative difference of a tensor's "
@@ -306,7 +306,7 @@ def _cpu_profile_lines(root: Path) -> list[str]:
             continue
         res = record["result"]
         lines.append(f"- `egosearch bench learner` there ({gpu}, {record['machine'].get('cores')} cores, "
-                     f"{record['date_utc'][:10]}; `{learner.relative_to(root)}`): the `cpu` profile's update "
+                     f"{record['date_utc'][:10]}; `{learner.relative_to(root)}`): the `cpu` preset's update "
                      f"{res.get('updates_per_s_cpu_profile')} updates/s on the GPU, its short training "
                      f"**{res.get('env_steps_per_core_s_cpu_profile')} "
                      f"{'decisions' if res.get('cpu_profile_steps') == 'decisions' else 'env steps'} per "

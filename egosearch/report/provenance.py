@@ -1,4 +1,4 @@
-"""Where results came from: commit, profile, machine, date and the wall time of every rule, and
+"""Where results came from: commit, preset, machine, date and the wall time of every rule, and
 the sha256 of every stored result file, so that a file edited or truncated by hand is caught.
 
 Reads the ``benchmark:`` files Snakemake writes per job (tab-separated, seconds in column ``s``).
@@ -54,7 +54,7 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
     """One row per job: the rule (first folder), the job (rest of the path), its wall time and, where
     the benchmark recorded it, its CPU time (``cpu_s``). A resumed training's benchmark times only
     the part after its resume: ``run_wall_s`` then carries the whole run's wall time, from its
-    ``curve.csv`` beside the benchmarks folder (``results/<profile>/train/<job>/``)."""
+    ``curve.csv`` beside the benchmarks folder (``results/<preset>/train/<job>/``)."""
     rows = []
     for path in sorted(Path(benchmarks_dir).rglob("*.tsv")):
         with open(path, newline="") as f:
@@ -78,7 +78,7 @@ def rule_times(benchmarks_dir: Path) -> list[dict]:
 
 PROVENANCE_NAME = "provenance.json"
 NOT_RESULTS = ("logs", "benchmarks")
-"""Top-level folders of ``results/<profile>/`` that hold no results (job logs and timings)."""
+"""Top-level folders of ``results/<preset>/`` that hold no results (job logs and timings)."""
 WORK_PARTS = ("ckpt", "partial")
 """Folders of a run in progress (checkpoints, a training not yet finished): never a stored result."""
 
@@ -116,7 +116,7 @@ WHEN_AND_WHERE = ("commit", "commit_dirty", "date_utc", "machine")
 
 
 def _same_results(old: dict, new: dict) -> bool:
-    """Whether ``new`` records what ``old`` does: the same stored files (sha256), jobs and profile,
+    """Whether ``new`` records what ``old`` does: the same stored files (sha256), jobs and preset,
     and no new note. A regeneration that rewrites identical files must not rewrite the record: a new
     commit and date in a committed file would say the results changed when none did."""
     if new.get("note", "") != old.get("note", ""):
@@ -234,7 +234,7 @@ def machines_of(jobs: list[dict]) -> list[dict]:
     return sorted(groups.values(), key=lambda m: (m["cpu"] is None, -m["wall_s"]))
 
 
-def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> dict:
+def write_provenance(preset: str, results: Path, out: Path, note: str = "") -> dict:
     """Write the record of ``results`` to ``out`` and return it; when ``out`` already records the same
     stored files (see :func:`_same_results`) it is left as it is and that record is returned. The
     previous record's ``note`` is kept unless a new one is given: a rewrite keeps what it does not
@@ -250,7 +250,7 @@ def write_provenance(profile: str, results: Path, out: Path, note: str = "") -> 
         per_rule[job["rule"]] = round(per_rule.get(job["rule"], 0.0) + job["wall_s"], 1)
     status = _git("status", "--porcelain", "--untracked-files=no")
     record = {
-        "profile": profile,
+        "preset": preset,
         "commit": _git("rev-parse", "HEAD"),
         "commit_dirty": bool(status) if status != "unknown" else None,
         "date_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),

@@ -6,8 +6,8 @@ The README and the pages under ``docs/`` mark generated blocks with HTML comment
     ... replaced by `egosearch report readme` ...
     <!-- egosearch:end table1 -->
 
-Each block name maps to a function that renders Markdown from files under ``paper_figs/<profile>/``
-and ``results/<profile>/`` (paths relative to the project root, whichever page the block is in).
+Each block name maps to a function that renders Markdown from files under ``paper_figs/<preset>/``
+and ``results/<preset>/`` (paths relative to the project root, whichever page the block is in).
 A block may sit in any page (:func:`pages`), or in several. ``egosearch report readme --check``
 fails when a block differs from what the stored files give (a test runs it), so no page can drift
 from the results.
@@ -24,12 +24,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from egosearch.core.preset_word import recorded_preset
 from egosearch.report.behaviour import block_claims
 from egosearch.report.gpu import block_gpu, block_gpu_projection
 from egosearch.report.speed import HOSTS, block_speed, machine_words
 from egosearch.report.stats import cell_contrast
 from egosearch.report.tables import BOTH_HOMES, PAPER_TABLE1
-from egosearch.report.workflow_jobs import job_cost_s, job_study, profile_seeds, workflow_config
+from egosearch.report.workflow_jobs import job_cost_s, job_study, preset_seeds, workflow_config
 
 BLOCK = re.compile(r"(<!-- egosearch:begin (?P<name>[a-z0-9_]+) -->\n)(?P<body>.*?)(<!-- egosearch:end (?P=name) -->)",
                    re.DOTALL)
@@ -43,16 +44,16 @@ def _fmt(x: float, digits: int = 2) -> str:
     return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
 
 
-def block_table1(root: Path, profile: str) -> str:
-    path = root / "paper_figs" / profile / "table1.md"
+def block_table1(root: Path, preset: str) -> str:
+    path = root / "paper_figs" / preset / "table1.md"
     if not path.exists():
         return _missing(root, path)
     return path.read_text(encoding="utf-8").rstrip("\n") + "\n"
 
 
-def block_table1_pooled(root: Path, profile: str) -> str:
+def block_table1_pooled(root: Path, preset: str) -> str:
     """Table 1 with both homes pooled, its notes, and where each home alone is (the README's block)."""
-    path = root / "paper_figs" / profile / "table1.md"
+    path = root / "paper_figs" / preset / "table1.md"
     if not path.exists():
         return _missing(root, path)
     text = path.read_text(encoding="utf-8")
@@ -61,12 +62,12 @@ def block_table1_pooled(root: Path, profile: str) -> str:
                      f"placement-head-on-policy) (`{path.relative_to(root)}`).\n")
 
 
-def stored_teacher(root: Path, profile: str, variant: str) -> str | None:
+def stored_teacher(root: Path, preset: str, variant: str) -> str | None:
     """The searcher a stored variant learned from: its first seed's recorded config's ``demo_teacher`` (its
     done.json), head moving (the reference's body); None when it learned from no demonstrations."""
     from egosearch.searchers import searcher_registry as searchers
 
-    done = root / "results" / profile / "train" / variant / "seed0" / "done.json"
+    done = root / "results" / preset / "train" / variant / "seed0" / "done.json"
     if not done.exists():
         return None
     config = json.loads(done.read_text(encoding="utf-8")).get("config", {})
@@ -75,7 +76,7 @@ def stored_teacher(root: Path, profile: str, variant: str) -> str | None:
     return searchers.with_head(config["demo_teacher"], True)
 
 
-def block_standing(root: Path, profile: str) -> str:
+def block_standing(root: Path, preset: str) -> str:
     """Per Table 1 cell (both homes pooled): the reference against the paper (is the paper's value inside its
     interval?), against Table 1's classical frontier searcher (the stored ``<reference>_vs_frontier.csv``) and
     against the searcher it learned from (its config's ``demo_teacher``: ``<reference>_vs_<teacher>.csv``), and
@@ -83,10 +84,10 @@ def block_standing(root: Path, profile: str) -> str:
     from egosearch.report.tables import BOTH_HOMES
 
     reference = _reference(root)
-    table = root / "paper_figs" / profile / "table1.csv"
-    versus = root / "results" / profile / "compare" / f"{reference}_vs_frontier.csv"
-    teacher = stored_teacher(root, profile, reference)
-    by_teacher = root / "results" / profile / "compare" / f"{reference}_vs_{teacher}.csv" if teacher else None
+    table = root / "paper_figs" / preset / "table1.csv"
+    versus = root / "results" / preset / "compare" / f"{reference}_vs_frontier.csv"
+    teacher = stored_teacher(root, preset, reference)
+    by_teacher = root / "results" / preset / "compare" / f"{reference}_vs_{teacher}.csv" if teacher else None
     for path in (table, versus, by_teacher):
         if path is not None and not path.exists():
             return _missing(root, path)
@@ -134,10 +135,10 @@ def _rise(last, first) -> str:
     return f"{rise:+.2f} [{low:+.2f}, {high:+.2f}]"
 
 
-def block_fig6(root: Path, profile: str) -> str:
+def block_fig6(root: Path, preset: str) -> str:
     """Per variant: success at the first and the last evaluation, the rise between them (what the curve
     says learning adds to its start), and the best mean along the way."""
-    path = root / "paper_figs" / profile / "fig6.csv"
+    path = root / "paper_figs" / preset / "fig6.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
@@ -156,8 +157,8 @@ def block_fig6(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
-    path = root / "paper_figs" / profile / f"{name}.csv"
+def block_fig7(root: Path, preset: str, name: str = "fig7") -> str:
+    path = root / "paper_figs" / preset / f"{name}.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
@@ -171,8 +172,8 @@ def block_fig7(root: Path, profile: str, name: str = "fig7") -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def block_provenance(root: Path, profile: str) -> str:
-    path = root / "results" / profile / "provenance.json"
+def block_provenance(root: Path, preset: str) -> str:
+    path = root / "results" / preset / "provenance.json"
     if not path.exists():
         return _missing(root, path)
     record = json.loads(path.read_text(encoding="utf-8"))
@@ -183,8 +184,8 @@ def block_provenance(root: Path, profile: str) -> str:
     summed = {"all": 0.0, "generalise": 0.0, "other": 0.0}
     ran = [job for job in record["jobs"] if "copy_of" not in job]  # a copied run is counted once, as its source
     for job in ran:
-        summed[job_study(job, config, record["profile"])] += job_cost_s(job)
-    lines = [f"- Profile `{record['profile']}`, provenance written at commit `{record['commit'][:7]}` on "
+        summed[job_study(job, config, recorded_preset(record))] += job_cost_s(job)
+    lines = [f"- Preset `{recorded_preset(record)}`, provenance written at commit `{record['commit'][:7]}` on "
              f"{record['date_utc'][:16].replace('T', ' ')} UTC on {machine_words(machine)}, "
              f"torch {machine.get('torch', '?')}.",
              f"- {len(ran)} jobs, {record['wall_s_all_jobs_summed'] / 3600:.2f} h of job wall time summed"
@@ -198,7 +199,7 @@ def block_provenance(root: Path, profile: str) -> str:
         lines.append("- The jobs ran on: " + "; ".join(
             f"{machine_words(m)} ({m['jobs']} jobs, {m['wall_s'] / 3600:.1f} h)" for m in known)
             + (f"; {unknown} jobs name no machine (recorded before jobs did)" if unknown else "") + ".")
-    estimate_path = root / "results" / profile / "bench" / "estimate_all.json"
+    estimate_path = root / "results" / preset / "bench" / "estimate_all.json"
     if estimate_path.exists():
         e = json.loads(estimate_path.read_text(encoding="utf-8"))
         rates = sorted(e.get("recorded_training_rates", {}).values())
@@ -217,7 +218,7 @@ def block_provenance(root: Path, profile: str) -> str:
             + f". The jobs' CPU time / {e['cores']}, the lower bound this page used to give: "
             f"{e['hours_cpu_over_cores']:.1f} h. `egosearch estimate all --cores N` calibrates for your machine "
             f"in a minute (from `{estimate_path.relative_to(root)}`).")
-        hosts = _host_estimates(root, profile)
+        hosts = _host_estimates(root, preset)
         if hosts:
             lines.append("- The same DAG calibrated on the other machines measured (docs/speed.md): " + "; ".join(hosts)
                          + ".")
@@ -235,10 +236,10 @@ def block_provenance(root: Path, profile: str) -> str:
     return "\n".join(lines) + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def _host_estimates(root: Path, profile: str) -> list[str]:
+def _host_estimates(root: Path, preset: str) -> list[str]:
     """Each ``bench/hosts/<machine>/estimate_all.json`` as words: the machine, the hours, the calibration."""
     out = []
-    for path in sorted((root / "results" / profile / "bench" / HOSTS).glob("*/estimate_all.json")):
+    for path in sorted((root / "results" / preset / "bench" / HOSTS).glob("*/estimate_all.json")):
         e = json.loads(path.read_text(encoding="utf-8"))
         if e.get("hours_here") is None:
             continue
@@ -307,11 +308,11 @@ def comparison_family(stem: str) -> str | None:
     return next((family for family, levers in ABLATION_FAMILIES.items() if candidate in levers), None)
 
 
-def block_compare(root: Path, profile: str, family: str | None = None, unfiled: bool = False) -> str:
-    """Every stored comparison (``results/<profile>/compare/<variant>_vs_<reference>.csv``) of one family of
+def block_compare(root: Path, preset: str, family: str | None = None, unfiled: bool = False) -> str:
+    """Every stored comparison (``results/<preset>/compare/<variant>_vs_<reference>.csv``) of one family of
     levers (:func:`comparison_family`; ``unfiled``: those of none; neither: all), each with its split by shortest
     path where stored."""
-    folder = root / "results" / profile / "compare"
+    folder = root / "results" / preset / "compare"
     paths = _cell_comparisons(folder)
     if family is not None or unfiled:
         paths = [p for p in paths if comparison_family(p.stem) == family]
@@ -351,9 +352,9 @@ def block_compare(root: Path, profile: str, family: str | None = None, unfiled: 
     return "\n".join(parts) + "\n" + note + "\n"
 
 
-def block_power(root: Path, profile: str) -> str:
+def block_power(root: Path, preset: str) -> str:
     """What each stored comparison can detect: ``detectable_80`` of its success rows."""
-    folder = root / "results" / profile / "compare"
+    folder = root / "results" / preset / "compare"
     paths = _cell_comparisons(folder)
     lines = []
     for path in paths:
@@ -375,15 +376,15 @@ def block_power(root: Path, profile: str) -> str:
     return "\n".join(lines) + "\n" if lines else "*No stored comparison yet.*\n"
 
 
-def block_departures(root: Path, profile: str) -> str:
-    """The generated Table 2's list of the profile's learner settings that are not the paper's."""
-    path = root / "paper_figs" / profile / "table2.md"
+def block_departures(root: Path, preset: str) -> str:
+    """The generated Table 2's list of the preset's learner settings that are not the paper's."""
+    path = root / "paper_figs" / preset / "table2.md"
     if not path.exists():
         return _missing(root, path)
     lines = path.read_text(encoding="utf-8").splitlines()
-    start = next((i for i, line in enumerate(lines) if line.startswith("Where this profile departs")), None)
+    start = next((i for i, line in enumerate(lines) if line.startswith("Where this preset departs")), None)
     if start is None:
-        return f"*`{path.relative_to(root)}` lists no departure: this profile is the paper's Table 2.*\n"
+        return f"*`{path.relative_to(root)}` lists no departure: this preset is the paper's Table 2.*\n"
     return "\n".join(lines[start:]).rstrip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
@@ -391,9 +392,9 @@ GENERALISE_SCREEN = "generalise_seed0"
 """The generalisation table of one seed per policy, stored before `snakemake generalise`'s three."""
 
 
-def block_generalise(root: Path, profile: str) -> str:
+def block_generalise(root: Path, preset: str) -> str:
     """The generalisation table (`snakemake generalise`), or its stored one-seed screen, said so."""
-    figs = root / "paper_figs" / profile
+    figs = root / "paper_figs" / preset
     full, screen = figs / "generalise.md", figs / f"{GENERALISE_SCREEN}.md"
     if full.exists():
         text, source = full.read_text(encoding="utf-8"), full
@@ -407,17 +408,17 @@ def block_generalise(root: Path, profile: str) -> str:
             f"`{source.with_suffix('.png').relative_to(root)}`.\n")
 
 
-def block_fresh(root: Path, profile: str) -> str:
+def block_fresh(root: Path, preset: str) -> str:
     """The fresh-set check (`snakemake fresh`): the reference's actors on sets drawn with another seed."""
-    path = root / "paper_figs" / profile / "fresh.md"
+    path = root / "paper_figs" / preset / "fresh.md"
     if not path.exists():
         return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 fresh")
     return path.read_text(encoding="utf-8").rstrip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def block_budget(root: Path, profile: str) -> str:
+def block_budget(root: Path, preset: str) -> str:
     """The budget study's table: success at its cell, env steps and core-hours per learner setting."""
-    path = root / "paper_figs" / profile / "budget.csv"
+    path = root / "paper_figs" / preset / "budget.csv"
     if not path.exists():
         return _missing(root, path).replace("snakemake --cores 2 all", "snakemake --cores 2 budget")
     df = pd.read_csv(path)
@@ -452,23 +453,23 @@ def _contrast_text(res: dict | None, intervals: tuple) -> str:
             f"paired on the {res['n_shared']} draws both cells share")
 
 
-def table1_contrast(root: Path, profile: str, variant: str = "head_on") -> Callable[[tuple, tuple], dict | None]:
+def table1_contrast(root: Path, preset: str, variant: str = "head_on") -> Callable[[tuple, tuple], dict | None]:
     """Cell-minus-cell contrasts of ``variant`` from its stored per-episode files, over every Table 1
-    home it was evaluated in (not the generalisation groups) and the profile's seeds (Table 1's:
-    :func:`profile_seeds`, not the reference's spread seeds stored beside them), each episode joined to
+    home it was evaluated in (not the generalisation groups) and the preset's seeds (Table 1's:
+    :func:`preset_seeds`, not the reference's spread seeds stored beside them), each episode joined to
     its scenario's draw (home, start, target)."""
     config = workflow_config()
-    homes, seeds = set(config["homes"]), profile_seeds(config, profile)
+    homes, seeds = set(config["homes"]), preset_seeds(config, preset)
 
     def cell(height: float, placement: str) -> pd.DataFrame | None:
         frames = []
-        runs = root / "results" / profile / "eval" / variant
+        runs = root / "results" / preset / "eval" / variant
         for seed in seeds:
             for path in sorted((runs / f"seed{seed}").glob(f"*/{placement}/h{height:g}.csv")):
                 home = path.parent.parent.name
                 if home not in homes:
                     continue
-                scen = root / "results" / profile / "scenarios" / home / placement / path.name
+                scen = root / "results" / preset / "scenarios" / home / placement / path.name
                 if not scen.exists():
                     return None
                 eps = pd.read_csv(path).merge(pd.read_csv(scen), on="scenario_id", validate="one_to_one")
@@ -534,9 +535,9 @@ def _reading_table1(df: pd.DataFrame, contrast: Callable[[tuple, tuple], dict | 
     return out
 
 
-def _reading_head(root: Path, profile: str) -> list[str]:
+def _reading_head(root: Path, preset: str) -> list[str]:
     """Head on against head off on every Table 1 scenario (the stored ``head_off_vs_head_on.csv``), per cell."""
-    path = root / "results" / profile / "compare" / "head_off_vs_head_on.csv"
+    path = root / "results" / preset / "compare" / "head_off_vs_head_on.csv"
     if not path.exists():
         return []
     df = pd.read_csv(path)
@@ -578,19 +579,19 @@ def _reading_fig7(df: pd.DataFrame) -> list[str]:
     return out
 
 
-def block_reading(root: Path, profile: str) -> str:
+def block_reading(root: Path, preset: str) -> str:
     """The stored run read against the paper's sentences, written from Table 1's and Figure 7's data and the
     stored head-on against head-off comparison: which claims it reproduces, by how much, and whether the 95%
     intervals are apart."""
-    figs = root / "paper_figs" / profile
+    figs = root / "paper_figs" / preset
     paths = [figs / "table1.csv", figs / "fig7.csv"]
     missing = [p for p in paths if not p.exists()]
     if missing:
         return _missing(root, missing[0])
-    lines = (_reading_table1(pd.read_csv(paths[0]), table1_contrast(root, profile))
-             + _reading_head(root, profile) + _reading_fig7(pd.read_csv(paths[1])))
+    lines = (_reading_table1(pd.read_csv(paths[0]), table1_contrast(root, preset))
+             + _reading_head(root, preset) + _reading_fig7(pd.read_csv(paths[1])))
     return ("\n".join(lines) + "\n\nFrom `" + "`, `".join(str(p.relative_to(root)) for p in paths)
-            + f"`; the height and cabinet contrasts from `results/{profile}/eval/head_on/` and the scenario sets.\n")
+            + f"`; the height and cabinet contrasts from `results/{preset}/eval/head_on/` and the scenario sets.\n")
 
 
 def _reference(root: Path) -> str:
@@ -599,11 +600,11 @@ def _reference(root: Path) -> str:
     return yaml.safe_load((root / "egosearch/workflow/config.yaml").read_text(encoding="utf-8"))["reference_variant"]
 
 
-def block_seed_spread(root: Path, profile: str) -> str:
+def block_seed_spread(root: Path, preset: str) -> str:
     """The reference's seed spread, its null screen before and after the spread counts, the screen's test's
     simulated false-positive rates and the difference a screen of N seeds detects (``snakemake seed_spread``)."""
     reference = _reference(root)
-    folder = root / "results" / profile / "compare"
+    folder = root / "results" / preset / "compare"
     summary_path, null_path = folder / f"seed_spread_{reference}.json", folder / f"null_screen_{reference}.csv"
     if not summary_path.exists() or not null_path.exists():
         return _missing(root, summary_path if not summary_path.exists() else null_path)
@@ -680,28 +681,28 @@ def block_seed_spread(root: Path, profile: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def block_failures(root: Path, profile: str) -> str:
-    """The failure-kind table (``paper_figs/<profile>/failures.md``, rule ``failures``) without its title."""
-    path = root / "paper_figs" / profile / "failures.md"
+def block_failures(root: Path, preset: str) -> str:
+    """The failure-kind table (``paper_figs/<preset>/failures.md``, rule ``failures``) without its title."""
+    path = root / "paper_figs" / preset / "failures.md"
     if not path.exists():
         return _missing(root, path)
     lines = path.read_text(encoding="utf-8").splitlines()
     return "\n".join(line for line in lines if not line.startswith("# ")).strip("\n") + "\n"
 
 
-def block_memory_window(root: Path, profile: str) -> str:
-    """How much memory the search asks for (``paper_figs/<profile>/memory_window.md``, rule ``memory_window``)."""
-    path = root / "paper_figs" / profile / "memory_window.md"
+def block_memory_window(root: Path, preset: str) -> str:
+    """How much memory the search asks for (``paper_figs/<preset>/memory_window.md``, rule ``memory_window``)."""
+    path = root / "paper_figs" / preset / "memory_window.md"
     if not path.exists():
         return _missing(root, path)
     return path.read_text(encoding="utf-8").strip("\n") + f"\n\nFrom `{path.relative_to(root)}`.\n"
 
 
-def block_teacher_tuning(root: Path, profile: str) -> str:
-    """The tuned searcher's tuning run again (``results/<profile>/teacher_tuning/record.json``, rule
+def block_teacher_tuning(root: Path, preset: str) -> str:
+    """The tuned searcher's tuning run again (``results/<preset>/teacher_tuning/record.json``, rule
     ``tune_teacher``): each candidate on the fit split against the untuned searcher, the choice, and the choice
     against the untuned searcher on the held-out split; success paired by scenario, 95% bootstrap intervals."""
-    path = root / "results" / profile / "teacher_tuning" / "record.json"
+    path = root / "results" / preset / "teacher_tuning" / "record.json"
     if not path.exists():
         return (f"*Not run yet: `{path.relative_to(root)}` is missing (`snakemake --cores 1 teacher_tuning`, about "
                 "13,000 episodes).*\n")
@@ -743,9 +744,9 @@ def _reread_conclusion(before: list[str], now: list[str]) -> str:
     return "fewer cells" if set(now) < set(before) else "other cells"
 
 
-def block_screens_reread(root: Path, profile: str) -> str:
+def block_screens_reread(root: Path, preset: str) -> str:
     """Every stored screen, its stored verdict and the seed-spread test's (``screens_reread.csv``)."""
-    path = root / "results" / profile / "compare" / "screens_reread.csv"
+    path = root / "results" / preset / "compare" / "screens_reread.csv"
     if not path.exists():
         return _missing(root, path)
     df = pd.read_csv(path)
@@ -777,12 +778,12 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "standing": block_standing,
     "fig6": block_fig6,
     "fig7": block_fig7,
-    "fig7_oracle": lambda root, profile: block_fig7(root, profile, "fig7_oracle"),
+    "fig7_oracle": lambda root, preset: block_fig7(root, preset, "fig7_oracle"),
     "provenance": block_provenance,
     # the stored comparisons, one block per page of docs/ablations/ and the index's for those of no family
-    **{f"compare_{family}": (lambda root, profile, family=family: block_compare(root, profile, family))
+    **{f"compare_{family}": (lambda root, preset, family=family: block_compare(root, preset, family))
        for family in ABLATION_FAMILIES},
-    "compare_unfiled": lambda root, profile: block_compare(root, profile, unfiled=True),
+    "compare_unfiled": lambda root, preset: block_compare(root, preset, unfiled=True),
     "power": block_power,
     "seed_spread": block_seed_spread,
     "failures": block_failures,
@@ -792,7 +793,7 @@ BLOCKS: dict[str, Callable[[Path, str], str]] = {
     "reading": block_reading,
     "claims": block_claims,  # the paper's behaviour sentences against the per-step traces
     "speed": block_speed,  # the stored benchmark records and trainings' speed
-    "gpu": block_gpu,  # the stored GPU check and the paper profile's projection
+    "gpu": block_gpu,  # the stored GPU check and the paper preset's projection
     "gpu_projection": block_gpu_projection,
 }
 
@@ -817,23 +818,23 @@ def page_root(page: Path) -> Path:
     return page.parent
 
 
-def render_readme(text: str, root: Path, profile: str) -> str:
+def render_readme(text: str, root: Path, preset: str) -> str:
     """``text`` with every marked block replaced by what the stored files give."""
     def replace(match: re.Match) -> str:
         name = match.group("name")
         if name not in BLOCKS:
             raise ValueError(f"README block {name!r} is unknown; known: {', '.join(BLOCKS)}")
-        return match.group(1) + BLOCKS[name](root, profile) + match.group(4)
+        return match.group(1) + BLOCKS[name](root, preset) + match.group(4)
 
     return BLOCK.sub(replace, text)
 
 
-def update_readme(readme: Path, profile: str, check: bool = False, root: Path | None = None) -> bool:
+def update_readme(readme: Path, preset: str, check: bool = False, root: Path | None = None) -> bool:
     """Rewrite the marked blocks of the page ``readme`` (or with ``check`` only compare), reading the stored
     files under ``root`` (default: :func:`page_root`); True when it was up to date."""
     readme = Path(readme)
     text = readme.read_text(encoding="utf-8")
-    rendered = render_readme(text, Path(root) if root is not None else page_root(readme), profile)
+    rendered = render_readme(text, Path(root) if root is not None else page_root(readme), preset)
     if rendered == text:
         return True
     if not check:
@@ -841,6 +842,6 @@ def update_readme(readme: Path, profile: str, check: bool = False, root: Path | 
     return False
 
 
-def update_pages(root: Path, profile: str, check: bool = False) -> list[Path]:
+def update_pages(root: Path, preset: str, check: bool = False) -> list[Path]:
     """:func:`update_readme` on every page of :func:`pages`; the pages that were out of date."""
-    return [page for page in pages(root) if not update_readme(page, profile, check=check, root=root)]
+    return [page for page in pages(root) if not update_readme(page, preset, check=check, root=root)]

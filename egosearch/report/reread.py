@@ -1,6 +1,6 @@
 """The stored screens read again with the test every screen runs now (docs/ablations/reread.md).
 
-A stored screen (``results/<profile>/compare/screen_<candidate>_seed<N>_vs_<reference>[_seed<N>][_in_<home>].csv``
+A stored screen (``results/<preset>/compare/screen_<candidate>_seed<N>_vs_<reference>[_seed<N>][_in_<home>].csv``
 or ``screen_<candidate>_seeds<A>-<B>_vs_<reference>.csv``) was read with the test of its day: a one-seed screen's
 interval resampled the scenarios only, a two-seed screen's counted one seed spread twice, a screen of three
 seeds or more ran the two-level bootstrap. :func:`reread_screens` recomputes each from the same evaluation files

@@ -1,6 +1,6 @@
 """The docs' speed figures, generated from stored benchmark records and training curves.
 
-``egosearch bench env|learner --out results/<profile>/bench/{env,learner}.json`` stores a benchmark's
+``egosearch bench env|learner --out results/<preset>/bench/{env,learner}.json`` stores a benchmark's
 result with its command, date, commit, CPU and the machine's load (:func:`egosearch.sim.bench_env.recorded`);
 :func:`block_speed` renders them, and the env steps per core-second of the stored trainings from
 their ``curve.csv``, so that no speed figure in the docs is typed. CSV and JSON in, Markdown out.
@@ -25,7 +25,7 @@ ENV_TARGETS = {"sensor_frames_per_s": 1000.0, "env_steps_per_s": 700.0}
 UPDATES_TARGET = 12.0
 """The issue's target for SAC+CURL updates/s at Table 2 settings."""
 CORE_S_TARGET = 200.0
-"""The budget issue's target for the learner benchmark's env steps per core-second of a cpu-profile training."""
+"""The budget issue's target for the learner benchmark's env steps per core-second of a cpu-preset training."""
 CORE_S_TARGET_AVX2 = 170.0
 """The same under ``ONEDNN_MAX_CPU_ISA=AVX2`` on the same AVX-512 host."""
 
@@ -36,18 +36,19 @@ LEARNER_KEYS = (
     ("table2_shared", "also reuses the critic's encoder pass for CURL and the actor: one optimiser step stale, "
                       "off by default"),
     ("table2_1thread", "the same on one thread"),
+    # the cpu preset's row, keyed as the stored records spell it (egosearch.core.preset_word)
     ("cpu_profile", "SAC-DrQ with the privileged critic, batch 64, one thread"),
     ("cpu_profile_avx2", "the same with oneDNN limited to AVX2, in its own process"),
 )
 
 
-def _bench_command(profile: str, what: str) -> str:
-    return f"egosearch bench {what} --json --out results/{profile}/bench/{what}.json"
+def _bench_command(preset: str, what: str) -> str:
+    return f"egosearch bench {what} --json --out results/{preset}/bench/{what}.json"
 
 
-def _missing(root: Path, path: Path, profile: str, what: str) -> str:
+def _missing(root: Path, path: Path, preset: str, what: str) -> str:
     return (f"*Not measured yet: `{path.relative_to(root)}` is missing (on an otherwise idle machine: "
-            f"`{_bench_command(profile, what)}`).*")
+            f"`{_bench_command(preset, what)}`).*")
 
 
 def _measured_on(record: dict) -> str:
@@ -67,10 +68,10 @@ def _met(value: float, target: float) -> str:
     return "met" if value >= target else "not met"
 
 
-def _env_lines(root: Path, profile: str) -> list[str]:
-    path = root / "results" / profile / "bench" / "env.json"
+def _env_lines(root: Path, preset: str) -> list[str]:
+    path = root / "results" / preset / "bench" / "env.json"
     if not path.exists():
-        return [_missing(root, path, profile, "env")]
+        return [_missing(root, path, preset, "env")]
     record = json.loads(path.read_text(encoding="utf-8"))
     r = record["result"]
     return [f"Env and sensor, one pinned core, `{r['layout']}` ({r['triangles']:,} triangles): "
@@ -79,13 +80,13 @@ def _env_lines(root: Path, profile: str) -> list[str]:
             f"**{r['env_steps_per_s']:,.0f} env steps/s** ({r['env_ms_per_step']} ms a step, "
             f"{r['env_resets_included']} resets included; target 700: "
             f"{_met(r['env_steps_per_s'], ENV_TARGETS['env_steps_per_s'])}). Measured by "
-            + _measured_on(record) + f"; from `{path.relative_to(root)}`."] + _reward_lines(root, profile)
+            + _measured_on(record) + f"; from `{path.relative_to(root)}`."] + _reward_lines(root, preset)
 
 
-def _reward_lines(root: Path, profile: str) -> list[str]:
-    """What the geodesic progress reward (a training lever) costs per env step against the profile's progress
-    reward, timed side by side on the same actions in one run (``results/<profile>/bench/env_rewards.json``)."""
-    path = root / "results" / profile / "bench" / "env_rewards.json"
+def _reward_lines(root: Path, preset: str) -> list[str]:
+    """What the geodesic progress reward (a training lever) costs per env step against the preset's progress
+    reward, timed side by side on the same actions in one run (``results/<preset>/bench/env_rewards.json``)."""
+    path = root / "results" / preset / "bench" / "env_rewards.json"
     if not path.exists():
         return []
     record = json.loads(path.read_text(encoding="utf-8"))
@@ -98,10 +99,10 @@ def _reward_lines(root: Path, profile: str) -> list[str]:
             + f"; from `{path.relative_to(root)}`."]
 
 
-def _learner_lines(root: Path, profile: str) -> list[str]:
-    path = root / "results" / profile / "bench" / "learner.json"
+def _learner_lines(root: Path, preset: str) -> list[str]:
+    path = root / "results" / preset / "bench" / "learner.json"
     if not path.exists():
-        return [_missing(root, path, profile, "learner")]
+        return [_missing(root, path, preset, "learner")]
     record = json.loads(path.read_text(encoding="utf-8"))
     r = record["result"]
     lines = ["Learner (Table 2 settings: batch 32, 5×84×84, all cores unless stated; updates/s from the median "
@@ -128,7 +129,7 @@ def _learner_lines(root: Path, profile: str) -> list[str]:
                   "every step, not comparable" if decisions else
                   f"the issue's target of {CORE_S_TARGET:g}: {_met(rate, CORE_S_TARGET)}")
         lines.append(f"**`env_steps_per_core_s_cpu_profile` {rate}**: {unit} per core-second of a "
-                     f"{steps}-{'decision' if decisions else 'step'} real training run of the `cpu` profile"
+                     f"{steps}-{'decision' if decisions else 'step'} real training run of the `cpu` preset"
                      + (" (a modular searcher: each decision walks several body steps, planned by the frontier "
                         "searcher)" if decisions else "") + " in `kitchen_living` "
                      f"(building the envs and writing its checkpoint, env stepping, acting and updates all in; "
@@ -158,21 +159,21 @@ def _benchmark_cpu_s(path: Path, run_wall_s: float) -> float | None:
     return cpu if cpu > 0 and wall >= WHOLE_RUN_SHARE * run_wall_s else None
 
 
-def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
+def _training_lines(root: Path, preset: str, variants: list[str]) -> list[str]:
     """Env steps per core-second of every stored training of ``variants``: final env steps over the
     final ``wall_s`` of its curve.csv times its torch threads, and over its job's CPU time where the
     benchmark recorded the whole run. Wall time counts the time a job waited for a core while more
     jobs ran than cores; CPU time does not."""
     rows = []
     for variant in variants:
-        for curve in sorted((root / "results" / profile / "train" / variant).glob("seed*/curve.csv")):
+        for curve in sorted((root / "results" / preset / "train" / variant).glob("seed*/curve.csv")):
             last = pd.read_csv(curve).sort_values("env_steps").iloc[-1]
             threads = 1
             done = curve.parent / "done.json"
             if done.exists():
                 threads = int(json.loads(done.read_text()).get("config", {}).get("num_threads") or 1) or 1
             if not math.isnan(last.get("wall_s", math.nan)):
-                benchmark = root / "results" / profile / "benchmarks" / "train" / variant / f"{curve.parent.name}.tsv"
+                benchmark = root / "results" / preset / "benchmarks" / "train" / variant / f"{curve.parent.name}.tsv"
                 rows.append((variant, curve.parent.name, int(last.env_steps), float(last.wall_s), threads,
                              _benchmark_cpu_s(benchmark, float(last.wall_s)), counts_decisions(curve)))
     if not rows:
@@ -186,15 +187,15 @@ def _training_lines(root: Path, profile: str, variants: list[str]) -> list[str]:
                      f"{wall:,.0f} | {threads} | "
                      f"{steps / (wall * threads):.0f} | {'–' if cpu is None else f'{cpu:,.0f}'} | "
                      f"{'–' if cpu is None else f'{steps / cpu:.0f}'} |")
-    return lines + ["", f"From `results/{profile}/train/<variant>/seed<N>/curve.csv` (last row's `wall_s`) and the "
-                        f"training job's CPU time in `results/{profile}/benchmarks/train/` (– where it does not "
+    return lines + ["", f"From `results/{preset}/train/<variant>/seed<N>/curve.csv` (last row's `wall_s`) and the "
+                        f"training job's CPU time in `results/{preset}/benchmarks/train/` (– where it does not "
                         "cover the whole run: a resumed run's covers its last part). A training that shared its "
                         "core waited part of its wall time; its CPU time is what it cost. A modular searcher's env "
                         "step is a decision (several body steps each), so its rates count decisions."]
 
 
 HOSTS = "hosts"
-"""``results/<profile>/bench/hosts/<machine>/`` (:func:`egosearch.core.machine.machine_folder_name`): the
+"""``results/<preset>/bench/hosts/<machine>/`` (:func:`egosearch.core.machine.machine_folder_name`): the
 learner benchmark (``learner.json``) and the estimate calibrated there (``estimate_all.json``) of a machine
 other than the stored run's benchmark machine."""
 
@@ -205,10 +206,10 @@ def machine_words(m: dict) -> str:
             + f", {m.get('cores') or '?'} cores" + (f", {m['gpu']}" if m.get("gpu") else ""))
 
 
-def _hosts_lines(root: Path, profile: str) -> list[str]:
+def _hosts_lines(root: Path, preset: str) -> list[str]:
     """The learner benchmark and the simulated ``all`` on every machine measured: the stored run's benchmark
     machine (``bench/learner.json``, its estimate ``bench/estimate_all.json``) and each under ``bench/hosts/``."""
-    bench = root / "results" / profile / "bench"
+    bench = root / "results" / preset / "bench"
     hosts = sorted((bench / HOSTS).glob("*/learner.json"))
     if not hosts:
         return []
@@ -217,7 +218,7 @@ def _hosts_lines(root: Path, profile: str) -> list[str]:
     lines = ["The learner benchmark on every machine measured, each otherwise idle (other processes' cores in "
              "brackets), and `snakemake --cores N all` simulated there (`egosearch estimate all`, trainings scaled "
              "by the calibration it ran on that machine):", "",
-             "| machine | records | measured | cpu-profile training per core-second (AVX2) | cpu-profile "
+             "| machine | records | measured | cpu-preset training per core-second (AVX2) | cpu-preset "
              "updates/s | Table 2 updates/s | `all` simulated |",
              "|---|---|---|---|---|---|---|"]
     for learner, estimate, where in rows:
@@ -240,7 +241,7 @@ def _hosts_lines(root: Path, profile: str) -> list[str]:
                      f"{'–' if rate is None else f'{rate} {unit}'}"
                      + (f" ({avx2})" if avx2 is not None else "") + f" | {r.get('updates_per_s_cpu_profile', '–')} | "
                      f"{r.get('updates_per_s_table2', '–')} | {cost} |")
-    folder = f"results/{profile}/bench/{HOSTS}/{MACHINE_PLACEHOLDER}"
+    folder = f"results/{preset}/bench/{HOSTS}/{MACHINE_PLACEHOLDER}"
     return lines + ["", f"Another machine's row: on it, otherwise idle, `egosearch bench learner --json --out "
                         f"{folder}/learner.json` and `egosearch estimate all --cores 2 --out "
                         f"{folder}/estimate_all.json` "
@@ -249,14 +250,14 @@ def _hosts_lines(root: Path, profile: str) -> list[str]:
 
 
 SCHEDULE_CHECKS = "schedule_check*.json"
-"""``results/<profile>/bench/schedule_check*.json``: ``egosearch estimate check --out`` of a finished run."""
+"""``results/<preset>/bench/schedule_check*.json``: ``egosearch estimate check --out`` of a finished run."""
 
 
-def _schedule_check_lines(root: Path, profile: str) -> list[str]:
+def _schedule_check_lines(root: Path, preset: str) -> list[str]:
     """Each stored run set beside the simulation of its own jobs: its elapsed time, the prediction from the
     record before it, and its own job times laid out by the simulation."""
     lines = []
-    for path in sorted((root / "results" / profile / "bench").glob(SCHEDULE_CHECKS)):
+    for path in sorted((root / "results" / preset / "bench").glob(SCHEDULE_CHECKS)):
         c = json.loads(path.read_text(encoding="utf-8"))
         elapsed = c["elapsed_s"]
         lines.append(
@@ -271,11 +272,11 @@ def _schedule_check_lines(root: Path, profile: str) -> list[str]:
         if lines else []
 
 
-def block_speed(root: Path, profile: str) -> str:
+def block_speed(root: Path, preset: str) -> str:
     config = workflow_config()
-    # the profile's pair, and the pairs its claims are also read on (at the cpu profile, the from-scratch one)
-    paired = [v for pair in claims_pairs({**config, "profile": profile}) for v in pair if v not in searchers.bounds()]
-    sections = [_env_lines(root, profile), _learner_lines(root, profile), _hosts_lines(root, profile),
-                _schedule_check_lines(root, profile),
-                _training_lines(root, profile, list(dict.fromkeys(variants_of_all(config) + paired)))]
+    # the preset's pair, and the pairs its claims are also read on (at the cpu preset, the from-scratch one)
+    paired = [v for pair in claims_pairs({**config, "preset": preset}) for v in pair if v not in searchers.bounds()]
+    sections = [_env_lines(root, preset), _learner_lines(root, preset), _hosts_lines(root, preset),
+                _schedule_check_lines(root, preset),
+                _training_lines(root, preset, list(dict.fromkeys(variants_of_all(config) + paired)))]
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"

@@ -356,9 +356,9 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
     order given.
 
     ``rows`` are (parameter, setting) pairs, e.g. ``egosearch.rl.config.table2_rows(cfg)`` (the caller
-    passes them: the report layer does not import the config). ``departures`` (field, this profile,
+    passes them: the report layer does not import the config). ``departures`` (field, this preset,
     paper, field documentation), e.g. ``egosearch.rl.config.departure_rows(cfg)``, add a second
-    table: every learner setting of this profile that is not the paper's.
+    table: every learner setting of this preset that is not the paper's.
     """
     departures = [tuple(str(x) for x in d) for d in departures]
     rows = [(str(a), str(b)) for a, b in rows]
@@ -368,9 +368,9 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
     md = [f"Table 2: {caption}", "", "| Parameter | Setting |", "|---|---|"]
     md += [f"| {_md_escape(a)} | {_md_escape(b)} |" for a, b in rows]
     if departures:
-        md += ["", f"Where this profile departs from the paper ({len(departures)} learner settings; the paper "
-               "profile is Table 2 exactly):", "",
-               "| Field | This profile | Paper | Source and meaning (the field's docstring) |", "|---|---|---|---|"]
+        md += ["", f"Where this preset departs from the paper ({len(departures)} learner settings; the paper "
+               "preset is Table 2 exactly):", "",
+               "| Field | This preset | Paper | Source and meaning (the field's docstring) |", "|---|---|---|---|"]
         md += [f"| `{f}` | {_md_escape(mine)} | {_md_escape(paper)} | {_md_escape(doc)} |"
                for f, mine, paper, doc in departures]
     suffixed(base, ".md").write_text("\n".join(md) + "\n", encoding="utf-8")
@@ -378,7 +378,7 @@ def table2(rows: Iterable[tuple[str, str]], out_prefix: PathLike, caption: str =
            r"Parameter & Setting \\", r"\midrule"]
     tex += [f"{_tex_escape(a)} & {_tex_escape(b)} " + r"\\" for a, b in rows]
     if departures:
-        tex += [r"\midrule", r"\multicolumn{2}{l}{\emph{Departures from the paper (this profile / paper)}} \\"]
+        tex += [r"\midrule", r"\multicolumn{2}{l}{\emph{Departures from the paper (this preset / paper)}} \\"]
         tex += [f"{_tex_escape(f)} & {_tex_escape(mine)} / {_tex_escape(paper)} " + r"\\"
                 for f, mine, paper, _ in departures]
     tex += [r"\bottomrule", r"\end{tabular}", r"\caption{" + _tex_escape(caption) + "}", r"\label{tab:table2}",

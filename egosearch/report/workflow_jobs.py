@@ -44,20 +44,20 @@ def workflow_heights(config: dict) -> list[str]:
 
 
 def claims_pairs(config: dict) -> list[list[str]]:
-    """The pairs the claims are read on at the config's profile: its own ``claims_pairs``, else the top
+    """The pairs the claims are read on at the config's preset: its own ``claims_pairs``, else the top
     level's."""
-    profile = config.get("profiles", {}).get(config.get("profile"), {})
-    return profile.get("claims_pairs", config.get("claims_pairs", []))
+    preset = config.get("presets", {}).get(config.get("preset"), {})
+    return preset.get("claims_pairs", config.get("claims_pairs", []))
 
 
-def profile_seeds(config: dict, profile: str | None = None) -> list[int]:
-    """The training seeds ``all`` trains and Table 1 reads at ``profile`` (the config's own profile unless
-    given): the profile's ``seeds``. Its ``spread_seeds`` beyond them (the reference's, trained for
+def preset_seeds(config: dict, preset: str | None = None) -> list[int]:
+    """The training seeds ``all`` trains and Table 1 reads at ``preset`` (the config's own preset unless
+    given): the preset's ``seeds``. Its ``spread_seeds`` beyond them (the reference's, trained for
     `snakemake seed_spread`) are no part of ``all`` or of its tables."""
-    profile = profile or config["profile"]
-    if profile not in config["profiles"]:
-        raise ValueError(f"profile {profile!r} is not in the config; its profiles: {', '.join(config['profiles'])}")
-    return list(config["profiles"][profile]["seeds"])
+    preset = preset or config["preset"]
+    if preset not in config["presets"]:
+        raise ValueError(f"preset {preset!r} is not in the config; its presets: {', '.join(config['presets'])}")
+    return list(config["presets"][preset]["seeds"])
 
 
 def variants_of_all(config: dict | None = None) -> list[str]:
@@ -66,11 +66,11 @@ def variants_of_all(config: dict | None = None) -> list[str]:
     return list(dict.fromkeys(config["variants"] + [config["reference_variant"]]))
 
 
-def job_study(job: dict, config: dict | None = None, profile: str | None = None) -> str:
+def job_study(job: dict, config: dict | None = None, preset: str | None = None) -> str:
     """Which command a recorded job belongs to: "all", "generalise", or "other" (comparisons,
-    the budget study, the fresh-set check, the traces, the spread seeds). ``profile``: the one the job
-    ran at (a provenance record's ``profile``), the config's own unless given; its seeds
-    (:func:`profile_seeds`) are those ``all`` and ``generalise`` train (a profile the config does not
+    the budget study, the fresh-set check, the traces, the spread seeds). ``preset``: the one the job
+    ran at (a provenance record's ``preset``), the config's own unless given; its seeds
+    (:func:`preset_seeds`) are those ``all`` and ``generalise`` train (a preset the config does not
     list has no known seeds: every seed counts). A policy's job (``train``, ``eval``, ``eval_start``:
     ``variant/seedN/...``) is of ``all`` only for a variant of ``all`` (:func:`variants_of_all`) at one
     of those seeds; a start's evaluation (``eval_start``, what learning adds) is of ``all`` for those
@@ -88,8 +88,8 @@ def job_study(job: dict, config: dict | None = None, profile: str | None = None)
     if rule == "bound":  # a Table 1 bound's evaluation is of all; another searcher's (a memory window, a floor) not
         return "all" if parts[0] in searchers.bounds() else "other"
     if rule in ("train", "eval", "eval_start"):
-        if (profile or config["profile"]) in config["profiles"]:
-            seeds = {f"seed{seed}" for seed in profile_seeds(config, profile)}
+        if (preset or config["preset"]) in config["presets"]:
+            seeds = {f"seed{seed}" for seed in preset_seeds(config, preset)}
             if len(parts) < 2 or parts[1] not in seeds:
                 return "other"
         if parts[0] in of_all:

@@ -6,7 +6,7 @@ searchers for the teacher, runs for the curve evaluations; the cost model reads 
 learner benchmark.
 
 - :mod:`egosearch.rl.config`: ``LearnerConfig`` (the run settings and the learner's own, composed: one
-  config class per learner), ``load_config(profile, overrides)``, ``table2_rows(cfg)``, ``departure_rows(cfg)``;
+  config class per learner), ``load_config(preset, overrides)``, ``table2_rows(cfg)``, ``departure_rows(cfg)``;
 - :mod:`egosearch.rl.config_page`: the docs site's page of every learner's fields (``egosearch config page``);
 - :mod:`egosearch.rl.run_settings`: ``RunSettings``, what every learner and the training loop share;
 - :mod:`egosearch.rl.training_aids`: the aids a learner's settings opt into (``DemonstrationSettings``,
@@ -17,7 +17,7 @@ learner benchmark.
 - :mod:`egosearch.rl.sac_curl_settings`, :mod:`egosearch.rl.sac_drq_settings`,
   :mod:`egosearch.rl.sac_drq_recurrent_settings`, :mod:`egosearch.rl.ppo_settings`: each learner's own
   settings, registered with it in the registry;
-- :mod:`egosearch.rl.profiles`: ``PROFILES`` (smoke / cpu / paper) as data, with their sources;
+- :mod:`egosearch.rl.presets`: ``PRESETS`` (smoke / cpu / paper) as data, with their sources;
 - :mod:`egosearch.rl.learner_registry`: the learners by name (``LEARNERS``, ``register``, ``make_agent``),
   the settings class of each and the actor file formats they write (``actor_loader``); adding a learner
   is one module (and its settings') and one ``register`` line there;
@@ -30,7 +30,7 @@ learner benchmark.
   ``pool_depth``, ``drq_arch``, ``act_with``, SAC-DrQ's actor file, ``PooledAgent``) and ``SacMixin``
   (SAC's temperature and actor step);
 - :mod:`egosearch.rl.sac_curl`: ``SacCurlAgent`` and its networks (the paper's learner);
-- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, SAC with a DrQ-v2-style update (the cpu profile's), and
+- :mod:`egosearch.rl.sac_drq`: ``SacDrqAgent``, SAC with a DrQ-v2-style update (the cpu preset's), and
   ``SacDrqBase``, its SAC set-up and Polyak step, which the recurrent form builds on;
 - :mod:`egosearch.rl.sac_drq_recurrent`: ``SacDrqRecurrentAgent``, SAC-DrQ with a GRU in the actor
   and another in the critic, trained on replayed sequences with burn-in (not the paper's algorithm);

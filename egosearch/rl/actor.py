@@ -77,7 +77,7 @@ class ActorPolicy:
         path = Path(path)
         # torch's own message for a non-torch file advises weights_only=False, which is wrong here.
         not_actor = (f"{path} is not an egosearch actor file; an actor file is the actor.pt that "
-                     "`egosearch train` writes (results/<profile>/train/<variant>/seed<N>/actor.pt)")
+                     "`egosearch train` writes (results/<preset>/train/<variant>/seed<N>/actor.pt)")
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no such actor file" if not path.exists() else not_actor)
         try:

@@ -13,13 +13,13 @@ Keys:
 - ``updates_per_s_table2_shared``: same, with ``share_encoder_forward=True`` (not CURL's math);
 - ``updates_per_s_naive``: CURL's update transcribed line by line (``impl="reference"``);
 - ``updates_per_s_table2_1thread``: the optimised update at Table 2 sizes on ONE thread;
-- ``updates_per_s_cpu_profile``: the ``cpu`` profile's update (its learner, batch and sizes) on its
+- ``updates_per_s_cpu_profile``: the ``cpu`` preset's update (its learner, batch and sizes) on its
   thread count (one);
 - ``env_steps_per_core_s_cpu_profile``: env steps per core-second of a short real training run of
-  the ``cpu`` profile's RL phase (env, acting and updates all in, its imitation phase left out;
+  the ``cpu`` preset's RL phase (env, acting and updates all in, its imitation phase left out;
   ``cpu_profile_run`` has its details), counted in ``cpu_profile_steps`` ("body steps"; "decisions"
-  while the profile was a modular searcher);
-- ``*_avx2`` (on a CPU with AVX-512): the cpu profile's rows again in a process whose oneDNN may
+  while the preset was a modular searcher);
+- ``*_avx2`` (on a CPU with AVX-512): the cpu preset's rows again in a process whose oneDNN may
   use AVX2 at most (``ONEDNN_MAX_CPU_ISA=AVX2``), for what a CPU without AVX-512 pays;
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
 - ``torch_threads``, ``device``, ``cpu``.
@@ -58,7 +58,7 @@ from egosearch.sim.home_pool import curve_homes
 
 @runtime_checkable
 class TrainingRun(Protocol):
-    """What :func:`gpu_check` reads of the training it times: a variant resolved at a learner profile
+    """What :func:`gpu_check` reads of the training it times: a variant resolved at a learner preset
     (:class:`egosearch.variants.ResolvedVariant` is one). The CLI resolves it, and rl/ names only what
     it reads, so that it never imports the variants layer above it."""
 
@@ -92,16 +92,16 @@ def _filled_replay(action_dim: int, device: torch.device, n: int = 600, seed: in
     return buf
 
 
-def time_updates(profile: str = "paper", overrides: dict | None = None, agent_options: dict | None = None,
+def time_updates(preset: str = "paper", overrides: dict | None = None, agent_options: dict | None = None,
                  threads: int | None = None, warmup: int = 3, updates: int = 10,
                  action_dim: int = 5) -> dict[str, float]:
     """Median and best seconds per full update (sampling included); ``agent_options``: keyword arguments
-    of the profile's learner's own constructor (SAC+CURL's ``impl``)."""
+    of the preset's learner's own constructor (SAC+CURL's ``impl``)."""
     before = torch.get_num_threads()
     if threads:
         torch.set_num_threads(threads)
     try:
-        cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
+        cfg = load_config(preset, {**(overrides or {}), "device": "auto"})
         torch.manual_seed(0)
         device = resolve_device(cfg.device)
         state_dim = PRIVILEGED_STATE_DIM if critic_reads_state(cfg) else 0
@@ -122,19 +122,19 @@ def time_updates(profile: str = "paper", overrides: dict | None = None, agent_op
         torch.set_num_threads(before)
 
 
-def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds: int = 15,
+def bench_stacked(seeds: int = 3, preset: str = "cpu", warmup: int = 3, rounds: int = 15,
                   overrides: dict | None = None) -> dict:
     """``egosearch bench stacked``: the update of ``seeds`` seeds stacked as one model
     (:mod:`egosearch.rl.stacked`) against the same seeds' separate updates one after the other, at
-    ``profile``'s learner, batch and sizes and its thread count, each seed sampling its own replay. The
+    ``preset``'s learner, batch and sizes and its thread count, each seed sampling its own replay. The
     two alternate round by round (a round: one update of every seed), so that a shared machine's load
     falls on both alike; the medians and the fastest rounds are reported. The critic warm-up is off
     (``critic_warmup_updates`` 0) so that every update is a whole one, actor and temperature included."""
     from egosearch.rl.stacked import SeedStreams, stack_agents
 
-    cfg = load_config(profile, {**(overrides or {}), "device": "auto"})
+    cfg = load_config(preset, {**(overrides or {}), "device": "auto"})
     if isinstance(cfg, DemonstrationSettings):
-        cfg = load_config(profile, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
+        cfg = load_config(preset, {"critic_warmup_updates": 0, **(overrides or {}), "device": "auto"})
     before = torch.get_num_threads()
     torch.set_num_threads(torch_threads(cfg.num_threads))
     try:
@@ -164,7 +164,7 @@ def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds:
                 times["separate"].append(t1 - t0)
                 times["stacked"].append(t2 - t1)
         median = {k: float(np.median(v)) for k, v in times.items()}
-        return {"profile": profile, "algorithm": cfg.algorithm, "seeds": seeds, "batch_size": cfg.batch_size,
+        return {"preset": preset, "algorithm": cfg.algorithm, "seeds": seeds, "batch_size": cfg.batch_size,
                 "torch_threads": torch.get_num_threads(), "device": str(device), "rounds": rounds,
                 "separate_round_s": round(median["separate"], 4), "stacked_round_s": round(median["stacked"], 4),
                 "separate_round_s_best": round(min(times["separate"]), 4),
@@ -174,8 +174,8 @@ def bench_stacked(seeds: int = 3, profile: str = "cpu", warmup: int = 3, rounds:
         torch.set_num_threads(before)
 
 
-def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: dict | None = None) -> dict:
-    """Env steps per core-second of a short REAL training run of ``profile`` (head-on,
+def training_throughput(preset: str = "cpu", env_steps: int = 3000, overrides: dict | None = None) -> dict:
+    """Env steps per core-second of a short REAL training run of ``preset`` (head-on,
     kitchen_living, everywhere): env stepping, acting and updates all in, its own evaluations
     left out. Core-seconds are this process's CPU time (user + system), so the figure holds on
     a busy machine too. Warm-up is cut to a tenth of the run so that updates weigh as in a long run
@@ -183,17 +183,17 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
 
 
     overrides = overrides or {}
-    full = load_config(profile, overrides)
+    full = load_config(preset, overrides)
     short = {"total_env_steps": env_steps, "init_steps": overrides.get("init_steps", max(1, env_steps // 10)),
              "eval_every": env_steps, "checkpoint_every": env_steps, "log_every": env_steps}
     if demonstration_settings(full).demo_episodes:
-        # A profile that learns from the classical searcher first: the stored rates count its RL phase
+        # A preset that learns from the classical searcher first: the stored rates count its RL phase
         # alone (egosearch.cost.rates), so this run does too. A few demonstrations fill the replay's demo
         # half (an update costs the same whatever they hold), the cloning is cut to a token, the critic's
         # warm-up scaled to the run's share of a whole training; their CPU time is taken off below.
         short.update(demo_episodes=max(2, full.num_envs), bc_updates=min(full.bc_updates, 20), dagger_rounds=0,
                      critic_warmup_updates=round(full.critic_warmup_updates * env_steps / full.total_env_steps))
-    cfg = load_config(profile, {**overrides, **short})
+    cfg = load_config(preset, {**overrides, **short})
     with tempfile.TemporaryDirectory() as out:
         cpu0, wall0 = time.process_time(), time.perf_counter()
         summary = train("EgoSearch-v0", cfg, out, env_kwargs={"layout": "kitchen_living", "placement": "everywhere"},
@@ -207,8 +207,8 @@ def training_throughput(profile: str = "cpu", env_steps: int = 3000, overrides: 
             "env_steps_per_core_s": round(env_steps / rl_cpu, 1), "threads": torch_threads(cfg.num_threads)}
 
 
-def cpu_profile_run_steps(quick: bool = False) -> int:
-    """Env steps of the benchmark's real cpu-profile training: about a minute of it (about 4,000 body steps;
+def cpu_preset_run_steps(quick: bool = False) -> int:
+    """Env steps of the benchmark's real cpu-preset training: about a minute of it (about 4,000 body steps;
     a modular searcher's decision walks several, so fewer decisions), or a few seconds with ``quick``."""
     cfg = load_config("cpu", {})
     if cfg.env_step_unit == DECISIONS:
@@ -218,13 +218,13 @@ def cpu_profile_run_steps(quick: bool = False) -> int:
 
 def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
-    ``cpu_profile_run=False`` leaves out the cpu profile's training run (a GPU check times a real
-    paper-profile training instead)."""
+    ``cpu_profile_run=False`` leaves out the cpu preset's training run (a GPU check times a real
+    paper-preset training instead)."""
     keep_freed_memory()  # as a training does, so that its updates cost here what they cost there
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
     cpu0, own0, wall0 = cpu_seconds_all(), own_cpu_seconds(), time.perf_counter()
-    eager = {"cuda_graph": False}  # the paper profile records its update on a GPU; these rows time it launched eagerly
+    eager = {"cuda_graph": False}  # the paper preset records its update on a GPU; these rows time it launched eagerly
     runs = {
         "table2": time_updates("paper", eager, updates=n),
         "table2_shared": time_updates("paper", {**eager, "share_encoder_forward": True}, updates=n),
@@ -235,8 +235,9 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         runs["table2_graph"] = time_updates("paper", {"cuda_graph": True}, warmup=8, updates=n)
     cpu_cfg = load_config("cpu", {})
     cpu_threads = torch_threads(cpu_cfg.num_threads)
+    # "cpu_profile": the record keys keep the word the stored benchmarks were written with (core.preset_word)
     runs["cpu_profile"] = time_updates("cpu", threads=cpu_threads, updates=2 * n)
-    throughput = training_throughput("cpu", env_steps=cpu_profile_run_steps(quick)) if cpu_profile_run else None
+    throughput = training_throughput("cpu", env_steps=cpu_preset_run_steps(quick)) if cpu_profile_run else None
     # oneDNN picks its kernels once per process, so the AVX2-limited rows need a process of their own
     avx2 = (_avx2_limited_cpu_profile(quick, cpu_profile_run)
             if cpu_vector_unit() == "AVX-512" and resolve_device("auto").type == "cpu" else None)
@@ -268,8 +269,8 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     return result
 
 
-def cpu_profile_rows(quick: bool, cpu_profile_run: bool) -> dict:
-    """The cpu profile's update rate and, with ``cpu_profile_run``, its short training's env steps per
+def cpu_preset_rows(quick: bool, cpu_profile_run: bool) -> dict:
+    """The cpu preset's update rate and, with ``cpu_profile_run``, its short training's env steps per
     core-second, as :func:`bench_learner` names them (without a suffix)."""
     keep_freed_memory()
     n = 3 if quick else 10
@@ -278,16 +279,16 @@ def cpu_profile_rows(quick: bool, cpu_profile_run: bool) -> dict:
     rows = {"updates_per_s_cpu_profile": round(1.0 / r["median_s"], 2)}
     if cpu_profile_run:
         rows["env_steps_per_core_s_cpu_profile"] = training_throughput(
-            "cpu", env_steps=cpu_profile_run_steps(quick))["env_steps_per_core_s"]
+            "cpu", env_steps=cpu_preset_run_steps(quick))["env_steps_per_core_s"]
     return rows
 
 
 def _avx2_limited_cpu_profile(quick: bool, cpu_profile_run: bool) -> dict | None:
-    """:func:`cpu_profile_rows` in a child process whose oneDNN may use AVX2 at most
+    """:func:`cpu_preset_rows` in a child process whose oneDNN may use AVX2 at most
     (``ONEDNN_MAX_CPU_ISA=AVX2``): what the same update costs on a CPU without AVX-512. None if the
     child fails (its error is printed)."""
-    code = ("import json, sys; from egosearch.rl.bench_learner import cpu_profile_rows; "
-            f"print(json.dumps(cpu_profile_rows({quick!r}, {cpu_profile_run!r})))")
+    code = ("import json, sys; from egosearch.rl.bench_learner import cpu_preset_rows; "
+            f"print(json.dumps(cpu_preset_rows({quick!r}, {cpu_profile_run!r})))")
     child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                            env={**os.environ, "ONEDNN_MAX_CPU_ISA": "AVX2"})
     if child.returncode != 0:
@@ -296,7 +297,7 @@ def _avx2_limited_cpu_profile(quick: bool, cpu_profile_run: bool) -> dict | None
     return json.loads(child.stdout.strip().splitlines()[-1])
 
 
-def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: dict | None = None) -> float | None:
+def host_syncs_per_update(preset: str = "paper", updates: int = 6, overrides: dict | None = None) -> float | None:
     """Host-device synchronisations per full update (replay sampling excluded), counted with
     torch's CUDA sync debug mode; None off CUDA. The update's metrics are read back in ONE sync
     (``metric_values``); anything above 1 is a round trip inside the update. The first 6 updates
@@ -305,7 +306,7 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
 
     if not torch.cuda.is_available():
         return None
-    cfg = load_config(profile, {**(overrides or {}), "device": "cuda"})
+    cfg = load_config(preset, {**(overrides or {}), "device": "cuda"})
     torch.manual_seed(0)
     state_dim = PRIVILEGED_STATE_DIM if critic_reads_state(cfg) else 0
     agent = make_agent(cfg, 5, 30, 4, torch.device("cuda"), state_dim)
@@ -328,8 +329,8 @@ def host_syncs_per_update(profile: str = "paper", updates: int = 6, overrides: d
 
 def gpu_check(seconds: float, out_dir: str, run: TrainingRun, overrides: dict | None = None,
               baseline_seconds: float = 0.0) -> dict:
-    """The paper profile on this machine's accelerator: the learner benchmarks, then a real training
-    of ``run`` (a variant resolved at the paper profile, :func:`egosearch.variants.resolve_variant`;
+    """The paper preset on this machine's accelerator: the learner benchmarks, then a real training
+    of ``run`` (a variant resolved at the paper preset, :func:`egosearch.variants.resolve_variant`;
     its curve evaluations included) for ``seconds`` of wall time, stopped with a checkpoint
     (``egosearch train --max-wall-s`` resumes it). The run's curve.csv, train.csv and config.json are
     left in ``out_dir``; ``overrides`` are the config fields the caller resolved ``run`` with, for the

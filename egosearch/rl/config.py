@@ -1,5 +1,5 @@
 """A learner's config: the run settings every learner shares, composed with the learner's own settings;
-the profiles (smoke, cpu, paper); and Table 2, generated from a config.
+the presets (smoke, cpu, paper); and Table 2, generated from a config.
 
 A training's config is :class:`LearnerConfig`: the :class:`egosearch.rl.run_settings.RunSettings` (env
 steps, envs, evaluation, checkpoints, device, ...), the observation options' fields, and the settings class
@@ -14,12 +14,12 @@ is built, before any work. Each field carries its own docstring saying where the
 github.com/MishaLaskin/curl, which Table 2 follows almost line by line) or "ours" (engineering choices of
 this project that do not change the algorithm).
 
-Profiles (:mod:`egosearch.rl.profiles`, data) are named value sets applied on top of the defaults:
+Presets (:mod:`egosearch.rl.presets`, data) are named value sets applied on top of the defaults:
 
 - ``paper``: Table 2 exactly (and CURL's defaults for what Table 2 does not list);
 - ``cpu``:   the default: a cheaper learner (SAC with a DrQ-v2-style update, not CURL) and
   training-only aids, so that policies search within the 2-core machine's budget (see
-  :func:`cpu_profile` for what it changes and the measurements behind it);
+  :func:`cpu_preset` for what it changes and the measurements behind it);
 - ``smoke``: a training run that finishes in seconds, to exercise the plumbing.
 
 ``table2_rows(cfg)`` renders a config as the (parameter, setting) rows of Table 2, in the
@@ -38,12 +38,12 @@ from typing import Any
 
 from egosearch.rl.learner_registry import ALGORITHMS, LEARNERS, learner  # the registered learners and their settings
 from egosearch.rl.network_settings import ACTIVATIONS, NetworkSettings, PooledSettings, RandomShiftSettings, SacSettings
-from egosearch.rl.profiles import (
-    PROFILES,
-    SMOKE_LEARNER_PROFILE,
-    cpu_profile,
-    paper_profile,
-    smoke_profile,
+from egosearch.rl.presets import (
+    PRESETS,
+    SMOKE_LEARNER_PRESET,
+    cpu_preset,
+    paper_preset,
+    smoke_preset,
     smoke_sized,
 )
 from egosearch.rl.run_settings import (
@@ -215,8 +215,8 @@ def refuse_foreign_fields(algorithm: str, values: dict[str, Any]) -> None:
 
 def _without_aids_left_off(klass: type[LearnerConfig], values: dict[str, Any]) -> dict[str, Any]:
     """``values`` less the training aids' fields that ``klass``'s learner does not have and that ``values`` set to
-    their defaults (the aid off): a variant that turns the cpu profile's aids off (``head_on_from_scratch``)
-    asks, at a profile whose learner has none (smoke's SAC+CURL), for what that learner already is."""
+    their defaults (the aid off): a variant that turns the cpu preset's aids off (``head_on_from_scratch``)
+    asks, at a preset whose learner has none (smoke's SAC+CURL), for what that learner already is."""
     own = {f.name for f in fields(klass)}
     off = {f.name: f.default for aid in TRAINING_AIDS for f in fields(aid) if f.name not in own}
     return {k: v for k, v in values.items() if k not in off or v != off[k]}
@@ -241,18 +241,18 @@ def _refuse_foreign(klass: type[LearnerConfig], values: dict[str, Any]) -> None:
         raise ValueError(f"unknown LearnerConfig field {key!r}{hint} for algorithm {mine}; {listed}")
 
 
-def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None) -> LearnerConfig:
-    """The config of ``profile`` with ``overrides`` on top, validated.
+def load_config(preset: str = "paper", overrides: dict[str, Any] | None = None) -> LearnerConfig:
+    """The config of ``preset`` with ``overrides`` on top, validated.
 
-    A profile is for every learner: the learner takes the profile's values of the fields it has (the
+    A preset is for every learner: the learner takes the preset's values of the fields it has (the
     demonstration fields and ``critic_privileged_state`` only where its settings include those training aids,
     :mod:`egosearch.rl.training_aids`), so a learner pins nothing it does not use.
     An override of a field the learner does not have (but a training aid's set to its default, off), an
-    unknown profile or field name and an out-of-range value are one-line ``ValueError``s.
+    unknown preset or field name and an out-of-range value are one-line ``ValueError``s.
     """
-    if profile not in PROFILES:
-        raise ValueError(f"unknown profile {profile!r}; allowed: {', '.join(PROFILES)}")
-    base, overrides = PROFILES[profile](), dict(overrides or {})
+    if preset not in PRESETS:
+        raise ValueError(f"unknown preset {preset!r}; allowed: {', '.join(PRESETS)}")
+    base, overrides = PRESETS[preset](), dict(overrides or {})
     klass = config_class(overrides.get("algorithm", base.get("algorithm", DEFAULT_ALGORITHM)))
     overrides = _without_aids_left_off(klass, overrides)
     _refuse_foreign(klass, overrides)
@@ -260,20 +260,20 @@ def load_config(profile: str = "paper", overrides: dict[str, Any] | None = None)
     return klass(**{**{k: v for k, v in base.items() if k in own}, **overrides}).validate()
 
 
-def load_variant_config(profile: str, variant_fields: dict[str, Any] | None = None,
+def load_variant_config(preset: str, variant_fields: dict[str, Any] | None = None,
                         overrides: dict[str, Any] | None = None) -> LearnerConfig:
-    """The config a training of a variant runs at ``profile``: the profile's, with the variant's fields
+    """The config a training of a variant runs at ``preset``: the preset's, with the variant's fields
     (``variant_fields``, its file's ``config``) on top, then the caller's ``overrides`` (seed, threads).
 
-    At ``smoke`` a variant keeps the learner and levers it has at the ``cpu`` profile (SAC-DrQ for ``head_on``,
-    SAC + CURL where it pins ``sac_curl``), every size of the run capped at the smoke profile's whatever the
-    variant pins (:func:`egosearch.rl.profiles.smoke_sized`): so that a ``cpu`` lever runs at smoke, minutes long.
-    The training, the cost line and the reading of a run's profile all take a variant's config from here."""
+    At ``smoke`` a variant keeps the learner and levers it has at the ``cpu`` preset (SAC-DrQ for ``head_on``,
+    SAC + CURL where it pins ``sac_curl``), every size of the run capped at the smoke preset's whatever the
+    variant pins (:func:`egosearch.rl.presets.smoke_sized`): so that a ``cpu`` lever runs at smoke, minutes long.
+    The training, the cost line and the reading of a run's preset all take a variant's config from here."""
     variant_fields, overrides = dict(variant_fields or {}), dict(overrides or {})
-    if profile != "smoke":
-        return load_config(profile, {**variant_fields, **overrides})
-    sized = smoke_sized(load_config(SMOKE_LEARNER_PROFILE, variant_fields).to_dict())
-    return load_config(profile, {**sized, **overrides})
+    if preset != "smoke":
+        return load_config(preset, {**variant_fields, **overrides})
+    sized = smoke_sized(load_config(SMOKE_LEARNER_PRESET, variant_fields).to_dict())
+    return load_config(preset, {**sized, **overrides})
 
 
 # ---- Table 2 --------------------------------------------------------------------------------
@@ -291,7 +291,7 @@ def _steps(n: int) -> str:
 def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
     """``cfg`` as the (parameter, setting) rows of the paper's Table 2, same order and wording.
 
-    With the ``paper`` profile this reproduces Table 2 exactly (e.g. ("Batch-size", "32"),
+    With the ``paper`` preset this reproduces Table 2 exactly (e.g. ("Batch-size", "32"),
     ("Replay buffer", "100000"), ("Number of training steps", "0.75M")). A row whose setting the learner
     does not have (PPO has no temperature) reads "none".
     """
@@ -381,8 +381,8 @@ def field_docs() -> dict[str, str]:
 
 def departure_rows(cfg: LearnerConfig) -> list[tuple[str, str, str, str]]:
     """(field, this config's value, the paper's value, where each comes from) for every field that
-    differs from the paper profile, housekeeping fields excepted: what a profile changes, generated.
-    The paper's value of a field is its default (the ``paper`` profile sets housekeeping alone)."""
+    differs from the paper preset, housekeeping fields excepted: what a preset changes, generated.
+    The paper's value of a field is its default (the ``paper`` preset sets housekeeping alone)."""
     paper, docs = field_defaults(), field_docs()
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
@@ -423,19 +423,19 @@ def first_sentence(doc: str) -> str:
     return doc.rstrip(".") + "." if doc else ""
 
 
-def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, Any] | None = None,
+def config_sources(algorithm: str, preset: str, variant_overrides: dict[str, Any] | None = None,
                    variant: str = "", set_overrides: dict[str, Any] | None = None) -> list[dict[str, str]]:
-    """Every field of ``algorithm``'s config at ``profile`` (with a variant's overrides on top, and the command
+    """Every field of ``algorithm``'s config at ``preset`` (with a variant's overrides on top, and the command
     line's ``--set`` overrides on top of those), in :func:`field_order`: its value, where the value comes from
-    (the field's default, the profile, the variant, ``--set``), the paper's value, the settings class and module
+    (the field's default, the preset, the variant, ``--set``), the paper's value, the settings class and module
     that declare it, its docstring's first sentence (``doc``) and its whole docstring (``doc_full``). What
     ``egosearch config show`` prints."""
     overrides = {**(variant_overrides or {}), **(set_overrides or {}), "algorithm": algorithm}
-    cfg = load_variant_config(profile, {**(variant_overrides or {}), "algorithm": algorithm}, set_overrides)
-    # at smoke a variant has its cpu config, each size capped (load_variant_config): the cpu profile is its base
-    base_profile = SMOKE_LEARNER_PROFILE if profile == "smoke" else profile
-    uncapped = load_config(base_profile, overrides) if profile == "smoke" else cfg
-    base, paper, docs = PROFILES[base_profile](), field_defaults(), field_docs()
+    cfg = load_variant_config(preset, {**(variant_overrides or {}), "algorithm": algorithm}, set_overrides)
+    # at smoke a variant has its cpu config, each size capped (load_variant_config): the cpu preset is its base
+    base_preset = SMOKE_LEARNER_PRESET if preset == "smoke" else preset
+    uncapped = load_config(base_preset, overrides) if preset == "smoke" else cfg
+    base, paper, docs = PRESETS[base_preset](), field_defaults(), field_docs()
     rows = []
     for name in sorted((f.name for f in fields(cfg)), key=field_order().index):
         owner = declaring_class(name, type(cfg))
@@ -448,7 +448,7 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
         elif name == "algorithm":
             source = "asked"
         elif name in base:
-            source = f"profile {base_profile}"
+            source = f"preset {base_preset}"
         else:
             source = "default"
         doc = docs.get(name, "")
@@ -460,12 +460,12 @@ def config_sources(algorithm: str, profile: str, variant_overrides: dict[str, An
 
 
 TABLE2_PAPER: tuple[tuple[str, str], ...] = tuple(table2_rows(LearnerConfig()))
-"""Table 2 as printed in the paper (the ``paper`` profile rendered by :func:`table2_rows`)."""
+"""Table 2 as printed in the paper (the ``paper`` preset rendered by :func:`table2_rows`)."""
 
 __all__ = ["ACTIVATIONS", "ALGORITHMS", "BODY_STEPS", "CURRICULUM_END_RADIUS", "CURRICULUM_START_RADIUS",
-           "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PROFILES",
+           "DECISIONS", "DEMO_TEACHERS", "DISTANCE_REWARDS", "HOUSEKEEPING_FIELDS", "PRESETS",
            "RESUMABLE_FIELDS",
-           "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_profile", "declaring_class",
+           "TABLE2_PAPER", "LearnerConfig", "config_class", "config_sources", "cpu_preset", "declaring_class",
            "departure_rows", "field_defaults", "field_docs", "field_order", "field_types", "first_sentence",
            "format_set", "identity_set", "load_config", "load_variant_config",
-           "own_settings", "paper_profile", "refuse_foreign_fields", "settings_classes", "smoke_profile", "table2_rows"]
+           "own_settings", "paper_preset", "refuse_foreign_fields", "settings_classes", "smoke_preset", "table2_rows"]

@@ -4,10 +4,10 @@ without the site. Never kept in git: a new learner or field is on it without a f
 
 One table of the fields every learner shares (the run settings and the observation options'), then one per
 registered learner of the fields it adds (the training aids it opts into, the building blocks its settings
-are made of, its own). Each row: the field, its paper value (its default), the ``cpu`` profile's value where
-the profile sets it, the settings class that declares it and its whole docstring. So a reader opens one file
-for one learner's config, whichever files declare it; ``egosearch config show ALGORITHM --profile P`` gives
-the same fields at any profile, with a variant on top.
+are made of, its own). Each row: the field, its paper value (its default), the ``cpu`` preset's value where
+the preset sets it, the settings class that declares it and its whole docstring. So a reader opens one file
+for one learner's config, whichever files declare it; ``egosearch config show ALGORITHM --preset P`` gives
+the same fields at any preset, with a variant on top.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from egosearch.rl.config import (
     shared_fields,
 )
 from egosearch.rl.learner_registry import LEARNERS
-from egosearch.rl.profiles import PROFILES
+from egosearch.rl.presets import PRESETS
 
 CONFIG_PAGE = "docs/config.md"
 """Where ``egosearch config page`` writes it by default (git-ignored; the docs build makes its own)."""
@@ -35,10 +35,10 @@ _HEAD = """# Every learner's config
 
 A learner's config is the fields every learner shares (the run settings and the observation options') and
 the fields its settings add: the training aids it opts into, the networks and SAC's settings it is built from,
-and its own. Each row gives the paper's value (the field's default; the `paper` profile changes only
-housekeeping), the `cpu` profile's value where that profile sets one, the settings class that declares the
+and its own. Each row gives the paper's value (the field's default; the `paper` preset changes only
+housekeeping), the `cpu` preset's value where that preset sets one, the settings class that declares the
 field, and the field's docstring, which names where its value comes from. `egosearch config show ALGORITHM
---profile P [--variant V]` prints the same fields at any profile, with a variant's values on top.
+--preset P [--variant V]` prints the same fields at any preset, with a variant's values on top.
 """
 
 
@@ -47,12 +47,12 @@ def _cell(text: str) -> str:
 
 
 def _table(algorithm: str, names: list[str]) -> list[str]:
-    defaults, docs, cpu, klass = field_defaults(), field_docs(), PROFILES["cpu"](), config_class(algorithm)
+    defaults, docs, cpu, klass = field_defaults(), field_docs(), PRESETS["cpu"](), config_class(algorithm)
     rows = ["| field | paper | cpu | declared in | what it is |", "|---|---|---|---|---|"]
     for name in names:
         owner = declaring_class(name, klass)
-        profile = repr(cpu[name]) if name in cpu and name != "algorithm" else ""
-        rows.append(f"| `{name}` | `{defaults[name]!r}` | {f'`{profile}`' if profile else ''} | "
+        preset = repr(cpu[name]) if name in cpu and name != "algorithm" else ""
+        rows.append(f"| `{name}` | `{defaults[name]!r}` | {f'`{preset}`' if preset else ''} | "
                     f"`{owner.__module__}.{owner.__name__}` | {_cell(docs.get(name, ''))} |")
     return rows
 

@@ -20,7 +20,7 @@ returns).
 A file is read only after its checks, each one line naming it (:class:`DemonstrationsError`):
 :func:`check_demonstrations` reads the summary and the ``.npz``'s header (a truncated or corrupt file, a summary
 that does not describe its ``.npz``), and compares the summary with what a run needs (:func:`wanted_summary`:
-another variant's, teacher's, profile's or observation's demonstrations are refused).
+another variant's, teacher's, preset's or observation's demonstrations are refused).
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ MATCHED = ("variant", "env_id", "env_kwargs", "teacher", "seed", "episodes", "fr
 def replay_downsample(cfg) -> int:
     """How the depth frames are pooled where the learner's replay stores them: ``obs_downsample`` for a
     learner whose replay pools them (SAC-DrQ, its recurrent form, PPO: ``egosearch.rl.pooled.PooledAgent``), 1
-    for one that stores the env's frames (SAC+CURL, the paper profile's learner, has no such field: its
+    for one that stores the env's frames (SAC+CURL, the paper preset's learner, has no such field: its
     config does not hold it, which is not a second default of it)."""
     return int(cfg.obs_downsample) if "obs_downsample" in cfg.to_dict() else 1
 

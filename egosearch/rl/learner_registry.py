@@ -36,7 +36,7 @@ class Learner:
     ``settings``: the dataclass of its own settings (or ``"module:Class"``), which
     :mod:`egosearch.rl.config` composes with the run settings into its config; None: the run settings alone;
     ``stacked``: its seeds can train in one process, their updates vmapped (:mod:`egosearch.rl.stacked`);
-    ``smoke_overrides``: config fields on top of the ``smoke`` profile that make its networks test-sized (the
+    ``smoke_overrides``: config fields on top of the ``smoke`` preset that make its networks test-sized (the
     tests build every registered learner with them)."""
 
     name: str

@@ -153,7 +153,7 @@ class PooledSettings:
     the 100 x 100 depth frames are average-pooled by this
     factor before the encoder (2 -> 50 x 50), as PointNav learners train from 64 x 64 depth
     (Shacklett et al., bps-nav, ICLR 2021). The env, its mask and success test stay at 100 x 100.
-    The ``cpu`` profile sets 2 (see :func:`cpu_profile`)."""
+    The ``cpu`` preset sets 2 (see :func:`cpu_preset`)."""
     encoder_stride2_layers: int = 1
     """CURL: 1 (the first conv has stride 2, the rest stride 1). The pooled learners (sac_drq,
     sac_drq_recurrent, ppo): the first this many convs have stride 2 (smaller maps, far fewer FLOPs)."""

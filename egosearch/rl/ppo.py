@@ -1,6 +1,6 @@
-"""PPO on SAC-DrQ's actor: a learner that spends cheap env steps (not the paper's, nor a profile's).
+"""PPO on SAC-DrQ's actor: a learner that spends cheap env steps (not the paper's, nor a preset's).
 
-A lever for the searcher's ceiling: SAC replays each transition many times (the cpu profile:
+A lever for the searcher's ceiling: SAC replays each transition many times (the cpu preset:
 16 sampled transitions per env step), PPO (Schulman et al. 2017) uses each one a few times
 (``ppo_epochs``) and then drops it, so the same core-hours buy several times the env steps, as
 habitat-baselines trains PointNav / ObjectNav (DD-PPO, Wijmans et al. 2020). An on-policy

@@ -16,7 +16,7 @@ from egosearch.rl.training_aids import PrivilegedCriticSettings
 class PpoSettings(PrivilegedCriticSettings, NetworkSettings, PooledSettings):
     """The settings PPO reads beyond the run settings (a privileged value network, not demonstrations)."""
 
-    # "ppo" only: PPO is a CHANGE OF ALGORITHM (the paper's learner is SAC + CURL) and no profile uses it.
+    # "ppo" only: PPO is a CHANGE OF ALGORITHM (the paper's learner is SAC + CURL) and no preset uses it.
     # A rollout is the last ``update_every`` env steps (``update_every / num_envs`` per env); an update
     # is ``ppo_epochs`` passes over it in ``ppo_minibatches`` minibatches (each an Adam step of the actor,
     # at ``actor_lr``, and of the value network, at ``critic_lr``).

@@ -35,7 +35,7 @@ DISTANCE_REWARDS = ("distance", "progress", "geodesic")
 LONG_RUN_BOUNDS = {
     "total_env_steps": (20_000_000, "env steps (about 27x Table 2's 750,000)"),
     "eval_episodes": (10_000, "episodes a curve point (the most scenarios of one set, `egosearch scenarios --n`)"),
-    "demo_episodes": (100_000, "demonstration episodes (about 67x the cpu profile's 1,500)"),
+    "demo_episodes": (100_000, "demonstration episodes (about 67x the cpu preset's 1,500)"),
 }
 """The most a training may ask for (``total_env_steps``, ``eval_episodes``, ``demo_episodes``) without
 ``--allow-long`` (``egosearch train``, ``demos``, ``evaluate --curve-of``, ``variant check``) or ``--config
@@ -69,28 +69,28 @@ class RunSettings:
     """Table 2 "Discount rate gamma"."""
     total_env_steps: int = 750_000
     """Table 2 "Number of training steps" 0.75M: environment steps (simulation samples, paper
-    4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` profile trains 200k body
-    steps, the 2-core budget's (see :func:`cpu_profile`); a modular searcher (``modular_searcher``) counts
+    4.2: "0.75 million simulation samples"), not gradient updates. The ``cpu`` preset trains 200k body
+    steps, the 2-core budget's (see :func:`cpu_preset`); a modular searcher (``modular_searcher``) counts
     decisions of several body steps instead (``head_on_modular``: 30k)."""
     batch_size: int = 32
     """Table 2 "Batch-size": transitions per gradient update (also the CURL negatives + 1)."""
 
-    # ---- the learner, the envs and their training-only aids (the cpu profile's departures) ----
+    # ---- the learner, the envs and their training-only aids (the cpu preset's departures) ----
     algorithm: str = "sac_curl"
     """Paper 4.2 / Table 2: "sac_curl" = SAC + CURL (:mod:`egosearch.rl.sac_curl`).
     "sac_drq" = ours, after DrQ-v2 (Yarats et al. 2021): SAC with ONE conv encoder trained by
     the critic only, random-shift augmentation, no contrastive loss and no target encoder
     (:mod:`egosearch.rl.sac_drq`); an update costs ~3 conv passes instead of CURL's ~9. This
-    CHANGES THE ALGORITHM: the cpu profile uses it, the paper profile never.
+    CHANGES THE ALGORITHM: the cpu preset uses it, the paper preset never.
     "sac_drq_recurrent" = ours, SAC-DrQ with a GRU memory in the actor and a separate one in the
     critic, trained on replayed sequences with burn-in (:mod:`egosearch.rl.sac_drq_recurrent`;
     Ni et al. 2022, Kapturowski et al. 2019): a recurrent policy, which CHANGES THE ALGORITHM
-    further (the paper's policy sees only the last ``frame_history`` frames); no profile uses it,
+    further (the paper's policy sees only the last ``frame_history`` frames); no preset uses it,
     a variant sets it. Every "sac_drq" field applies to it as well but ``critic_layer_norm`` and the
     reconstruction decoder's (``encoder_aux_loss``, ``encoder_aux_weight``); it adds its own memory fields.
     "ppo" = ours, PPO (Schulman et al. 2017) on SAC-DrQ's actor, with a separate value network
     (:mod:`egosearch.rl.ppo`): an on-policy learner, which CHANGES THE ALGORITHM (the paper's is
-    SAC + CURL); no profile uses it, a variant sets it (see the "ppo_*" fields)."""
+    SAC + CURL); no preset uses it, a variant sets it (see the "ppo_*" fields)."""
     num_envs: int = 1
     """Ours (CURL: 1): environments stepped in lockstep in one process, their actions computed
     in one batched forward pass (acting cost per env step falls ~N-fold). Each env has its own
@@ -105,14 +105,14 @@ class RunSettings:
     (EgoSearch-v0 -> EgoSearchMemory-v0, EgoSearchNoHead-v0 -> EgoSearchNoHeadMemory-v0), whose
     observation also carries where the target was last seen, by the searcher's own odometry, and
     the steps since (``egosearch.sim.env``): the same as naming that id in the variant file. This
-    CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` profile sets it, with
-    ``obs_downsample`` 2 (see :func:`cpu_profile` for the comparison that chose them); the paper
-    profile never."""
+    CHANGES THE OBSERVATION, for the actor and at evaluation too. The ``cpu`` preset sets it, with
+    ``obs_downsample`` 2 (see :func:`cpu_preset` for the comparison that chose them); the paper
+    preset never."""
     modular_searcher: bool = False
     """Paper: False (the policy acts at every body step: its steps, turns and head). True: a modular
     searcher (SemExp, Chaplot et al. NeurIPS 2020; the modular pipeline of Gervet et al. 2023; the stored
-    ``head_on_modular`` pair, the ``cpu`` profile's before it learned at every body step, see
-    :func:`cpu_profile`): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
+    ``head_on_modular`` pair, the ``cpu`` preset's before it learned at every body step, see
+    :func:`cpu_preset`): the policy trains, and so is evaluated, in the ``*Modular-v0`` env of
     its variant's head (EgoSearch-v0 -> EgoSearchModular-v0, EgoSearchNoHead-v0 ->
     EgoSearchNoHeadModular-v0; ``egosearch.searchers.modular``): it decides only where to explore (a
     point on its own floor map, walked to as the nearest reachable frontier) and how to sweep the head,
@@ -127,9 +127,9 @@ class RunSettings:
     2019's form, which the paper cites; potential-based shaping as in habitat-lab). "geodesic" =
     the decrease of the geodesic distance to where the target counts as found, at every step,
     seen or not (habitat-lab's DistanceToGoalReward), with the collision term unclipped (the
-    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``cpu`` profile's since
+    paper's stops growing at 30 collisions): a CHANGE OF THE REWARD, the ``cpu`` preset's since
     the stuck-student redo (``ablations/head_on_geodesic_finetune.yaml`` screened it on three seeds;
-    before it the profile took "progress"). TRAINING ONLY: evaluation always scores the paper's task
+    before it the preset took "progress"). TRAINING ONLY: evaluation always scores the paper's task
     (success, SPL), whatever the training reward. A variant's ``train_env: distance_reward``
     takes precedence."""
     curriculum_steps: int = 0
@@ -151,8 +151,8 @@ class RunSettings:
     (plus the per-step noise). Otherwise training heights are drawn from [this, 1.8] m. The
     paper's Section 5 names randomising the abstract model's height as the way to cover
     characters of other heights; its learner transfers from [1.0, 1.8] m down to the 0.45 m
-    camera of Table 1, the smaller learner of the cpu profile did not (its searches at 0.45 m
-    collided twice as often as at 1.05 m), so the cpu profile trains at every Table 1 height.
+    camera of Table 1, the smaller learner of the cpu preset did not (its searches at 0.45 m
+    collided twice as often as at 1.05 m), so the cpu preset trains at every Table 1 height.
     TRAINING ONLY: evaluation uses the stored scenarios' fixed heights."""
 
     # ---- training loop (CURL defaults or ours) ------------------------------------------
@@ -164,7 +164,7 @@ class RunSettings:
     """Ours (CURL: 1): gradient updates done each time updates are due; the update-to-data
     ratio is ``updates_per_step / update_every``."""
     eval_every: int = 10_000
-    """Ours: environment steps between evaluations (a row of curve.csv each; the ``cpu`` profile: 20k)."""
+    """Ours: environment steps between evaluations (a row of curve.csv each; the ``cpu`` preset: 20k)."""
     eval_episodes: int = 10
     """Ours (CURL: 10): deterministic episodes of the default evaluation. At most 10,000 unless the run allows
     more (``--allow-long``; :data:`LONG_RUN_BOUNDS`)."""
@@ -176,7 +176,7 @@ class RunSettings:
     stored sets; 0: none. The memory levers set 50k (their issue asks for the actors at 50k, 100k and 200k)."""
     checkpoint_every: int = 10_000
     """Ours: environment steps between resumable checkpoints (atomic writes). A checkpoint ends every env's
-    episode, so that a resumed run equals one that was not stopped: the ``cpu`` profile checkpoints every 20k."""
+    episode, so that a resumed run equals one that was not stopped: the ``cpu`` preset checkpoints every 20k."""
     seed: int = 1
     """Ours: seeds torch, numpy, python's random, the env and its action space."""
 
@@ -199,7 +199,7 @@ class RunSettings:
     one (``egosearch.rl.cuda_graph``). The same math, with capturable Adam; the random numbers
     come from torch's CUDA generator at other offsets than an eager update's. Used only where it
     applies: algorithm sac_curl on CUDA without ``compile``; the other learners and the CPU ignore
-    it. The ``paper`` profile turns it on: on an H200 both the update and a paper-profile training
+    it. The ``paper`` preset turns it on: on an H200 both the update and a paper-preset training
     ran several times faster with it (docs/gpu.md gives the stored measurement)."""
     keep_checkpoint: bool = False
     """Ours: keep the last checkpoint (agent + optimisers + replay) after training finishes;

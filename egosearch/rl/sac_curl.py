@@ -595,7 +595,7 @@ class SacCurlAgent(SacMixin, AgentBase):
         reads it. ``ActorNet(arch)`` loads ``state_dict`` (casting back to float32).
 
         Floating weights are stored as ``storage_dtype``: float16 halves the file (the conv-to-128
-        projection alone is 2.5M weights at the cpu profile), keeping a committed actor under
+        projection alone is 2.5M weights at the cpu preset), keeping a committed actor under
         10 MB; actions then differ from the live agent's by ~1e-3. :func:`load_actor_net` rounds
         through float16 whatever the storage, so every reported number is of the float16 actor."""
         weights = actor_weights({"convs": self.critic.convs, "head": self.actor}, storage_dtype)

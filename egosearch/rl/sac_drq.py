@@ -1,4 +1,4 @@
-"""SAC with a DrQ-v2-style update: the cpu profile's cheaper learner (not the paper's CURL).
+"""SAC with a DrQ-v2-style update: the cpu preset's cheaper learner (not the paper's CURL).
 
 What it keeps from SAC + CURL (:mod:`egosearch.rl.sac_curl`): the soft actor-critic losses,
 twin critics with Polyak targets, the tanh-Gaussian actor, the automatic temperature, the inputs
@@ -182,7 +182,7 @@ class DrqCritic(nn.Module):
 class FrameDecoder(nn.Module):
     """SAC-AE's auxiliary (``encoder_aux_loss: reconstruction``): conv features -> the newest pooled
     depth frame, in the encoder's input scale [-0.5, 0.5]. Fully connected, because the pooled
-    frames are small (25 x 25 at the cpu profile)."""
+    frames are small (25 x 25 at the cpu preset)."""
 
     def __init__(self, conv_dim: int, hidden_dim: int, side: int):
         super().__init__()

@@ -1,6 +1,6 @@
 """Recurrent SAC-DrQ: :mod:`egosearch.rl.sac_drq` with a GRU memory in the actor and in the critic.
 
-NOT the paper's learner, nor the cpu profile's: a lever for the searcher's ceiling. The
+NOT the paper's learner, nor the cpu preset's: a lever for the searcher's ceiling. The
 memoryless learners see the last ``frame_history`` depth frames and nothing older, so a search
 cannot know where it has already looked. Here the actor and the critic each carry a GRU state
 over the whole episode.

@@ -1,4 +1,4 @@
-"""SAC-DrQ's own settings (the cpu profile's learner, :mod:`egosearch.rl.sac_drq`): its pooled input and
+"""SAC-DrQ's own settings (the cpu preset's learner, :mod:`egosearch.rl.sac_drq`): its pooled input and
 random shift, and the two changes of its critic and encoder a lever may make; beside them the networks
 and SAC's settings of :mod:`egosearch.rl.network_settings` and the training aids of
 :mod:`egosearch.rl.training_aids`. Registered with the learner in
@@ -27,7 +27,7 @@ class SacDrqSettings(PrivilegedCriticSettings, DemonstrationSettings, SacSetting
     every hidden Linear layer of each Q-function MLP, before its activation, as RLPD (Ball et al. 2023,
     *Efficient online reinforcement learning with offline data*) found needed to keep a critic that
     learns from demonstrations in every batch from extrapolating wildly. A change of the critic's
-    architecture: the ``head_on_imitation_finetune_critic_ln`` lever, no profile's default."""
+    architecture: the ``head_on_imitation_finetune_critic_ln`` lever, no preset's default."""
 
     encoder_aux_loss: str = "none"
     """Paper: "none" for "sac_drq" (the paper's encoder has CURL's contrastive loss beside the
@@ -37,7 +37,7 @@ class SacDrqSettings(PrivilegedCriticSettings, DemonstrationSettings, SacSetting
     pooled and shifted as the encoder saw it, from the conv features, and its squared error trains
     the encoder beside the critic's loss, so the features the actor reads keep the free space a
     critic with the privileged state may not need. A loss the paper's learner does not have: it
-    CHANGES THE ALGORITHM; the ``head_on_encoder_aux`` lever, no profile's default. TRAINING ONLY:
+    CHANGES THE ALGORITHM; the ``head_on_encoder_aux`` lever, no preset's default. TRAINING ONLY:
     the decoder is not part of the actor file."""
     encoder_aux_weight: float = 1.0
     """SAC-AE (Yarats et al. 2019): 1 on pixels in [-0.5, 0.5]: the weight of

@@ -4,7 +4,7 @@
 ``train_stacked(env_id, cfgs, out_dirs)`` runs one :class:`egosearch.rl.train.LiveRun` per seed:
 each has its own envs, replay, CSV logs, evaluator, checkpoint and actor files in its own folder,
 written exactly as :func:`egosearch.rl.train.train` writes them (the same paths,
-``results/<profile>/train/<variant>/seed<k>/``, and the same formats), and each draws from its own
+``results/<preset>/train/<variant>/seed<k>/``, and the same formats), and each draws from its own
 random streams (:class:`egosearch.rl.stacked.SeedStreams`: every torch, numpy and python draw of seed
 ``k``, acting, sampling and the update's, is made from seed ``k``'s states, which its checkpoint
 saves). Only the gradient updates are one stacked model. The seeds step in lockstep, so they share

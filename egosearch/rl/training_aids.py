@@ -1,10 +1,10 @@
 """Training aids a learner's settings opt into: a privileged critic and learning from the classical searcher's
 demonstrations (cloning, DAgger, the critic's warm-up, demonstrations in replay, the cloning term).
 
-Neither is the paper's (its critic sees what the actor sees and it has no teacher); the ``cpu`` profile uses
-both (see :func:`egosearch.rl.profiles.cpu_profile`). A learner's settings class that reads one lists its
+Neither is the paper's (its critic sees what the actor sees and it has no teacher); the ``cpu`` preset uses
+both (see :func:`egosearch.rl.presets.cpu_preset`). A learner's settings class that reads one lists its
 class among its bases (SAC-DrQ's and recurrent SAC-DrQ's both, PPO's the privileged critic), so its config
-has those fields and no other learner's does: a profile's values of them reach only the learners that have
+has those fields and no other learner's does: a preset's values of them reach only the learners that have
 them, and a variant that sets one for another learner is refused in one line. The training loop, the
 demonstrations and the cost model read them through :func:`demonstration_settings` and
 :func:`critic_reads_state`, which give a learner without the piece its defaults (no teacher, no state).
@@ -42,13 +42,13 @@ class PrivilegedCriticSettings:
     ``egosearch.sim.env.privileged_state``) beside the observation, as Baisero & Amato 2022 advise
     (history + state, not state alone). The actor, and so every policy and actor file, sees only
     the observation. This CHANGES THE ALGORITHM. TRAINING ONLY: evaluation never uses it. The
-    ``cpu`` profile sets it (see :func:`cpu_profile` for the comparison that chose it)."""
+    ``cpu`` preset sets it (see :func:`cpu_preset` for the comparison that chose it)."""
 
 
 @dataclass
 class DemonstrationSettings:
-    """Learning from the classical searcher's demonstrations, the ``cpu`` profile's (see its
-    :func:`egosearch.rl.profiles.cpu_profile`): TRAINING ONLY, each a CHANGE OF ALGORITHM (a teacher the
+    """Learning from the classical searcher's demonstrations, the ``cpu`` preset's (see its
+    :func:`egosearch.rl.presets.cpu_preset`): TRAINING ONLY, each a CHANGE OF ALGORITHM (a teacher the
     paper's learner does not have). The actor, its file and every evaluation are as without them."""
 
     shown_after: ClassVar[str] = "train_height_min"
@@ -61,14 +61,14 @@ class DemonstrationSettings:
     seeded by ``seed``), for ``bc_updates``, ``demo_batch_fraction`` and ``bc_weight``. Learning from
     frontier-exploration demonstrations before RL: PIRLNav (Ramrakhya et al., CVPR 2023); demonstrations
     kept in replay: RLPD (Ball et al., ICML 2023). Their collection is part of the training's time. The
-    ``cpu`` profile: 1,500 (see :func:`cpu_profile`). At most 100,000 unless the run allows more
+    ``cpu`` preset: 1,500 (see :func:`cpu_preset`). At most 100,000 unless the run allows more
     (``--allow-long``; ``egosearch.rl.run_settings.LONG_RUN_BOUNDS``)."""
     demo_teacher: str = "frontier"
     """Ours (with ``demo_episodes`` >= 1): the classical searcher whose episodes are the demonstrations, one
     of :data:`DEMO_TEACHERS`. "frontier", the project's default: the untuned frontier searcher, Table 1's
     classical row (``egosearch.searchers.frontier``). "frontier_tuned": the same searcher tuned on
     training-side sets (``egosearch.searchers.frontier_tuned``, its own bound row; ``egosearch tune`` redoes
-    the tuning), the ``cpu`` profile's since the stuck-student redo (it was "frontier" before). Either holds
+    the tuning), the ``cpu`` preset's since the stuck-student redo (it was "frontier" before). Either holds
     its head fixed where the body has none (the head-off variant learns from the head-fixed teacher)."""
     bc_updates: int = 0
     """Paper: 0. PIRLNav's first phase (Ramrakhya et al. 2023: behaviour cloning, then RL fine-tuning):
@@ -76,7 +76,7 @@ class DemonstrationSettings:
     ``batch_size`` demonstration transitions each (squared error between the actor's mean action, after
     its tanh, and the teacher's; the random shift as in updates). The warm-up's ``init_steps`` then
     act with the cloned policy instead of at random. The step-0 row of curve.csv is the cloned policy. The
-    ``cpu`` profile: 12,000."""
+    ``cpu`` preset: 12,000."""
     dagger_rounds: int = 0
     """Paper: 0. DAgger (Ross, Gordon & Bagnell 2011), after ``bc_updates``: this many rounds in which the
     cloned student drives ``dagger_episodes`` training-side episodes (its mean action), the teacher labels
@@ -97,24 +97,24 @@ class DemonstrationSettings:
     """PIRLNav (Ramrakhya et al. 2023: the critic learns first, the cloned policy frozen, so that
     the first policy steps follow a critic fitted to it): the first this many RL updates train only
     the critic's projection and Q-heads; the encoder, the actor and the temperature stay as cloned. The
-    ``cpu`` profile: 2,500."""
+    ``cpu`` preset: 2,500."""
     demo_batch_fraction: float = 0.0
     """RLPD (Ball et al. 2023: 0.5, "symmetric sampling"): this fraction of every update's batch is
     drawn from the demonstrations, the rest from the online replay. 0: online only (the paper). The ``cpu``
-    profile: 0.5."""
+    preset: 0.5."""
     bc_weight: float = 0.0
     """TD3+BC (Fujimoto & Gu 2021: the actor's loss plus a squared error to the data's action, weighted
     against the critic's scale; their alpha 2.5 is a weight of 1 / 2.5 = 0.4 here), the optional term of
     RLPD-style training: the actor's SAC loss plus ``bc_weight`` x mean |Q| x the squared error
     between its mean action and the teacher's on the batch's demonstration rows. It decays linearly to
     0 over the first ``bc_decay_steps`` env steps, so that RL may leave the teacher. 0: none. The ``cpu``
-    profile: 0.4."""
+    preset: 0.4."""
     bc_decay_steps: int = 0
     """Ours (with ``bc_weight``): env steps over which the behaviour-cloning term falls to 0 (to
-    ``bc_weight_floor``, when set). The ``cpu`` profile: 100k, half its run."""
+    ``bc_weight_floor``, when set). The ``cpu`` preset: 100k, half its run."""
     bc_weight_floor: float = 0.0
     """Ours (with ``bc_weight``), 0: the behaviour-cloning term decays to nothing, so after ``bc_decay_steps``
-    RL alone moves the student (the ``cpu`` profile, whose curve stops rising there). > 0: the weight never
+    RL alone moves the student (the ``cpu`` preset, whose curve stops rising there). > 0: the weight never
     falls below this, so the teacher's detours around furniture keep pulling on the actor for the whole run
     (a lever of the stuck-student issue, ``ablations/head_on_cloning_floor.yaml``; RLPD and TD3+BC keep a
     constant weight). At most ``bc_weight``."""
@@ -135,7 +135,7 @@ class DemonstrationSettings:
                 "bc_weight": self.bc_weight > 0}
         for name, used in uses.items():
             if used and self.demo_episodes == 0:
-                # the cpu profile sets them all: name every one that needs turning off with the teacher
+                # the cpu preset sets them all: name every one that needs turning off with the teacher
                 on = [f"{n}: 0" for n in ("bc_updates", "critic_warmup_updates", "demo_batch_fraction", "bc_weight",
                                           "bc_decay_steps") if getattr(self, n)]
                 if self.demo_teacher != "frontier":

@@ -4,7 +4,7 @@ makes and the env it acts in, and what the tables, figures and workflow say of i
 :data:`SEARCHERS` holds one :class:`Searcher` per name, in registration order; :func:`names` is every
 name ``--policy`` takes besides ``actor`` (a trained actor, with ``--weights``), :func:`bounds` the
 rows Table 1 sets beside each policy. A searcher's evaluations sit where a variant's would
-(``results/<profile>/eval/<name>/``), so no variant may take one of these names. Adding a searcher is
+(``results/<preset>/eval/<name>/``), so no variant may take one of these names. Adding a searcher is
 one module with its policy (``reset(seed=None)`` and ``act(obs)``:
 :class:`egosearch.searchers.policies.Policy`) and one :func:`register` line below; the CLI, Table 1,
 the path-length report, Figure 6, the workflow's checks and the Snakemake rules read this registry.
@@ -161,20 +161,20 @@ register("frontier_head_off", "egosearch.searchers.frontier:FrontierPolicy", env
          path_style=("#bd9e39", ":", "D"),
          fig6_level=("classical searcher, head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)), "#777777"))
 # The frontier searcher tuned on training-side sets (egosearch.searchers.frontier_tuned), a bound row of its
-# own: the untuned rows above stay Table 1's classical reference. It is the cpu profile's teacher
+# own: the untuned rows above stay Table 1's classical reference. It is the cpu preset's teacher
 # (demo_teacher) since the stuck-student redo, so Figure 6 draws it as a level too.
 register("frontier_tuned", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy", head=True,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
          label="frontier searcher, tuned", bound=True, classical=True, path_style=("#637939", "-.", "P"),
          what="the frontier searcher with its parameters tuned on training-side sets only (generated homes, "
               "other scenario seeds), never on Table 1's",
-         fig6_level=("tuned searcher (the cpu profile's teacher), head moving", "-.", "#637939"))
+         fig6_level=("tuned searcher (the cpu preset's teacher), head moving", "-.", "#637939"))
 register("frontier_tuned_head_off", "egosearch.searchers.frontier_tuned:FrontierTunedPolicy",
          env_id="EgoSearchNoHead-v0", head=False,
          help="the same tuned on training-side sets: a teacher and a bound of its own",
          label="frontier searcher, tuned, head fixed", what="the same with the camera fixed to the body",
          bound=True, classical=True, path_style=("#8ca252", ":", "X"),
-         fig6_level=("tuned searcher (the cpu profile's teacher), head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)),
+         fig6_level=("tuned searcher (the cpu preset's teacher), head fixed", (0, (5, 1.5, 1, 1.5, 1, 1.5)),
                      "#8ca252"))
 # The tuned searcher held to its last K steps (egosearch.searchers.frontier: memory_window): how much memory the
 # task asks for, against the student's 5 frames (`snakemake memory_window`, docs/baselines.md). Not Table 1 rows.

@@ -2,7 +2,7 @@
 building a generated home costs against a training episode, per episode and with the pool.
 
 ``--out`` stores a benchmark's result with what it was measured on (:func:`recorded`): the docs' speed
-figures are generated from such files (``results/<profile>/bench/*.json``), never typed.
+figures are generated from such files (``results/<preset>/bench/*.json``), never typed.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def one_core():
 
 
 REWARDS_TIMED = ("progress", "geodesic")
-"""The training r_d forms ``bench env`` times side by side: the cpu profile's and the geodesic lever's."""
+"""The training r_d forms ``bench env`` times side by side: the cpu preset's and the geodesic lever's."""
 REWARD_ROUNDS = 6
 OPTIONS_TIMED = ("map_image", "strided_history")
 """The memory levers' observation options ``bench env`` times beside the env without them, in the same run."""
@@ -115,7 +115,7 @@ def bench_homes(n_homes: int = 6, first_seed: int = 0, episodes: int = 3, seed: 
     included) against the seconds of a training episode, on one core.
 
     A training episode costs its env steps plus the learner's share; the learner's share is taken
-    from the cpu profile's measured rate (``learner_env_steps_per_core_s`` env steps per core-second
+    from the cpu preset's measured rate (``learner_env_steps_per_core_s`` env steps per core-second
     of a whole training, env included, ``egosearch bench learner``). ``build_share_per_episode`` is
     the share of training time a new home per episode would take; ``build_share_pooled`` the share
     with :class:`egosearch.sim.home_pool.HomePoolEnv`'s pool (one build every ``episodes_per_swap``

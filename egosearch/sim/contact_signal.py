@@ -58,6 +58,6 @@ class ContactSignalSettings:
     whose top is below the view): the env's ``contact_signal`` option, whose ``proprio`` gains a bump bit
     and the collisions of the last 5 steps / 5 (``egosearch.sim.contact_signal``). It keeps the variant's env
     id (an env keyword option, recorded with the run's config in its actor file, which ``egosearch evaluate``
-    reads back). This CHANGES THE OBSERVATION, for the actor and at evaluation too: the ``cpu`` profile's
+    reads back). This CHANGES THE OBSERVATION, for the actor and at evaluation too: the ``cpu`` preset's
     since the stuck-student redo (``ablations/head_on_contact_signal.yaml`` screened it alone on three
     seeds)."""

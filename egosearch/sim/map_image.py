@@ -139,4 +139,4 @@ class MapImageSettings:
     SemExp, Chaplot et al. 2020), after the memory-window measurement (``snakemake memory_window``: held to 5 steps
     of memory the tuned searcher falls to the student's level). An env keyword option, recorded with the run's
     config in its actor file, which ``egosearch evaluate`` reads back. This CHANGES THE OBSERVATION, for the actor
-    and at evaluation too; no profile turns it on (``ablations/head_on_map_image.yaml`` screens it)."""
+    and at evaluation too; no preset turns it on (``ablations/head_on_map_image.yaml`` screens it)."""

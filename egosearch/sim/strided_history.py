@@ -38,4 +38,4 @@ class StridedHistorySettings:
     after the memory-window measurement (``snakemake memory_window``: the tuned searcher held to 5 steps falls to
     the student's level, 20 to 50 steps give its level back). An env keyword option, recorded with the run's
     config in its actor file, which ``egosearch evaluate`` reads back. This CHANGES THE OBSERVATION, for the
-    actor and at evaluation too; no profile turns it on (``ablations/head_on_strided_history.yaml`` screens it)."""
+    actor and at evaluation too; no preset turns it on (``ablations/head_on_strided_history.yaml`` screens it)."""

@@ -76,11 +76,11 @@ def coerce_numbers(value, schema: dict, root: dict | None = None):
 
 
 def every_claims_pairs(config: dict) -> list[tuple[str, list[list[str]]]]:
-    """(where in the config, pairs) for the top level's ``claims_pairs`` and each profile's own: all are
-    checked, whichever profile runs, so that a typo waits for no other profile's run."""
+    """(where in the config, pairs) for the top level's ``claims_pairs`` and each preset's own: all are
+    checked, whichever preset runs, so that a typo waits for no other preset's run."""
     return [("claims_pairs", config.get("claims_pairs", []))] + [
-        (f"profiles/{name}/claims_pairs", profile["claims_pairs"])
-        for name, profile in config.get("profiles", {}).items() if "claims_pairs" in profile]
+        (f"presets/{name}/claims_pairs", preset["claims_pairs"])
+        for name, preset in config.get("presets", {}).items() if "claims_pairs" in preset]
 
 
 def check_config(config: dict, schema_path: Path = SCHEMA_PATH) -> None:
@@ -125,15 +125,15 @@ def let_jobs_run_long(config: dict) -> None:
 
 
 def check_training_seeds(config: dict) -> None:
-    """Every seed a training of the run takes (each profile's ``seeds``, ``spread_seeds`` and budget seeds, and the
+    """Every seed a training of the run takes (each preset's ``seeds``, ``spread_seeds`` and budget seeds, and the
     screen's ``screen_seed`` on) at most 2**32 - 1: a training seeds numpy's 32-bit global generator, and a
     larger seed failed in its job, after the DAG had started."""
     from egosearch.core.seeds import MAX_SEED
 
     given = [("screen_seed", config.get("screen_seed", 0) + config.get("screen_seeds", 1) - 1)]
-    for name, profile in config.get("profiles", {}).items():
-        given += [(f"profiles/{name}/{key}", max(profile.get(key) or [0])) for key in ("seeds", "spread_seeds")]
-        given.append((f"profiles/{name}/budget/seeds", max((profile.get("budget") or {}).get("seeds") or [0])))
+    for name, preset in config.get("presets", {}).items():
+        given += [(f"presets/{name}/{key}", max(preset.get(key) or [0])) for key in ("seeds", "spread_seeds")]
+        given.append((f"presets/{name}/budget/seeds", max((preset.get("budget") or {}).get("seeds") or [0])))
     for where, seed in given:
         if seed > MAX_SEED:
             value = (f"{config['screen_seed']} with screen_seeds={config.get('screen_seeds', 1)} trains seeds up to "
@@ -143,26 +143,26 @@ def check_training_seeds(config: dict) -> None:
 
 
 def check_budgets(config: dict) -> None:
-    """Each profile's budget study reads each setting once, the profile's own (its ``reference``, else the
+    """Each preset's budget study reads each setting once, the preset's own (its ``reference``, else the
     reference variant) apart from the others: a setting that is the reference too drew the same runs twice."""
-    for name, profile in config.get("profiles", {}).items():
-        budget = profile.get("budget") or {}
+    for name, preset in config.get("presets", {}).items():
+        budget = preset.get("budget") or {}
         reference = budget.get("reference", config.get("reference_variant"))
         if reference in budget.get("variants", []):
             named = "budget/reference" if "reference" in budget else "reference_variant"
-            raise ConfigError(f"config profiles/{name}/budget/variants: {reference!r} is the study's own setting "
+            raise ConfigError(f"config presets/{name}/budget/variants: {reference!r} is the study's own setting "
                               f"({named}), read against itself; leave it out of variants (its runs are the "
-                              "profile's seeds already)")
+                              "preset's seeds already)")
 
 
 def command_line_claims_pairs(config: dict, command_line: dict | None) -> None:
-    """``--config claims_pairs=...`` where the run's profile names its own: the profile's are read, and the ones
+    """``--config claims_pairs=...`` where the run's preset names its own: the preset's are read, and the ones
     typed would be ignored without a word."""
-    profile = config.get("profile")
-    if command_line and "claims_pairs" in command_line and "claims_pairs" in config["profiles"].get(profile, {}):
-        raise ConfigError(f"config claims_pairs: the {profile} profile names its own (profiles/{profile}/"
+    preset = config.get("preset")
+    if command_line and "claims_pairs" in command_line and "claims_pairs" in config["presets"].get(preset, {}):
+        raise ConfigError(f"config claims_pairs: the {preset} preset names its own (presets/{preset}/"
                           "claims_pairs in egosearch/workflow/config.yaml), which the run reads instead of the "
-                          "top level's; edit that one, or run another profile")
+                          "top level's; edit that one, or run another preset")
 
 
 def check_pair_heads(variants: dict[str, Variant], config: dict) -> None:
@@ -178,12 +178,12 @@ def check_pair_heads(variants: dict[str, Variant], config: dict) -> None:
 
 def workflow_variants(config: dict, compare: bool | str = False,
                       directory: Path = ABLATIONS_DIR) -> dict[str, Variant]:
-    """Every variant the run may train, read and checked against the run's learner profile:
-    ``variants``, ``reference_variant``, the profile's ``budget`` variants and reference, the variants of
-    every ``claims_pairs`` (the top level's and each profile's) and, when set (or when
+    """Every variant the run may train, read and checked against the run's learner preset:
+    ``variants``, ``reference_variant``, the preset's ``budget`` variants and reference, the variants of
+    every ``claims_pairs`` (the top level's and each preset's) and, when set (or when
     ``compare`` names a target that compares, "compare" or "screen"), ``variant``."""
     target = compare if isinstance(compare, str) else "compare"
-    budget_config = config["profiles"][config["profile"]].get("budget", {})
+    budget_config = config["presets"][config["preset"]].get("budget", {})
     budget = budget_config.get("variants", []) + ([budget_config["reference"]] if "reference" in budget_config else [])
     generalise = config.get("generalise") or {"variants": []}
     claims = [(where, name) for where, pairs in every_claims_pairs(config) for pair in pairs for name in pair
@@ -192,7 +192,7 @@ def workflow_variants(config: dict, compare: bool | str = False,
     named_by: dict[str, str] = {}
     for key, name in ([("variants", n) for n in config["variants"]]
                       + [("reference_variant", config["reference_variant"])]
-                      + [(f"profiles/{config['profile']}/budget", n) for n in budget]
+                      + [(f"presets/{config['preset']}/budget", n) for n in budget]
                       + [("generalise/variants", n) for n in generalise["variants"]] + claims
                       + ([("variant", config["variant"])] if config.get("variant") else [])):
         named_by.setdefault(name, key)
@@ -202,7 +202,7 @@ def workflow_variants(config: dict, compare: bool | str = False,
     if compare and config["variant"] == config["reference_variant"]:
         raise VariantError(f"variant={config['variant']!r} is the reference variant itself: {target} needs another "
                            "variant (or another reference_variant)")
-    learner = config["profiles"][config["profile"]]["learner"]
+    learner = config["presets"][config["preset"]]["learner"]
     variants = {}
     for name in names:
         variants[name] = _named_variant(name, named_by[name], directory)
@@ -232,6 +232,21 @@ def _named_variant(name: str, key: str, directory: Path) -> Variant:
         except VariantError as err:
             raise VariantError(f"config {key}: {err}") from None
     return load_variant(name, directory)
+
+
+OLD_PRESET_KEY = "profile"
+"""The old name of the workflow config's ``preset`` (``--config profile=NAME``), read for one release (until
+egosearch 0.2); Snakemake's ``--profile`` is a folder of its options (``profiles/``), a different thing."""
+
+
+def renamed_preset_key(config: dict, note: bool = True) -> None:
+    """Read ``--config profile=NAME`` as ``preset=NAME`` (in place), with a one-line note when ``note``."""
+    if OLD_PRESET_KEY not in config:
+        return
+    config["preset"] = config.pop(OLD_PRESET_KEY)
+    if note:
+        print("egosearch: note: --config profile=NAME is the old name of --config preset=NAME (the learner preset: "
+              "smoke, cpu or paper; not Snakemake's --profile); it is read until egosearch 0.2", file=sys.stderr)
 
 
 def checked_variants(config: dict, argv: list[str] | None = None,
@@ -281,7 +296,7 @@ def recorded_set(run_dir: Path) -> dict | None:
 def trainings_set_line(trainings, set_overrides: dict, learner_of) -> str | None:
     """One line, or None. ``trainings``: the DAG's training jobs as (variant, run folder). Each must take
     ``set_overrides`` (their ranges, and only fields its learner has, at ``learner_of(variant)``, the run's
-    learner profile); and a training stored in its folder, whether the plan reuses it or Snakemake would redo
+    learner preset); and a training stored in its folder, whether the plan reuses it or Snakemake would redo
     it, must have recorded the same set: results under one variant's name take one config."""
     from egosearch.variants import identity_set, resolve_variant
 

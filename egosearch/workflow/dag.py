@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 @dataclass(frozen=True)
 class DagJob:
     """One job of the DAG. ``id`` is unique in the DAG: the ``benchmark:`` path relative to
-    ``results/<profile>/benchmarks/`` without ``.tsv`` (``train/head_on/seed0``), or for a job that
+    ``results/<preset>/benchmarks/`` without ``.tsv`` (``train/head_on/seed0``), or for a job that
     writes no benchmark its rule and wildcard values (``provenance``, ``all``). ``record_rule`` and
     ``job`` split a benchmark path the way a provenance record keys its jobs (first folder, rest:
     ``eval``, ``head_on/seed0/kitchen_living/everywhere/h0.45``); both are None without a benchmark.
@@ -77,7 +77,7 @@ def _config_items(config: Mapping[str, object] | Sequence[str] | None) -> list[s
 def dag_jobs(target: str = "all", cores: int = 2, config: Mapping[str, object] | Sequence[str] | None = None,
              root: str | os.PathLike | None = None, timeout: float = 300) -> list[DagJob]:
     """The jobs ``snakemake --forceall --cores <cores> <target> --config <config>`` would run, in
-    Snakemake's job-id order. ``config`` is ``{"profile": "smoke"}`` or ``["profile=smoke"]``: read
+    Snakemake's job-id order. ``config`` is ``{"preset": "smoke"}`` or ``["preset=smoke"]``: read
     as the command line reads it. Raises RuntimeError with Snakemake's last lines when the DAG
     cannot be built (a bad config, a missing input no rule makes)."""
     root = Path(root or ROOT)
@@ -96,11 +96,11 @@ def dag_jobs(target: str = "all", cores: int = 2, config: Mapping[str, object] |
     return [DagJob(**(row | {"deps": tuple(row["deps"])})) for row in rows]
 
 
-def _benchmark_key(benchmark: str, profile_root: Path) -> str | None:
-    """The benchmark path relative to ``results/<profile>/benchmarks/``, without ``.tsv``."""
+def _benchmark_key(benchmark: str, preset_root: Path) -> str | None:
+    """The benchmark path relative to ``results/<preset>/benchmarks/``, without ``.tsv``."""
     path = Path(benchmark)
     try:
-        rel = path.relative_to(profile_root)
+        rel = path.relative_to(preset_root)
     except ValueError:
         return None
     return str(rel.with_suffix("")) if rel.suffix == ".tsv" else str(rel)
@@ -129,22 +129,22 @@ def _collect(target: str, cores: int, config_items: list[str]) -> list[dict]:
         workflow = workflow_api._workflow
         workflow._prepare_dag(forceall=True, ignore_incomplete=True, lock_warn_only=True, nolock=True)
         workflow._build_dag()
-        return plan_rows(workflow.dag, workflow.config.get("profile"))
+        return plan_rows(workflow.dag, workflow.config.get("preset"))
 
 
-def plan_rows(dag, profile: str | None) -> list[dict]:
+def plan_rows(dag, preset: str | None) -> list[dict]:
     """The jobs a built Snakemake DAG will run (its ``needrun_jobs``: with ``forceall`` every job), as the
-    JSON rows of :class:`DagJob`, in Snakemake's job-id order; ``profile`` names the benchmark folder that
+    JSON rows of :class:`DagJob`, in Snakemake's job-id order; ``preset`` names the benchmark folder that
     keys them. What the child process writes, and what the Snakefile's cost line reads from the live DAG
     of a run or a dry run (:func:`plan_jobs`)."""
-    benchmarks = Path("results") / str(profile) / "benchmarks"
+    benchmarks = Path("results") / str(preset) / "benchmarks"
     dag.update_priority()  # a job's priority is read from the DAG once computed (Snakemake does it later)
     jobs = sorted(dag.needrun_jobs(), key=dag.jobid)
     ids, keys, taken, wildcards = {}, {}, set(), {}
     for job in jobs:
         key = keys[job] = _benchmark_key(str(job.benchmark), benchmarks) if job.benchmark else None
         wildcards[job] = {k: str(v) for k, v in job.wildcards_dict.items()}
-        ident = key or "/".join([job.rule.name, *(v for k, v in wildcards[job].items() if k != "profile")])
+        ident = key or "/".join([job.rule.name, *(v for k, v in wildcards[job].items() if k != "preset")])
         if ident in taken:
             ident = f"{ident}#{dag.jobid(job)}"
         ids[job] = ident
@@ -165,9 +165,9 @@ def plan_rows(dag, profile: str | None) -> list[dict]:
     return rows
 
 
-def plan_jobs(dag, profile: str | None) -> list[DagJob]:
+def plan_jobs(dag, preset: str | None) -> list[DagJob]:
     """:func:`plan_rows` as :class:`DagJob`: the plan of the run (or dry run) whose DAG ``dag`` is."""
-    return [DagJob(**(row | {"deps": tuple(row["deps"])})) for row in plan_rows(dag, profile)]
+    return [DagJob(**(row | {"deps": tuple(row["deps"])})) for row in plan_rows(dag, preset)]
 
 
 def whole_dag(dag) -> bool:

@@ -19,8 +19,8 @@ def test_the_clock_is_observed_sized_and_set_by_its_config_field():
     assert env_space_dims("EgoSearch-v0", {"toy_step_clock": True})["proprio"] == 5
     assert parse_env_options(["toy_step_clock=true"]) == {"toy_step_clock": True}
     cfg = load_config("cpu", {"toy_step_clock": True})
-    # the field adds its option to whatever options the profile itself turns on (the cpu profile's contact signal)
-    profile_options = observation_kwargs(load_config("cpu", {}).to_dict())
-    assert "toy_step_clock" not in profile_options
-    assert observation_kwargs(cfg.to_dict()) == profile_options | {"toy_step_clock": True}
+    # the field adds its option to whatever options the preset itself turns on (the cpu preset's contact signal)
+    preset_options = observation_kwargs(load_config("cpu", {}).to_dict())
+    assert "toy_step_clock" not in preset_options
+    assert observation_kwargs(cfg.to_dict()) == preset_options | {"toy_step_clock": True}
     assert not load_config("cpu", {}).toy_step_clock

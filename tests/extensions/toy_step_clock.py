@@ -26,4 +26,4 @@ class ToyStepClockSettings:
 
     toy_step_clock: bool = False
     """Paper: False. Ours (a toy of the extension test): True appends the episode's steps / 100 to
-    ``proprio``. This CHANGES THE OBSERVATION; no profile sets it."""
+    ``proprio``. This CHANGES THE OBSERVATION; no preset sets it."""

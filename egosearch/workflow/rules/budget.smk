@@ -2,7 +2,7 @@
 # low cabinets against env steps and core-hours, for the learner settings of config `budget:`
 # (their paths: budget_inputs in common.smk).
 rule budget:
-    """What each learner setting buys per env step and per core-hour (the evidence for the profile)."""
+    """What each learner setting buys per env step and per core-hour (the evidence for the preset)."""
     input:
         ancient([path for runs in budget_inputs().values() for pair in runs for path in pair]),
     output:

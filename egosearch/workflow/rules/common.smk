@@ -3,7 +3,7 @@
 # does not rerun a job with stored outputs for a MISSING input (a variant added to the config):
 # the Snakefile names such rules and the `-R` that redoes them.
 # Names and paths shared by every rule. Every output path is a function of
-# (profile, variant, seed, layout, placement, height): Snakemake knows them all in advance.
+# (preset, variant, seed, layout, placement, height): Snakemake knows them all in advance.
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
@@ -45,8 +45,8 @@ if EXECUTOR == "slurm" and workflow.is_main_process:
 # Optional (`--use-conda`): the software every rule runs with.
 CONDA_ENV = "../envs/egosearch.yaml"
 
-PROFILE = config["profile"]
-PROF = config["profiles"][PROFILE]
+PRESET = config["preset"]
+PROF = config["presets"][PRESET]
 LAYOUT = config["layout"]  # the full-body runs', the budget cell's and the pictures' home
 HOMES = config["homes"]  # Table 1's homes
 SEEDS = PROF["seeds"]
@@ -54,19 +54,19 @@ HEIGHTS = workflow_heights(config)
 PLACEMENTS = config["placements"]
 FULLBODY = PROF["fullbody"]
 REF = config["reference_variant"]
-RESULTS = f"results/{PROFILE}"
+RESULTS = f"results/{PRESET}"
 # `--config set="FIELD=VALUE,..."`: learner fields on top of every variant's, handed to the trainings (and
 # demonstrations) this run makes as `--set` arguments (checked in the Snakefile with the config)
 SET_OVERRIDES = workflow_set(config)
 SET_ARGS = set_arguments(SET_OVERRIDES)
-FIGS = f"paper_figs/{PROFILE}"
+FIGS = f"paper_figs/{PRESET}"
 BASELINES = ["one_step_short", "one_step_long", "noisy_search"]
 
 # The variants `all` trains (checked in the Snakefile with the compare candidate, if any).
 VARIANTS = {name: CHECKED_VARIANTS[name] for name in dict.fromkeys(config["variants"] + [REF])}
 
 wildcard_constraints:
-    profile="smoke|cpu|paper",
+    preset="smoke|cpu|paper",
     variant="[A-Za-z0-9_\\-]+",
     seed="[0-9]+",
     height="[0-9.]+",
@@ -120,8 +120,8 @@ def print_the_plans_cost():
     from egosearch.cost.estimate import print_costs
     from egosearch.workflow.dag import plan_jobs, whole_dag
 
-    print_costs(workflow.dag_settings.targets or {"all"}, config, PROFILE, SEEDS, REF, cores_given(),
-                trainings_per_gpu=TRAININGS_PER_GPU, plan=plan_jobs(workflow.dag, PROFILE),
+    print_costs(workflow.dag_settings.targets or {"all"}, config, PRESET, SEEDS, REF, cores_given(),
+                trainings_per_gpu=TRAININGS_PER_GPU, plan=plan_jobs(workflow.dag, PRESET),
                 whole=whole_dag(workflow.dag))
 
 
@@ -250,11 +250,11 @@ def provenance_file():
     return f"{RESULTS}/provenance.json"
 
 
-# Paper-profile trainings side by side on one GPU (config trainings_per_gpu; egosearch.core.gpu_share): on one
+# Paper-preset trainings side by side on one GPU (config trainings_per_gpu; egosearch.core.gpu_share): on one
 # machine each asks for one of `gpu_slots`, which the run offers that many of (unless the command line's
 # --resources names gpu_slots: then that many), and takes a fair share of --cores; under a cluster executor each
 # training is a job asking for a whole GPU. Outputs and paths are the same either way.
-if PROFILE == "paper":
+if PRESET == "paper":
     try:
         TRAININGS_PER_GPU = resolve_trainings_per_gpu(config.get("trainings_per_gpu", "auto"), LOCAL_RUN)
     except ValueError as err:
@@ -268,7 +268,7 @@ if PROFILE == "paper":
             # each training asks for one slot: with none, the plan lists trainings that could never start
             import sys
 
-            print(f"egosearch: error: --resources gpu_slots={SLOTS}: every paper-profile training asks for one "
+            print(f"egosearch: error: --resources gpu_slots={SLOTS}: every paper-preset training asks for one "
                   "gpu_slots (its share of the GPU), so none could start; give gpu_slots=1 or more (the trainings "
                   "side by side on one GPU), or leave it out (config trainings_per_gpu sets it: "
                   f"{TRAININGS_PER_GPU} here)", file=sys.stderr)
@@ -278,19 +278,19 @@ if PROFILE == "paper":
         workflow.register_resource("gpu_slots", TRAININGS_PER_GPU)
 else:
     TRAININGS_PER_GPU = 1
-TRAIN_THREADS = train_threads(PROFILE, cores_given() if LOCAL_RUN else None, TRAININGS_PER_GPU)
+TRAIN_THREADS = train_threads(PRESET, cores_given() if LOCAL_RUN else None, TRAININGS_PER_GPU)
 
 
-def train_resources(profile):
+def train_resources(preset):
     """Portable resources: the same DAG runs locally, under slurm or cluster-generic."""
-    if profile == "paper":
+    if preset == "paper":
         # a few times the training's length on the one GPU measured (docs/gpu.md), for slower GPUs; on one
         # machine a share of its GPU (gpu_slots, above), under a cluster executor a whole one
         return dict(mem_mb=8000, runtime=12 * 60, **(dict(gpu_slots=1) if LOCAL_RUN else dict(gpu=1)))
-    if profile == "cpu":
+    if preset == "cpu":
         # a per-step training with its teacher's episodes takes about an hour alone on the reference CPU, and
         # hosts differ up to 3x: the stored run's longest took 191 min (a 50 px variant with the target memory),
-        # its profile's own trainings up to 108 min; the largest held 3.3 GB (the map-image lever, whose replay
+        # its preset's own trainings up to 108 min; the largest held 3.3 GB (the map-image lever, whose replay
         # keeps a 4 x 32 x 32 map a step; the others up to 2.5 GB), plus the job's own snakemake
         # (tests/test_cluster.py reads them)
         return dict(mem_mb=4000, runtime=6 * 60, gpu=0)
@@ -312,7 +312,7 @@ def compare_candidate(wildcards):
 
 
 SCREEN_SEEDS = list(range(config["screen_seed"], config["screen_seed"] + config["screen_seeds"]))
-# The reference's seeds that measure the seed spread (the profile's spread_seeds; its seeds when it names none).
+# The reference's seeds that measure the seed spread (the preset's spread_seeds; its seeds when it names none).
 SPREAD_SEEDS = PROF.get("spread_seeds", SEEDS)
 
 
@@ -378,7 +378,7 @@ def fig6_level_files():
 
 
 # The budget study: a setting is a variant file (ablations/budget_*.yaml: learner overrides on top
-# of the profile), so the train and evaluate rules serve it unchanged; the profile's own setting
+# of the preset), so the train and evaluate rules serve it unchanged; the preset's own setting
 # is the runs of BUDGET_REF, all seeds.
 BUDGET = PROF.get("budget", {"variants": [], "seeds": [0]})
 # The setting the others are read against: the reference variant (whose runs `all` makes anyway)
@@ -432,14 +432,14 @@ def fresh_files(kind):
 
 
 def decisions_floors():
-    """(variant, floor) for each variant of the profile's claims pairs that is a modular searcher (at the cpu
-    profile the stored modular pair, head_on_modular and head_off_modular): its floor is the same walk with
+    """(variant, floor) for each variant of the preset's claims pairs that is a modular searcher (at the cpu
+    preset the stored modular pair, head_on_modular and head_off_modular): its floor is the same walk with
     random decisions (MODULAR_FLOORS), on the same stored sets."""
     from egosearch.variants import resolve_variant
 
     learner = PROF["learner"]
     out = []
-    for pair in claims_pairs({**config, "profile": PROFILE}):
+    for pair in claims_pairs({**config, "preset": PRESET}):
         for variant in pair:
             if variant not in CHECKED_VARIANTS:  # a classical searcher's pair
                 continue

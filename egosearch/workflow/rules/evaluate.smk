@@ -1,14 +1,14 @@
 rule evaluate:
     """One trained policy on one Table 1 cell: a row per episode."""
     input:
-        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
-        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        actor=ancient("results/{preset}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        update("results/{profile}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     threads: 1
     resources:
         mem_mb=1500,
@@ -25,14 +25,14 @@ rule evaluate_start:
     untrained net) on one Table 1 cell: what its learning starts from, on the stored sets. Runs stored
     before trainings wrote the start have none: the job stops with one line saying so."""
     input:
-        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
-        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        actor=ancient("results/{preset}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        update("results/{profile}/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/eval_start/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     params:
         start=lambda wc, input: start_actor(input.actor),
     threads: 1
@@ -57,11 +57,11 @@ rule curve_level:
     variant's training curve is evaluated on, each episode seeded as the curve's: its level in Figure 6,
     read on the curve's own episodes."""
     output:
-        update("results/{profile}/eval_curve/{bound}/{variant}.csv"),
+        update("results/{preset}/eval_curve/{bound}/{variant}.csv"),
     log:
-        "results/{profile}/logs/eval_curve/{bound}/{variant}.log",
+        "results/{preset}/logs/eval_curve/{bound}/{variant}.log",
     benchmark:
-        "results/{profile}/benchmarks/eval_curve/{bound}/{variant}.tsv"
+        "results/{preset}/benchmarks/eval_curve/{bound}/{variant}.tsv"
     wildcard_constraints:
         bound="|".join(REFERENCE_SEARCHERS),
     threads: 1
@@ -72,7 +72,7 @@ rule curve_level:
         CONDA_ENV
     shell:
         "egosearch evaluate --force --policy {wildcards.bound} --curve-of {wildcards.variant} "
-        "--profile {wildcards.profile} --out {output} > {log} 2>&1"
+        "--preset {wildcards.preset} --out {output} > {log} 2>&1"
 
 
 rule tune_teacher:
@@ -80,11 +80,11 @@ rule tune_teacher:
     fit split, the one chosen and the untuned searcher on a held-out split, never a stored set; the record
     says whether the shipped parameters still win and what they do held out. About 13,000 episodes."""
     output:
-        update("results/{profile}/teacher_tuning/record.json"),
+        update("results/{preset}/teacher_tuning/record.json"),
     log:
-        "results/{profile}/logs/teacher_tuning.log",
+        "results/{preset}/logs/teacher_tuning.log",
     benchmark:
-        "results/{profile}/benchmarks/teacher_tuning.tsv"
+        "results/{preset}/benchmarks/teacher_tuning.tsv"
     threads: 1
     resources:
         mem_mb=1500,
@@ -102,13 +102,13 @@ rule bound:
     (head moving or held fixed), the privileged oracle (it knows the target) or the modular searcher's
     walk with random decisions (head moving or fixed)."""
     input:
-        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        scenarios=ancient("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        update("results/{profile}/eval/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/eval/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/bound/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     wildcard_constraints:
         bound="|".join(REFERENCE_SEARCHERS),
     threads: 1

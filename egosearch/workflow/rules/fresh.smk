@@ -1,17 +1,17 @@
 # The fresh-set check (`snakemake --cores 2 fresh`, outside `all`): the reference's trained actors
 # on scenario sets drawn with `fresh_scenario_seed` in Table 1's homes and cells, read against the
-# stored sets. The sets and evaluations live under results/{profile}/fresh/, apart from Table 1's.
+# stored sets. The sets and evaluations live under results/{preset}/fresh/, apart from Table 1's.
 # (workflow_check refuses a fresh seed equal to the stored sets' seed). The sets and evaluations are
 # the scenarios and evaluate rules' jobs with the fresh seed and paths.
 
 
 use rule scenarios as fresh_scenarios with:
     output:
-        update("results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/fresh/scenarios/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/fresh/scenarios/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/fresh/scenarios/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/fresh/scenarios/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/fresh/scenarios/{layout}/{placement}/h{height}.tsv"
     params:
         n=PROF["scenarios_per_cell"],
         seed=FRESH_SEED,
@@ -19,14 +19,14 @@ use rule scenarios as fresh_scenarios with:
 
 use rule evaluate as fresh_evaluate with:
     input:
-        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
-        scenarios="results/{profile}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
+        actor=ancient("results/{preset}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios="results/{preset}/fresh/scenarios/{layout}/{placement}/h{height}.csv",
     output:
-        update("results/{profile}/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/fresh/eval/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
 
 
 rule fresh:

@@ -4,11 +4,11 @@ rule fullbody:
         actor=ancient(f"{RESULTS}/train/{REF}/seed{{seed}}/actor.pt"),
         scenarios=ancient(fullbody_scenarios),
     output:
-        update("results/{profile}/fullbody/{setting}/seed{seed}.csv"),
+        update("results/{preset}/fullbody/{setting}/seed{seed}.csv"),
     log:
-        "results/{profile}/logs/fullbody/{setting}/seed{seed}.log",
+        "results/{preset}/logs/fullbody/{setting}/seed{seed}.log",
     benchmark:
-        "results/{profile}/benchmarks/fullbody/{setting}/seed{seed}.tsv"
+        "results/{preset}/benchmarks/fullbody/{setting}/seed{seed}.tsv"
     params:
         limit=FULLBODY["scenarios"],
         T=FULLBODY["T"],
@@ -30,11 +30,11 @@ rule fullbody_oracle:
     input:
         scenarios=ancient(fullbody_scenarios),
     output:
-        update("results/{profile}/fullbody_oracle/{setting}/seed{seed}.csv"),
+        update("results/{preset}/fullbody_oracle/{setting}/seed{seed}.csv"),
     log:
-        "results/{profile}/logs/fullbody_oracle/{setting}/seed{seed}.log",
+        "results/{preset}/logs/fullbody_oracle/{setting}/seed{seed}.log",
     benchmark:
-        "results/{profile}/benchmarks/fullbody_oracle/{setting}/seed{seed}.tsv"
+        "results/{preset}/benchmarks/fullbody_oracle/{setting}/seed{seed}.tsv"
     params:
         limit=FULLBODY["scenarios"],
         T=FULLBODY["T"],

@@ -4,11 +4,11 @@
 rule group_scenarios:
     """One scenario set over a group of generated homes: `scenarios_per_home` in each."""
     output:
-        update("results/{profile}/scenarios/{group}/{placement}/h{height}.csv"),
+        update("results/{preset}/scenarios/{group}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/scenarios/{group}/{placement}/h{height}.log",
+        "results/{preset}/logs/scenarios/{group}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/scenarios/{group}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/scenarios/{group}/{placement}/h{height}.tsv"
     wildcard_constraints:
         group="|".join(GEN_GROUPS),
     params:

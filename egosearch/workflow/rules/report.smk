@@ -25,7 +25,7 @@ rule table1:
 
 
 rule table2:
-    """The learner's hyperparameters of this profile, generated from the config (paper Table 2)."""
+    """The learner's hyperparameters of this preset, generated from the config (paper Table 2)."""
     output:
         update(expand(f"{FIGS}/table2.{{ext}}", ext=["md", "tex"])),
     log:
@@ -38,11 +38,11 @@ rule table2:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table2 --force --profile {params.learner} --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report table2 --force --preset {params.learner} --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule table2_paper:
-    """Table 2 of the paper, regenerated from the `paper` profile of the config."""
+    """Table 2 of the paper, regenerated from the `paper` preset of the config."""
     output:
         update(expand("paper_figs/table2.{ext}", ext=["md", "tex"])),
     log:
@@ -54,7 +54,7 @@ rule table2_paper:
     conda:
         CONDA_ENV
     shell:
-        "egosearch report table2 --force --profile paper --out-prefix {params.prefix} > {log} 2>&1"
+        "egosearch report table2 --force --preset paper --out-prefix {params.prefix} > {log} 2>&1"
 
 
 rule fig6:
@@ -228,11 +228,11 @@ rule screens_reread:
     log:
         f"{RESULTS}/logs/report/screens_reread.log",
     params:
-        profile=PROFILE,
+        preset=PRESET,
     conda:
         CONDA_ENV
     shell:
-        "egosearch report reread-screens --force --profile {params.profile} --out {output} 2>&1 | tee {log}"
+        "egosearch report reread-screens --force --preset {params.preset} --out {output} 2>&1 | tee {log}"
 
 
 rule seed_spread:
@@ -243,7 +243,7 @@ rule seed_spread:
 
 
 rule provenance:
-    """Commit, profile, machine, date, the wall time of every rule and the sha256 of every stored
+    """Commit, preset, machine, date, the wall time of every rule and the sha256 of every stored
     result file, next to the results. Every result of `all` is an input, so that the record is
     checked whenever one of them is rewritten; update() keeps the old record in place (Snakemake
     would delete it first), so that the command leaves it byte for byte as it was when no stored
@@ -263,17 +263,17 @@ rule provenance:
     log:
         f"{RESULTS}/logs/report/provenance.log",
     params:
-        profile=PROFILE,
+        preset=PRESET,
         results=lambda wc, output: str(Path(output[0]).parent),
     conda:
         CONDA_ENV
     shell:
-        "egosearch report provenance --force --profile {params.profile} --results {params.results} --out {output} "
+        "egosearch report provenance --force --preset {params.preset} --results {params.results} --out {output} "
         "> {log} 2>&1"
 
 
 rule learning_adds:
-    """What learning adds: the profile's pair (head on, head off) against its own start (each seed's
+    """What learning adds: the preset's pair (head on, head off) against its own start (each seed's
     policy at step 0: the clone after imitation, else the untrained net) on the same stored sets, per
     cell and per shortest-path bin (part of `all`; Table 1's notes say the reference's)."""
     input:
@@ -299,7 +299,7 @@ rule learning_adds_compare:
 
 rule decisions_floor:
     """What a modular searcher's learned decisions add: each modular pair of the claims pairs (at the cpu
-    profile the stored head_on_modular and head_off_modular) against the same walk with random decisions,
+    preset the stored head_on_modular and head_off_modular) against the same walk with random decisions,
     per cell and per shortest-path bin. Nothing to do where no claims pair is a modular searcher."""
     input:
         [f"{RESULTS}/compare/{variant}_vs_{floor}.csv" for variant, floor in DECISIONS_FLOORS],
@@ -330,7 +330,7 @@ rule teacher_compare:
 rule versus_teacher:
     """`snakemake --cores 2 versus_teacher`: Figure 6's pair (the first of claims_pairs) against every classical
     searcher of its head (searchers registered as classical): the untuned frontier searcher, Table 1's classical
-    row, and the tuned one, the teacher the cpu profile's pair learned from (VERSUS_TEACHER, common.smk)."""
+    row, and the tuned one, the teacher the cpu preset's pair learned from (VERSUS_TEACHER, common.smk)."""
     input:
         [f"{RESULTS}/compare/{variant}_vs_{searcher}.csv" for variant, searcher in VERSUS_TEACHER],
 

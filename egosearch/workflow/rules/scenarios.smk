@@ -1,11 +1,11 @@
 rule scenarios:
     """The fixed scenario set of one Table 1 cell (paper 6.1)."""
     output:
-        update("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        update("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/scenarios/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/scenarios/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/scenarios/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/scenarios/{layout}/{placement}/h{height}.tsv"
     wildcard_constraints:
         layout="kitchen_living|bedroom_bath|studio|home[0-9]+",
     params:

@@ -24,15 +24,15 @@ SEARCH_TRACE_FILES = [f"{RESULTS}/traces/{v}/seed{s}/{home}/{placement}/h{height
 rule trace:
     """One trained policy on one Table 1 cell, every step of every episode recorded."""
     input:
-        actor=ancient("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
-        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        actor=ancient("results/{preset}/train/{variant}/seed{seed}/actor.pt"),
+        scenarios=ancient("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        trace=update("results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"),
-        episodes=update("results/{profile}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        trace=update("results/{preset}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.npz"),
+        episodes=update("results/{preset}/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/traces/{variant}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     threads: 1
     resources:
         mem_mb=1500,
@@ -52,14 +52,14 @@ rule trace_bound:
     """A classical searcher on one Table 1 cell, every step of every episode recorded (the claims read
     on the classical pair)."""
     input:
-        scenarios=ancient("results/{profile}/scenarios/{layout}/{placement}/h{height}.csv"),
+        scenarios=ancient("results/{preset}/scenarios/{layout}/{placement}/h{height}.csv"),
     output:
-        trace=update("results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.npz"),
-        episodes=update("results/{profile}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
+        trace=update("results/{preset}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.npz"),
+        episodes=update("results/{preset}/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.csv"),
     log:
-        "results/{profile}/logs/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
+        "results/{preset}/logs/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.log",
     benchmark:
-        "results/{profile}/benchmarks/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
+        "results/{preset}/benchmarks/traces/{bound}/seed{seed}/{layout}/{placement}/h{height}.tsv"
     wildcard_constraints:
         bound="|".join(CLASSICAL_SEARCHERS),
     threads: 1

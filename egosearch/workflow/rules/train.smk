@@ -4,26 +4,26 @@ rule train:
     publishes the outputs only when the run is complete. The workflow config's `set` reaches it as --set
     arguments; a stored training recorded with another set stops the run before any job (rules/common.smk)."""
     output:
-        actor=update("results/{profile}/train/{variant}/seed{seed}/actor.pt"),
-        curve=update("results/{profile}/train/{variant}/seed{seed}/curve.csv"),
+        actor=update("results/{preset}/train/{variant}/seed{seed}/actor.pt"),
+        curve=update("results/{preset}/train/{variant}/seed{seed}/curve.csv"),
     log:
-        "results/{profile}/logs/train/{variant}/seed{seed}.log",
+        "results/{preset}/logs/train/{variant}/seed{seed}.log",
     benchmark:
-        "results/{profile}/benchmarks/train/{variant}/seed{seed}.tsv"
+        "results/{preset}/benchmarks/train/{variant}/seed{seed}.tsv"
     params:
-        learner=lambda wc: config["profiles"][wc.profile]["learner"],
+        learner=lambda wc: config["presets"][wc.preset]["learner"],
         out_dir=lambda wc, output: str(Path(output.actor).parent),
         work_dir=lambda wc, output: str(Path(output.actor).parent / "partial"),
-    # 1; at the paper profile on one machine, --cores / trainings_per_gpu (common.smk)
+    # 1; at the paper preset on one machine, --cores / trainings_per_gpu (common.smk)
     threads: TRAIN_THREADS
     resources:
-        **train_resources(PROFILE),
+        **train_resources(PRESET),
     conda:
         CONDA_ENV
     # SET_ARGS: the workflow config's `set` as --set arguments (rules/common.smk), empty without one, so that the
     # command of a run without a set is the one Snakemake recorded for the stored trainings
     shell:
-        "egosearch train --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
+        "egosearch train --force --variant {wildcards.variant} --preset {params.learner} --seed {wildcards.seed} "
         f"--threads {{threads}} --work-dir {{params.work_dir}} --out-dir {{params.out_dir}}{SET_ARGS} > {{log}} 2>&1"
 
 
@@ -33,17 +33,17 @@ rule demos:
     head-fixed one otherwise. The transitions are
     git-ignored (*.replay.npz); the summary beside them records episodes, success and CPU time."""
     output:
-        transitions="results/{profile}/demos/{variant}/seed{seed}.replay.npz",
-        summary="results/{profile}/demos/{variant}/seed{seed}.json",
+        transitions="results/{preset}/demos/{variant}/seed{seed}.replay.npz",
+        summary="results/{preset}/demos/{variant}/seed{seed}.json",
     log:
-        "results/{profile}/logs/demos/{variant}/seed{seed}.log",
+        "results/{preset}/logs/demos/{variant}/seed{seed}.log",
     benchmark:
-        "results/{profile}/benchmarks/demos/{variant}/seed{seed}.tsv"
+        "results/{preset}/benchmarks/demos/{variant}/seed{seed}.tsv"
     params:
-        learner=lambda wc: config["profiles"][wc.profile]["learner"],
+        learner=lambda wc: config["presets"][wc.preset]["learner"],
     threads: 1
     conda:
         CONDA_ENV
     shell:
-        "egosearch demos --force --variant {wildcards.variant} --profile {params.learner} --seed {wildcards.seed} "
+        "egosearch demos --force --variant {wildcards.variant} --preset {params.learner} --seed {wildcards.seed} "
         f"--out {{output.transitions}}{SET_ARGS} > {{log}} 2>&1"

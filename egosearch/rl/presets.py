@@ -1,13 +1,13 @@
-"""The learner profiles as data: ``smoke``, ``cpu`` and ``paper``, each the values it sets on top of the fields'
+"""The learner presets as data: ``smoke``, ``cpu`` and ``paper``, each the values it sets on top of the fields'
 defaults (the defaults are Table 2's and CURL's, see the fields' docstrings).
 
-A profile is for every learner: a learner takes the values of the fields it has and leaves the others (the
-``cpu`` profile's pooled input means nothing to SAC + CURL), while a variant that names a field its learner
-does not have is refused in one line (:func:`egosearch.rl.config.load_config`). Each profile names its
-sources: the paper section or Table 2 row, and for the ``cpu`` profile the source of each departure beside its
+A preset is for every learner: a learner takes the values of the fields it has and leaves the others (the
+``cpu`` preset's pooled input means nothing to SAC + CURL), while a variant that names a field its learner
+does not have is refused in one line (:func:`egosearch.rl.config.load_config`). Each preset names its
+sources: the paper section or Table 2 row, and for the ``cpu`` preset the source of each departure beside its
 value; the fields' own docstrings, which the generated Table 2 pages list beside every departure, say the same
-field by field. How the ``cpu`` profile was found, measurement by measurement, is docs/learner.md ("How the
-cpu profile was found").
+field by field. How the ``cpu`` preset was found, measurement by measurement, is docs/learner.md ("How the
+cpu preset was found").
 """
 
 from __future__ import annotations
@@ -91,8 +91,8 @@ CPU: dict[str, Any] = {
 privileged critic, cloned from the tuned frontier searcher and then fine-tuned with its episodes in replay, on 50 px
 depth with the last-seen target memory and a contact signal, 200k env steps. Each value that departs from the
 paper names its source in the comment beside it and in its field's docstring (the generated Table 2 lists them);
-how each was found, and the profiles before it (``ablations/budget_cpu_curl_24k.yaml``,
-``ablations/head_on_modular.yaml``, ...), is docs/learner.md ("How the cpu profile was found"). Its throughput:
+how each was found, and the presets before it (``ablations/budget_cpu_curl_24k.yaml``,
+``ablations/head_on_modular.yaml``, ...), is docs/learner.md ("How the cpu preset was found"). Its throughput:
 ``egosearch bench learner`` (``env_steps_per_core_s_cpu_profile``)."""
 
 SMOKE: dict[str, Any] = {
@@ -116,7 +116,7 @@ SMOKE: dict[str, Any] = {
 2-layer 8-filter encoder, 64-unit MLPs, 300 env steps, a 1000-transition replay and 2 evaluation episodes.
 
 Alone (``load_config("smoke")``, the unit tests' base) they sit on the fields' defaults: SAC + CURL with 100->84
-crops and K = 5 as in the paper. A variant at the smoke profile (:func:`egosearch.rl.config.load_variant_config`,
+crops and K = 5 as in the paper. A variant at the smoke preset (:func:`egosearch.rl.config.load_variant_config`,
 what ``egosearch train``, the DAG and the cost line read) is instead its own ``cpu`` learner and levers with every
 size of the run capped at :data:`SMOKE_CAPS`, so that any ``cpu`` lever can be smoke-tested in minutes."""
 
@@ -125,7 +125,7 @@ SMOKE_CAPS: dict[str, int] = {
     "total_env_steps": SMOKE["total_env_steps"],
     "init_steps": SMOKE["init_steps"],
     "num_envs": 2,
-    "batch_size": 32,  # Table 2's, the smoke profile's
+    "batch_size": 32,  # Table 2's, the smoke preset's
     "replay_capacity": SMOKE["replay_capacity"],
     "eval_episodes": SMOKE["eval_episodes"],
     "demo_episodes": 2,
@@ -161,24 +161,24 @@ config sets lower stays lower (a lever that shrinks a network is smoke-tested as
 stays off. :func:`smoke_sized` applies them."""
 
 
-def paper_profile() -> dict[str, Any]:
-    """The ``paper`` profile's values (:data:`PAPER`)."""
+def paper_preset() -> dict[str, Any]:
+    """The ``paper`` preset's values (:data:`PAPER`)."""
     return dict(PAPER)
 
 
-def cpu_profile() -> dict[str, Any]:
-    """The ``cpu`` profile's values (:data:`CPU`, whose comments name the source of each departure from the
+def cpu_preset() -> dict[str, Any]:
+    """The ``cpu`` preset's values (:data:`CPU`, whose comments name the source of each departure from the
     paper)."""
     return dict(CPU)
 
 
-def smoke_profile() -> dict[str, Any]:
-    """The ``smoke`` profile's values (:data:`SMOKE`)."""
+def smoke_preset() -> dict[str, Any]:
+    """The ``smoke`` preset's values (:data:`SMOKE`)."""
     return dict(SMOKE)
 
 
-SMOKE_LEARNER_PROFILE = "cpu"
-"""Whose learner and levers a variant has at the smoke profile: the default profile's, so that a ``cpu`` lever
+SMOKE_LEARNER_PRESET = "cpu"
+"""Whose learner and levers a variant has at the smoke preset: the default preset's, so that a ``cpu`` lever
 (``bc_weight``, a pooled input, a memory in the observation) runs at smoke as it will run, only smaller."""
 
 
@@ -188,9 +188,9 @@ def smoke_sized(values: dict[str, Any]) -> dict[str, Any]:
     return {key: min(value, SMOKE_CAPS[key]) if key in SMOKE_CAPS else value for key, value in values.items()}
 
 
-PROFILES: dict[str, Callable[[], dict[str, Any]]] = {
-    "smoke": smoke_profile,
-    "cpu": cpu_profile,
-    "paper": paper_profile,
+PRESETS: dict[str, Callable[[], dict[str, Any]]] = {
+    "smoke": smoke_preset,
+    "cpu": cpu_preset,
+    "paper": paper_preset,
 }
-"""Profile name -> function returning (a copy of) its values on top of the fields' defaults."""
+"""Preset name -> function returning (a copy of) its values on top of the fields' defaults."""

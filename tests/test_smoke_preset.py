@@ -1,4 +1,4 @@
-"""Issue 73 item 3, "smoke means minutes, for every variant": at the smoke profile a variant trains its cpu
+"""Issue 73 item 3, "smoke means minutes, for every variant": at the smoke preset a variant trains its cpu
 learner and levers at toy sizes, whatever steps or episodes it pins, so that any cpu lever is smoke-tested in
 minutes; the cost line reads the same capped config (tests/test_estimate.py, tests/test_workflow.py)."""
 
@@ -9,7 +9,7 @@ import json
 import yaml
 
 from egosearch.rl.config import load_config
-from egosearch.rl.profiles import SMOKE_CAPS
+from egosearch.rl.presets import SMOKE_CAPS
 from egosearch.variants import ABLATIONS_DIR, resolve_variant, variant_names
 
 
@@ -37,7 +37,7 @@ def test_every_stored_variant_at_smoke_is_its_cpu_learner_with_every_size_capped
     assert resolve_variant("head_on_batch128", "smoke", None, {"batch_size": 64}).config.batch_size == 64
 
 
-def test_the_smoke_profile_alone_is_still_the_unit_tests_toy_sac_curl():
+def test_the_smoke_preset_alone_is_still_the_unit_tests_toy_sac_curl():
     """load_config("smoke") without a variant stays the toy SAC+CURL the unit tests and the pinned updates build on."""
     cfg = load_config("smoke")
     assert (cfg.algorithm, cfg.total_env_steps, cfg.actor_hidden_dim, cfg.curl_latent) == ("sac_curl", 300, 64, 32)
@@ -52,7 +52,7 @@ def test_a_cpu_lever_trains_at_smoke_end_to_end(tmp_path):
     data = yaml.safe_load((ABLATIONS_DIR / "head_on.yaml").read_text())
     variant.write_text(yaml.safe_dump({**data, "name": variant.stem, "config": {"bc_weight": 0.2}}))
     out = tmp_path / "run"
-    args = ["train", "--variant", str(variant), "--profile", "smoke", "--seed", "0", "--threads", "1", "--out-dir"]
+    args = ["train", "--variant", str(variant), "--preset", "smoke", "--seed", "0", "--threads", "1", "--out-dir"]
     assert main([*args, str(out)]) == 0
     config = json.loads((out / "config.json").read_text())["config"]
     assert (config["algorithm"], config["bc_weight"], config["total_env_steps"]) == ("sac_drq", 0.2, 300)
