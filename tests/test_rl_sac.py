@@ -425,6 +425,39 @@ def test_the_learner_benchmark_times_table2_eagerly_although_the_paper_preset_gr
     assert "updates_per_s_table2" in result
 
 
+def test_memory_lever_costs_alternate_the_observations_and_divide_core_seconds_per_step(monkeypatch):
+    """Round by round, plain then each option; the ratio is the plain rate over the option's (median of rounds)."""
+    import egosearch.rl.bench_learner as bench
+
+    asked, rates = [], {"plain": iter([100.0, 80.0]), "map_image": iter([60.0, 60.0]),
+                        "strided_history": iter([90.0, 70.0])}
+
+    def fake_throughput(preset="cpu", env_steps=3000, overrides=None):
+        name = next(iter(overrides)) if overrides else "plain"
+        asked.append((preset, name, dict(overrides or {})))
+        return {"env_steps_per_core_s": next(rates[name])}
+
+    monkeypatch.setattr(bench, "training_throughput", fake_throughput)
+    result = bench.memory_lever_costs(quick=True, rounds=2)
+    assert [name for _, name, _ in asked] == ["plain", "map_image", "strided_history"] * 2
+    assert all(preset == "cpu" for preset, _, _ in asked)
+    assert [o for _, name, o in asked if name == "map_image"] == [{"map_image": True}] * 2
+    assert result["env_steps_per_core_s_plain"] == 90.0 and result["env_steps_per_core_s_map_image"] == 60.0
+    assert result["map_image_cost_ratio"] == 1.5  # 90 / 60: a map-image step costs half as much again
+    assert result["strided_history_cost_ratio"] == 1.12  # 90 / 80
+
+
+def test_memory_levers_is_refused_by_the_benchmarks_that_do_not_read_it(tmp_path, capsys):
+    from egosearch.cli import main
+
+    for what in ("env", "stacked"):
+        assert main(["bench", what, "--memory-levers", "--out", str(tmp_path / "r.json")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [f"egosearch bench: error: --memory-levers is read by `bench learner` only, not by "
+                       f"`bench {what}`"]
+    assert not (tmp_path / "r.json").exists()
+
+
 def test_cuda_graph_is_on_in_the_paper_preset_alone_and_ignored_on_the_cpu():
     assert load_config("paper", {}).cuda_graph and not load_config("cpu", {}).cuda_graph
     assert not load_config("smoke", {}).cuda_graph

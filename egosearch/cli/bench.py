@@ -26,7 +26,7 @@ DEFAULTS = {"layout": "kitchen_living", "frames": 3000, "steps": 3000, "seconds"
 benchmark that does not read it is told apart from one left alone)."""
 READ_BY = {"layout": "env", "frames": "env", "steps": "env", "seconds": "gpu", "out_dir": "gpu",
            "cuda_graph": "gpu", "baseline_seconds": "gpu", "side_by_side": "gpu", "stacked": "gpu",
-           "seeds": "stacked"}
+           "seeds": "stacked", "memory_levers": "learner"}
 """The benchmark that reads each of the options that only one of them reads."""
 
 
@@ -71,11 +71,13 @@ def run(args) -> None:
             resolved = resolve_variant(GPU_CHECK_VARIANT, "paper", {**overrides, "seed": 0})
             return gpu_check(args.seconds, args.out_dir, resolved, overrides=overrides,
                              baseline_seconds=args.baseline_seconds)
-        return bench_learner()
+        return bench_learner(memory_levers=args.memory_levers)
 
     options = f" --layout {args.layout} --frames {args.frames} --steps {args.steps}" if args.what == "env" else ""
     if args.what == "stacked":
         options = f" --seeds {args.seeds}"
+    if args.what == "learner" and args.memory_levers:
+        options = " --memory-levers"
     if args.what == "gpu":
         options = (f" --side-by-side {args.side_by_side}" if args.side_by_side else "") + (
             f" --stacked {args.stacked}" if args.stacked else "") + (

@@ -21,6 +21,8 @@ Keys:
   while the preset was a modular searcher);
 - ``*_avx2`` (on a CPU with AVX-512): the cpu preset's rows again in a process whose oneDNN may
   use AVX2 at most (``ONEDNN_MAX_CPU_ISA=AVX2``), for what a CPU without AVX-512 pays;
+- ``memory_levers`` (with ``--memory-levers``): the same short training with each memory lever's
+  observation beside the plain one, alternating, and each one's cost ratio (:func:`memory_lever_costs`);
 - ``replay_gb_100k``: memory of a 100k-transition replay buffer (frames stored once);
 - ``torch_threads``, ``device``, ``cpu``.
 """
@@ -216,10 +218,11 @@ def cpu_preset_run_steps(quick: bool = False) -> int:
     return 400 * cfg.num_envs if quick else 4000
 
 
-def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
+def bench_learner(quick: bool = False, cpu_profile_run: bool = True, memory_levers: bool = False) -> dict:
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
     ``cpu_profile_run=False`` leaves out the cpu preset's training run (a GPU check times a real
-    paper-preset training instead)."""
+    paper-preset training instead); ``memory_levers`` adds :func:`memory_lever_costs` under
+    ``"memory_levers"`` (about six minutes more)."""
     keep_freed_memory()  # as a training does, so that its updates cost here what they cost there
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
@@ -241,6 +244,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     # oneDNN picks its kernels once per process, so the AVX2-limited rows need a process of their own
     avx2 = (_avx2_limited_cpu_profile(quick, cpu_profile_run)
             if cpu_vector_unit() == "AVX-512" and resolve_device("auto").type == "cpu" else None)
+    levers = memory_lever_costs(quick) if memory_levers else None
     wall = time.perf_counter() - wall0
     cpu1 = cpu_seconds_all()
     own = own_cpu_seconds() - own0
@@ -258,6 +262,8 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
         result["cpu_profile_run"] = throughput
     if avx2 is not None:
         result.update({f"{key}_avx2": value for key, value in avx2.items()})
+    if levers is not None:
+        result["memory_levers"] = levers
     result["replay_gb_100k"] = round(replay_gb(100_000), 3)
     result["torch_threads"] = torch.get_num_threads()
     result["cpu_profile_threads"] = torch_threads(cpu_cfg.num_threads)
@@ -266,6 +272,35 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True) -> dict:
     if cpu0 is not None and cpu1 is not None:
         result["other_load"] = round(max(0.0, (cpu1 - cpu0) - own) / wall, 2) if wall > 0 else None
     result["bench_s"] = round(wall, 1)
+    return result
+
+
+MEMORY_LEVER_OPTIONS = ("map_image", "strided_history")
+"""The observation options of the memory levers (issue "the student remembers where it has been") whose
+training cost ``bench learner --memory-levers`` measures beside the plain observation's."""
+
+
+def memory_lever_costs(quick: bool = False, rounds: int = 2) -> dict:
+    """What each memory lever's observation costs a training: the cpu preset's short real training
+    (:func:`training_throughput`: env, acting and updates, in this process's core-seconds) with the plain
+    observation and with each of :data:`MEMORY_LEVER_OPTIONS`, alternating round by round, so that a shared
+    machine's load falls on all of them alike. Reports each one's env steps per core-second (the median of
+    its rounds) and, for each option, its core-seconds per env step against the plain one's
+    (``<option>_cost_ratio``: 1.4 means a training's RL phase costs 40 % more)."""
+    keep_freed_memory()
+    steps = cpu_preset_run_steps(quick)
+    rates: dict[str, list[float]] = {name: [] for name in ("plain", *MEMORY_LEVER_OPTIONS)}
+    for _ in range(rounds):
+        for name in rates:
+            overrides = {} if name == "plain" else {name: True}
+            rates[name].append(training_throughput("cpu", env_steps=steps, overrides=overrides)["env_steps_per_core_s"])
+    result: dict = {"env_steps": steps, "rounds": rounds}
+    for name, values in rates.items():
+        result[f"env_steps_per_core_s_{name}"] = round(float(np.median(values)), 1)
+        result[f"env_steps_per_core_s_{name}_rounds"] = values
+    for name in MEMORY_LEVER_OPTIONS:
+        result[f"{name}_cost_ratio"] = round(result["env_steps_per_core_s_plain"]
+                                             / result[f"env_steps_per_core_s_{name}"], 2)
     return result
 
 
