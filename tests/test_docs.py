@@ -187,6 +187,27 @@ def test_speed_block_comes_from_the_stored_records(tmp_path):
     assert "| `head_on` | 0 | 300,000 decisions | 2,000 |" in text and "| `head_on` | 1 | 300,000 | 3,000 |" in text
 
 
+def test_speed_block_gives_the_memory_levers_costs_from_their_records(tmp_path):
+    from egosearch.report.speed import block_speed
+
+    assert "memory levers" not in block_speed(tmp_path, "p")              # neither record: no section
+    bench = tmp_path / "results" / "p" / "bench"
+    bench.mkdir(parents=True)
+    (bench / "env_memory_levers.json").write_text(json.dumps(_record(
+        {"env_ms_per_step_by_option": {"none": 1.0, "map_image": 3.1, "strided_history": 1.2},
+         "option_over_none": {"map_image": 3.1, "strided_history": 1.2}}, "egosearch bench env")))
+    text = block_speed(tmp_path, "p")
+    assert "| `map_image` | **3.10x** (3.1 against 1.0 ms) | – |" in text   # the learner's record is not stored
+    (bench / "learner_memory_levers.json").write_text(json.dumps(_record(
+        {"memory_levers": {"env_steps_per_core_s_plain": 90.0, "env_steps_per_core_s_map_image": 60.0,
+                           "map_image_cost_ratio": 1.5}}, "egosearch bench learner --memory-levers", other=1.2)))
+    text = block_speed(tmp_path, "p")
+    assert ("| `map_image` | **3.10x** (3.1 against 1.0 ms) | **1.50x** (60.0 against 90.0 env steps per "
+            "core-second) |") in text
+    assert "| `strided_history` | **1.20x** (1.0" not in text and "| `strided_history` | **1.20x** (1.2 against" in text
+    assert "`egosearch bench learner --memory-levers` on" in text and "other processes used 1.20 cores" in text
+
+
 def test_every_machine_measured_is_a_row_of_the_speed_block_and_a_line_of_provenance(tmp_path):
     """A machine's own benchmark and estimate (``bench/hosts/<machine>/``) beside the benchmark machine's."""
     from egosearch.report.readme import block_provenance

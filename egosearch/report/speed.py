@@ -99,6 +99,41 @@ def _reward_lines(root: Path, preset: str) -> list[str]:
             + f"; from `{path.relative_to(root)}`."]
 
 
+MEMORY_LEVER_RECORDS = ("env_memory_levers.json", "learner_memory_levers.json")
+"""The records of what the memory levers' observations cost, each a ratio measured in one run (so that it holds
+on a busy machine): ``egosearch bench env --out results/<preset>/bench/env_memory_levers.json`` (per env step)
+and ``egosearch bench learner --memory-levers --out results/<preset>/bench/learner_memory_levers.json`` (per env
+step of a short real training, acting and updates in)."""
+
+
+def _memory_lever_lines(root: Path, preset: str) -> list[str]:
+    """What each memory lever's observation costs against the plain one, per env step and per training, from the
+    two records of :data:`MEMORY_LEVER_RECORDS` (none when neither is stored)."""
+    env_path, learner_path = (root / "results" / preset / "bench" / name for name in MEMORY_LEVER_RECORDS)
+    if not env_path.exists() and not learner_path.exists():
+        return []
+    lines = ["What the memory levers' observations cost against the plain observation, each a ratio of the two "
+             "measured side by side in one run (so that it holds on a busy machine):", "",
+             "| option | env step (`bench env`) | training's RL phase (`bench learner --memory-levers`) |",
+             "|---|---|---|"]
+    env = json.loads(env_path.read_text(encoding="utf-8")) if env_path.exists() else None
+    learner = json.loads(learner_path.read_text(encoding="utf-8")) if learner_path.exists() else None
+    env_ratios = (env or {}).get("result", {}).get("option_over_none", {})
+    env_ms = (env or {}).get("result", {}).get("env_ms_per_step_by_option", {})
+    levers = (learner or {}).get("result", {}).get("memory_levers", {})
+    for option in dict.fromkeys([*env_ratios, *(k[:-len("_cost_ratio")] for k in levers if k.endswith("_cost_ratio"))]):
+        step = (f"**{env_ratios[option]:.2f}x** ({env_ms[option]} against {env_ms['none']} ms)"
+                if option in env_ratios else "–")
+        rl = (f"**{levers[option + '_cost_ratio']:.2f}x** ({levers['env_steps_per_core_s_' + option]} against "
+              f"{levers['env_steps_per_core_s_plain']} env steps per core-second)"
+              if option + "_cost_ratio" in levers else "–")
+        lines.append(f"| `{option}` | {step} | {rl} |")
+    for record, path in ((env, env_path), (learner, learner_path)):
+        if record is not None:
+            lines += ["", f"Measured by {_measured_on(record)}; from `{path.relative_to(root)}`."]
+    return lines
+
+
 def _learner_lines(root: Path, preset: str) -> list[str]:
     path = root / "results" / preset / "bench" / "learner.json"
     if not path.exists():
@@ -276,7 +311,8 @@ def block_speed(root: Path, preset: str) -> str:
     config = workflow_config()
     # the preset's pair, and the pairs its claims are also read on (at the cpu preset, the from-scratch one)
     paired = [v for pair in claims_pairs({**config, "preset": preset}) for v in pair if v not in searchers.bounds()]
-    sections = [_env_lines(root, preset), _learner_lines(root, preset), _hosts_lines(root, preset),
+    sections = [_env_lines(root, preset), _learner_lines(root, preset), _memory_lever_lines(root, preset),
+                _hosts_lines(root, preset),
                 _schedule_check_lines(root, preset),
                 _training_lines(root, preset, list(dict.fromkeys(variants_of_all(config) + paired)))]
     return "\n\n".join("\n".join(lines) for lines in sections if lines) + "\n"
