@@ -290,10 +290,10 @@ def train_resources(preset):
     if preset == "cpu":
         # a per-step training with its teacher's episodes takes about an hour alone on the reference CPU, and
         # hosts differ up to 3x: the stored run's longest took 191 min (a 50 px variant with the target memory),
-        # its preset's own trainings up to 108 min; the largest held 3.3 GB (the map-image lever, whose replay
-        # keeps a 4 x 32 x 32 map a step; the others up to 2.5 GB), plus the job's own snakemake
-        # (tests/test_cluster.py reads them)
-        return dict(mem_mb=4000, runtime=6 * 60, gpu=0)
+        # its preset's own trainings up to 108 min; the largest held 4.8 GB (the map-image lever, whose replay
+        # keeps a 4 x 32 x 32 map a step, resumed from its checkpoint; from the start 3.3 GB; the others up to
+        # 2.5 GB), plus the job's own snakemake (tests/test_cluster.py reads them)
+        return dict(mem_mb=5500, runtime=6 * 60, gpu=0)
     return dict(mem_mb=1500, runtime=10, gpu=0)
 
 
