@@ -54,6 +54,7 @@ from egosearch.rl.replay import ReplayBuffer, replay_gb
 from egosearch.rl.train import torch_threads, train
 from egosearch.rl.training_aids import DemonstrationSettings, critic_reads_state, demonstration_settings
 from egosearch.runs.evaluate import scenario_evaluator
+from egosearch.sim.bench_env import OPTIONS_TIMED
 from egosearch.sim.env import PRIVILEGED_STATE_DIM
 from egosearch.sim.home_pool import curve_homes
 
@@ -275,9 +276,10 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True, memory_leve
     return result
 
 
-MEMORY_LEVER_OPTIONS = ("map_image", "strided_history")
+MEMORY_LEVER_OPTIONS = OPTIONS_TIMED
 """The observation options of the memory levers (issue "the student remembers where it has been") whose
-training cost ``bench learner --memory-levers`` measures beside the plain observation's."""
+training cost ``bench learner --memory-levers`` measures beside the plain observation's: those whose env step
+``bench env`` times, so that the two records name the same options."""
 
 
 def memory_lever_costs(quick: bool = False, rounds: int = 2) -> dict:
