@@ -245,8 +245,8 @@ def add_bench(sub) -> None:
     p.add_argument("--seeds", type=int, help="stacked: the seeds stacked, >= 2 (default 3)")
     p.add_argument("--memory-levers", action="store_true",
                    help="learner: also time the cpu preset's short training with each memory lever's observation "
-                        "(map_image, strided_history) beside the plain one, alternating, and print what each costs "
-                        "a training against it (about six minutes more)")
+                        "(the options `bench env` times) beside the plain one, two rounds alternating, and print what "
+                        "each costs a training against it (six more short trainings)")
     p.add_argument("--frames", type=int, help="env: sensor frames to time, >= 1 (default 3000)")
     p.add_argument("--steps", type=int, help="env: env steps to time, >= 1 (default 3000)")
     p.add_argument("--seconds", type=float, help="gpu: the training's wall time, > 0 (default 150)")

@@ -223,7 +223,7 @@ def bench_learner(quick: bool = False, cpu_profile_run: bool = True, memory_leve
     """Benchmarks of the learner (see the module docstring); ``quick`` for tests (~seconds);
     ``cpu_profile_run=False`` leaves out the cpu preset's training run (a GPU check times a real
     paper-preset training instead); ``memory_levers`` adds :func:`memory_lever_costs` under
-    ``"memory_levers"`` (about six minutes more)."""
+    ``"memory_levers"`` (two rounds of three short trainings more)."""
     keep_freed_memory()  # as a training does, so that its updates cost here what they cost there
     torch.set_num_threads(torch_threads(0))
     n = 3 if quick else 10
