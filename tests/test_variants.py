@@ -45,7 +45,8 @@ def test_bad_variant_files(tmp_path):
 
 # Fields that change how fast or how often a run reports, not what it learns.
 NOT_LEARNING = {"num_threads", "device", "compile", "cuda_graph", "channels_last", "share_encoder_forward",
-                "eval_episodes", "eval_every", "log_every", "checkpoint_every", "keep_checkpoint", "seed"}
+                "eval_episodes", "eval_every", "log_every", "checkpoint_every", "keep_checkpoint", "seed",
+                "actor_snapshot_every"}
 REPO = __import__("pathlib").Path(__file__).resolve().parent.parent
 
 

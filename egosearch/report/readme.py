@@ -551,8 +551,17 @@ def _reading_head(root: Path, preset: str) -> list[str]:
         cells.append(f"{r.height:g} m {where} {on_minus_off:+.3f} [{-r.ci_high:+.3f}, {-r.ci_low:+.3f}]")
     return ["- **Head on vs head off** (paper: head movement gives a 20% higher success rate): on every Table 1 "
             "scenario, head-on minus head-off is " + "; ".join(cells) + f" (95% intervals); head-off is lower after "
-            f"Holm in {lower} of {len(cells)} cells (`{path.relative_to(root)}`; Figure 6's curves read 30 episodes "
-            "a point and cannot tell)."]
+            f"Holm in {lower} of {len(cells)} cells (`{path.relative_to(root)}`; Figure 6's curves read "
+            f"{_curve_points_text(root, preset)} and cannot tell)."]
+
+
+def _curve_points_text(root: Path, preset: str) -> str:
+    """How many episodes a point of ``head_on``'s stored curve reads (its first seed's first point), in words."""
+    episodes = root / "results" / preset / "train" / "head_on" / "seed0" / "curve_episodes.csv"
+    if not episodes.exists():
+        return "fewer episodes than Table 1"
+    steps = pd.read_csv(episodes, usecols=["env_steps"])["env_steps"]
+    return f"{int((steps == steps.min()).sum())} episodes a point"
 
 
 def _reading_fig7(df: pd.DataFrame) -> list[str]:

@@ -343,7 +343,7 @@ def table2_rows(cfg: LearnerConfig) -> list[tuple[str, str]]:
 
 HOUSEKEEPING_FIELDS = frozenset({"eval_every", "eval_episodes", "log_every", "checkpoint_every", "seed", "device",
                                   "num_threads", "channels_last", "compile", "cuda_graph",
-                                  "keep_checkpoint"})
+                                  "keep_checkpoint", "actor_snapshot_every"})
 """Fields that change how a run is watched, saved or placed on the machine, never what it learns."""
 
 
