@@ -30,6 +30,29 @@ def test_a_pin_holds_a_value_the_cpu_profile_no_longer_has(name):
     assert not [key for key in pinned if getattr(cpu, key) == config[key]], "the cpu preset's own value again"
 
 
+def test_a_new_cpu_training_reads_its_curve_on_100_scenarios_and_keeps_its_actor_every_50k(tmp_path):
+    """The memory issue's Figure 6: 100 scenarios a point per seed (75 resolve a rise of 0.10 on 3 seeds), and
+    the actor kept at 50k, 100k, 150k and 200k env steps. A variant that pins nothing takes both."""
+    from egosearch.variants import resolve_variant
+
+    (tmp_path / "fresh_lever.yaml").write_text("name: fresh_lever\nenv_id: EgoSearch-v0\ntrain_env: "
+                                               "{layout: paper_homes, placement: everywhere}\n")
+    cfg = resolve_variant(load_variant("fresh_lever", tmp_path), "cpu").config
+    assert cfg.eval_episodes >= 100
+    snapshots = list(range(cfg.actor_snapshot_every, cfg.total_env_steps + 1, cfg.actor_snapshot_every))
+    assert snapshots == [50_000, 100_000, 150_000, 200_000]
+
+
+@pytest.mark.parametrize("side", ["head_on", "head_off"])
+def test_the_stored_pair_trains_as_the_variant_its_runs_were_made_as(side):
+    """head_on's and head_off's stored runs were trained as *_curve100 and copied: the two resolve alike."""
+    from egosearch.variants import resolve_variant
+
+    stored, made_as = resolve_variant(side, "cpu"), resolve_variant(f"{side}_curve100", "cpu")
+    assert stored.env_id == made_as.env_id and stored.train_env == made_as.train_env
+    assert stored.config.to_dict() == made_as.config.to_dict()
+
+
 def test_bad_variant_files(tmp_path):
     (tmp_path / "typo.yaml").write_text("name: typo\nenv_id: EgoSearch-v1\ntrain_env: {layout: kitchen_living, "
                                         "placement: everywhere}\n")
