@@ -607,8 +607,8 @@ ISSUE_CASES = [
      ["train", "--variant", "head_on", "--preset", "smoke", "--out-dir", "{t}/run"],
      # at smoke head_on has its cpu learner and observation (issue 73): what differs is every size of the run
      "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: "
-     "actor_hidden_dim=256 (now 64), batch_size=64 (now 32), bc_decay_steps=100000 (now 150), bc_updates=12000 "
-     "(now 20) ...; use another out_dir"),
+     "actor_hidden_dim=256 (now 64), actor_snapshot_every=50000 (now 150), batch_size=64 (now 32), "
+     "bc_decay_steps=100000 (now 150) ...; use another out_dir"),
     ("train_into_a_run_of_another_seed", "traceback", ["train", "--variant", "head_on", "--seed", "5", "--out-dir",
                                                        "{t}/run"],
      "egosearch train: error: --out-dir: finished run {t}/run/done.json was written with a different config: seed=0 "

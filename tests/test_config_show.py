@@ -57,8 +57,8 @@ def test_the_curriculum_radii_are_fields_and_stored_runs_load_without_them():
     assert narrow.start_radius(50) == 2.0
     with pytest.raises(ValueError, match="curriculum_start_radius=5.0 is out of range"):
         load_config("cpu", {"curriculum_start_radius": 5.0, "curriculum_end_radius": 3.0})
-    stored = REPO / "results/cpu/train/head_on/seed0/config.json"
-    if stored.exists():  # recorded before the fields: loads at their defaults
+    stored = REPO / "results/cpu/train/head_off_imitation_finetune/seed0/config.json"
+    if stored.exists():  # a pair kept under its name, recorded before the fields: loads at their defaults
         recorded = json.loads(stored.read_text())["config"]
         assert "curriculum_end_radius" not in recorded
         assert LearnerConfig.from_stored(recorded).curriculum_end_radius == 12.0
