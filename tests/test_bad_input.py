@@ -1988,7 +1988,7 @@ ISSUE73_CONFIGS = [
      "config claims_pairs: ['frontier_head_off', 'frontier'] is frontier_head_off (head fixed), frontier (head "
      "moving); a pair is [head moving, head fixed]"),
     ("screen_seeds_past_numpys_seed", "cryptic",  # the DAG ran; the fifth training failed in its job
-     {"variant": "head_off", "screen_seed": BIG - 1}, "screen",
+     {"variant": "head_off", "screen_seed": BIG - 1, "screen_seeds": 5}, "screen",
      f"config screen_seed: {BIG - 1} with screen_seeds=5 trains seeds up to {BIG + 3}, which {SEED_BOUND}"),
     ("preset_seed_past_numpys_seed", "cryptic", _preset("smoke", seeds=[BIG]), "all",
      f"config presets/smoke/seeds: {BIG} {SEED_BOUND}"),
