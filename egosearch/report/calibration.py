@@ -38,7 +38,8 @@ import pandas as pd
 from egosearch.report.seed_spread import seed_spread, seed_spread_test
 
 CANDIDATE_SEEDS = (1, 2, 3, 6)
-"""The screens simulated: one and two seeds (the stored lever screens), three, and the default screen_seeds."""
+"""The screens simulated: one, two and three seeds (the stored lever screens) and six. The workflow's default
+screen_seeds (the power analysis's recommendation, which follows the reference's spread) is not itself simulated."""
 RHOS = (0.0, 0.5, 0.7, 0.9)
 """How closely one seed's shifts move together between cells: the stored record says how closely the stored seed
 means correlate (:func:`~egosearch.report.null_screen.cell_correlation`), and five seeds cannot say it precisely."""
